@@ -1,0 +1,5 @@
+//! Contact between a point and an oriented box.
+
+use crate::shape::{Point, Obb};
+
+super::sat_contact!(Point, Obb);

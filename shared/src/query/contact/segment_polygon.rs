@@ -1,0 +1,5 @@
+//! Contact between a segment and a convex polygon.
+
+use crate::shape::{Segment, ConvexPolygon};
+
+super::sat_contact!(Segment, ConvexPolygon);

@@ -1,0 +1,1 @@
+//! Ray casts against every shape kind (first hit, distance, normal).
