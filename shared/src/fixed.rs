@@ -36,9 +36,8 @@ pub const MAX_EXTENT: i32 = 1 << 27;
 pub const MAX_SPEED: i32 = 1 << 26;
 
 // The headroom argument in the module docs, checked by the compiler.
-const _: () = assert!(
-    (MAX_COORD as i64) + 2 * (MAX_EXTENT as i64) + (MAX_SPEED as i64) < i32::MAX as i64
-);
+const _: () =
+    assert!((MAX_COORD as i64) + 2 * (MAX_EXTENT as i64) + (MAX_SPEED as i64) < i32::MAX as i64);
 
 /// Whole pixels to units.
 #[inline]
@@ -229,7 +228,7 @@ mod tests {
         assert_eq!(line_order(x, diag), Ordering::Less);
         assert_eq!(line_order(diag, y), Ordering::Less);
         assert_eq!(line_order(-diag, diag), Ordering::Equal);
-        assert_eq!(line_order(y, -x), Ordering::Less);
+        assert_eq!(line_order(y, -x), Ordering::Greater);
     }
 
     proptest! {

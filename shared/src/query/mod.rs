@@ -5,3 +5,4 @@ pub mod contact;
 pub mod ray;
 
 pub use contact::{contact, Contact, Proximity};
+pub use ray::{cast_ray, Ray, RayCast, RayHit, Toi};

@@ -1,0 +1,71 @@
+//! Everything that can go wrong on the client side of a connection.
+
+use ledge_server::framing::FrameError;
+use ledge_server::protocol::{CloseCode, RejectReason};
+use ledge_server::Fingerprint;
+
+/// Why connecting or talking to a server failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ClientError {
+    /// `HOST:PORT` could not be parsed or resolved.
+    #[error("cannot resolve server address {0:?} (expected HOST:PORT)")]
+    Address(String),
+    /// The local UDP socket could not be opened.
+    #[error("cannot open a UDP socket: {0}")]
+    Socket(std::io::Error),
+    /// The TLS/QUIC client configuration was refused.
+    #[error("client TLS configuration: {0}")]
+    Config(String),
+    /// quinn refused to start the connection (e.g. an invalid server name).
+    #[error("cannot connect: {0}")]
+    Connect(#[from] quinn::ConnectError),
+    /// The server's certificate is not the pinned one.
+    #[error("server certificate fingerprint is {presented}, expected {expected}")]
+    FingerprintMismatch {
+        /// The pinned fingerprint.
+        expected: Fingerprint,
+        /// The fingerprint of the certificate the server presented.
+        presented: Fingerprint,
+    },
+    /// The server closed the connection with an application close code.
+    #[error("server closed the connection ({code:?}): {reason}")]
+    ClosedByServer {
+        /// The close code, if this version knows it.
+        code: Option<CloseCode>,
+        /// The server's reason text.
+        reason: String,
+    },
+    /// The connection failed (handshake, timeout, reset, ...).
+    #[error("connection failed: {0}")]
+    Connection(quinn::ConnectionError),
+    /// The server refused the hello.
+    #[error("server rejected us: {0}")]
+    Rejected(RejectReason),
+    /// A frame or message from the server was malformed or the stream broke.
+    #[error("control stream: {0}")]
+    Frame(#[from] FrameError),
+    /// The server sent a valid message at the wrong time.
+    #[error("unexpected message from server: {0}")]
+    Unexpected(String),
+    /// The server ended the control stream.
+    #[error("server ended the control stream")]
+    StreamEnded,
+    /// The server did not answer in time.
+    #[error("server did not answer in time")]
+    Timeout,
+}
+
+impl ClientError {
+    /// Classifies a quinn connection error, decoding application closes.
+    pub fn from_connection_error(error: quinn::ConnectionError) -> ClientError {
+        match error {
+            quinn::ConnectionError::ApplicationClosed(close) => ClientError::ClosedByServer {
+                code: u32::try_from(close.error_code.into_inner())
+                    .ok()
+                    .and_then(CloseCode::from_u32),
+                reason: String::from_utf8_lossy(&close.reason).into_owned(),
+            },
+            other => ClientError::Connection(other),
+        }
+    }
+}

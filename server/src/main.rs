@@ -1,0 +1,111 @@
+//! `ledge-server`: host a ledge game.
+//!
+//! Prints the certificate fingerprint clients must pin, then runs until
+//! Ctrl-C or SIGTERM and shuts down gracefully.
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Parser;
+use ledge_server::config::{
+    DEFAULT_BIND, DEFAULT_CERT_DIR, DEFAULT_MAX_CATCH_UP, DEFAULT_TICK_RATE,
+};
+use ledge_server::{Server, ServerConfig};
+use tracing_subscriber::EnvFilter;
+
+/// Authoritative ledge server (QUIC over UDP).
+#[derive(Debug, Parser)]
+#[command(version)]
+struct Cli {
+    /// UDP address to listen on.
+    #[arg(long, default_value = DEFAULT_BIND)]
+    bind: SocketAddr,
+    /// Directory of the certificate and key (created on first start).
+    #[arg(long, default_value = DEFAULT_CERT_DIR)]
+    cert_dir: PathBuf,
+    /// Simulation ticks per second.
+    #[arg(long, default_value_t = DEFAULT_TICK_RATE,
+          value_parser = clap::value_parser!(u32).range(1..=1000))]
+    tick_rate: u32,
+}
+
+#[tokio::main]
+async fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    tracing_subscriber::fmt()
+        .with_env_filter(EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()))
+        .init();
+
+    let config = ServerConfig {
+        bind: cli.bind,
+        cert_dir: cli.cert_dir,
+        tick_rate: cli.tick_rate,
+        max_catch_up: DEFAULT_MAX_CATCH_UP,
+    };
+    let server = Server::bind(config.clone()).with_context(|| {
+        format!(
+            "starting the server on {} with certificates in {}",
+            config.bind,
+            config.cert_dir.display()
+        )
+    })?;
+    let fingerprint = server.fingerprint();
+    let port = server.local_addr().port();
+    println!("ledge server listening on {}", server.local_addr());
+    println!("certificate SHA-256 fingerprint: {fingerprint}");
+    println!(
+        "connect with: cargo run --release -p ledge-client -- \
+         --connect 127.0.0.1:{port} --cert-hash {fingerprint} --name YOUR_NAME"
+    );
+
+    let signals = ShutdownSignals::install().context("installing signal handlers")?;
+    let shutdown = server.shutdown_handle();
+    tokio::spawn(async move {
+        let signal = signals.recv().await;
+        tracing::info!("{signal} received");
+        shutdown.shutdown();
+    });
+    server.run().await.context("running the server")
+}
+
+/// Ctrl-C and, on Unix, SIGTERM.
+struct ShutdownSignals {
+    #[cfg(unix)]
+    term: tokio::signal::unix::Signal,
+}
+
+impl ShutdownSignals {
+    /// Registers the handlers now, so a failure stops the start-up.
+    fn install() -> std::io::Result<ShutdownSignals> {
+        Ok(ShutdownSignals {
+            #[cfg(unix)]
+            term: tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?,
+        })
+    }
+
+    /// Resolves on the first signal, naming it.
+    async fn recv(mut self) -> &'static str {
+        let ctrl_c = async {
+            match tokio::signal::ctrl_c().await {
+                Ok(()) => "Ctrl-C",
+                Err(e) => {
+                    tracing::error!("cannot listen for Ctrl-C: {e}");
+                    std::future::pending().await
+                }
+            }
+        };
+        #[cfg(unix)]
+        {
+            tokio::select! {
+                name = ctrl_c => name,
+                _ = self.term.recv() => "SIGTERM",
+            }
+        }
+        #[cfg(not(unix))]
+        {
+            let _ = &mut self;
+            ctrl_c.await
+        }
+    }
+}

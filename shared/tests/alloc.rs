@@ -1,0 +1,90 @@
+//! No allocation per tick in steady state: a counting global allocator
+//! watches many ticks of the warm-up room after a warm-up period.
+//!
+//! Only allocations made by the test's own thread while counting is on are
+//! counted (the test harness's threads may allocate at any time).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use ledge_shared::scene::{run_scripted, scripted_inputs, warmup_room};
+use ledge_shared::world::Event;
+
+struct Counting;
+
+static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+
+thread_local! {
+    static COUNTING: Cell<bool> = const { Cell::new(false) };
+}
+
+fn note() {
+    if COUNTING.try_with(Cell::get).unwrap_or(false) {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+// SAFETY: every call is forwarded unchanged to the system allocator.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        note();
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        note();
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        note();
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Counts allocations made by `f` on this thread.
+fn allocations(f: impl FnOnce()) -> u64 {
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    COUNTING.with(|c| c.set(true));
+    f();
+    COUNTING.with(|c| c.set(false));
+    ALLOCATIONS.load(Ordering::Relaxed) - before
+}
+
+#[test]
+fn the_counter_counts() {
+    let n = allocations(|| {
+        std::hint::black_box(vec![1u8; 16]);
+    });
+    assert_eq!(n, 1);
+}
+
+#[test]
+fn warmup_room_ticks_allocate_nothing_in_steady_state() {
+    let mut world = warmup_room();
+    // Warm-up: the buffers grow to the scene's needs.
+    run_scripted(&mut world, 5_000);
+    let mut kinds = [0u64; 3];
+    let n = allocations(|| {
+        for _ in 0..60_000 {
+            let input = scripted_inputs(world.tick());
+            for e in world.step(&[input]) {
+                kinds[match e {
+                    Event::Contact { .. } => 0,
+                    Event::Trigger { .. } => 1,
+                    Event::Squished { .. } => 2,
+                }] += 1;
+            }
+            std::hint::black_box(world.state_hash());
+        }
+    });
+    assert_eq!(n, 0, "allocations during 60,000 steady-state ticks");
+    // The run exercised contacts (restitution) and triggers, and their events.
+    assert!(kinds[0] > 1_000, "contact events: {kinds:?}");
+    assert!(kinds[1] > 100, "trigger events: {kinds:?}");
+}
