@@ -1,5 +1,5 @@
 //! Narrow phase cost in ns per pair for every pair of shape kinds, and one
-//! tick of the warm-up room.
+//! tick of the warm-up room (`tick/warmup_room`).
 //!
 //! `cargo bench -p ledge-shared --bench narrow_phase`; `docs/PERFORMANCE.md`
 //! has the table. Each pair is timed over a fixed batch of placements drawn
@@ -133,5 +133,21 @@ fn narrow(c: &mut Criterion) {
     bench_pair::<ConvexPolygon, ConvexPolygon>(c, "polygon_polygon");
 }
 
-criterion_group!(benches, narrow);
+/// One tick of the warm-up room under the scripted inputs (steady state:
+/// the room is warmed up first so the buffers are allocated).
+fn warmup_tick(c: &mut Criterion) {
+    let mut world = ledge_shared::scene::warmup_room();
+    for t in 0..600 {
+        world.step(&[ledge_shared::scene::scripted_inputs(t)]);
+    }
+    let mut t = 600u64;
+    c.bench_function("tick/warmup_room", |bench| {
+        bench.iter(|| {
+            t += 1;
+            world.step(&[ledge_shared::scene::scripted_inputs(t)]).len()
+        })
+    });
+}
+
+criterion_group!(benches, narrow, warmup_tick);
 criterion_main!(benches);

@@ -1,0 +1,335 @@
+//! Control-stream messages: one reliable, ordered QUIC stream per session,
+//! each message one length-prefixed frame (see [`super::frame`]).
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+use super::codec::{bytes, Message};
+use super::datagram::Snapshot;
+use super::{ProtocolError, MAX_FRAME, PROTOCOL_VERSION};
+
+/// Longest player name, in bytes of UTF-8.
+pub const MAX_NAME_LEN: usize = 32;
+/// Longest chat line, in bytes of UTF-8.
+pub const MAX_CHAT_LEN: usize = 256;
+/// Longest room name or level id, in bytes of UTF-8.
+pub const MAX_ID_LEN: usize = 64;
+/// Longest free-text reason or notice, in bytes of UTF-8.
+pub const MAX_REASON_LEN: usize = 256;
+/// Longest opaque simulation-config blob in [`Welcome::sim_config`].
+pub const MAX_SIM_CONFIG_LEN: usize = 4096;
+
+/// Checks a text field: `min..=max` bytes of UTF-8, no control characters
+/// (which covers newlines, escapes and NUL).
+pub fn check_text(
+    field: &'static str,
+    text: &str,
+    min: usize,
+    max: usize,
+) -> Result<(), ProtocolError> {
+    if text.len() < min {
+        return Err(ProtocolError::InvalidString {
+            field,
+            problem: "empty",
+        });
+    }
+    if text.len() > max {
+        return Err(ProtocolError::InvalidString {
+            field,
+            problem: "too long",
+        });
+    }
+    if text.chars().any(char::is_control) {
+        return Err(ProtocolError::InvalidString {
+            field,
+            problem: "contains control characters",
+        });
+    }
+    Ok(())
+}
+
+/// Checks a player name: 1..=[`MAX_NAME_LEN`] bytes, no control characters.
+pub fn check_name(name: &str) -> Result<(), ProtocolError> {
+    check_text("player name", name, 1, MAX_NAME_LEN)
+}
+
+/// Checks a peer's protocol version against [`PROTOCOL_VERSION`].
+pub fn check_version(theirs: u32) -> Result<(), ProtocolError> {
+    if theirs == PROTOCOL_VERSION {
+        Ok(())
+    } else {
+        Err(ProtocolError::BadVersion {
+            ours: PROTOCOL_VERSION,
+            theirs,
+        })
+    }
+}
+
+/// A player's id, unique within one server run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+pub struct PlayerId(pub u32);
+
+impl fmt::Display for PlayerId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "#{}", self.0)
+    }
+}
+
+/// Messages a client sends on the control stream.
+///
+/// **Compatibility:** `Hello` is variant 0 and its fields never change, so a
+/// server can always read a client's version and answer
+/// [`RejectReason::ProtocolVersion`] instead of failing to decode.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ClientControl {
+    /// Opens the session; must be the first message, and the only `Hello`.
+    Hello {
+        /// The client's [`PROTOCOL_VERSION`]. Not checked by the decoder:
+        /// the server checks it ([`check_version`]) and rejects politely.
+        version: u32,
+        /// Display name, checked by [`check_name`].
+        name: String,
+    },
+    /// A chat line: 1..=[`MAX_CHAT_LEN`] bytes, no control characters.
+    Chat {
+        /// The line.
+        text: String,
+    },
+    /// Asks for a [`ServerControl::Pong`] with the same nonce (liveness,
+    /// round-trip time).
+    Ping {
+        /// Echoed back.
+        nonce: u64,
+    },
+    /// The client is leaving; the server closes the connection normally.
+    Leave,
+}
+
+impl Message for ClientControl {
+    const WHAT: &'static str = "client control message";
+    const MAX_LEN: usize = MAX_FRAME;
+
+    fn validate(&self) -> Result<(), ProtocolError> {
+        match self {
+            ClientControl::Hello { name, .. } => check_name(name),
+            ClientControl::Chat { text } => check_text("chat text", text, 1, MAX_CHAT_LEN),
+            ClientControl::Ping { .. } | ClientControl::Leave => Ok(()),
+        }
+    }
+}
+
+/// Tick timing of a room, sent in [`Welcome`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct NetTiming {
+    /// Simulation ticks per second (60 by default).
+    pub tick_rate: u32,
+    /// A snapshot is sent every this many ticks (snapshot rate =
+    /// `tick_rate / snapshot_interval`).
+    pub snapshot_interval: u32,
+    /// How many ticks of input each [`super::InputPacket`] should repeat.
+    pub input_redundancy: u8,
+}
+
+impl NetTiming {
+    fn validate(&self) -> Result<(), ProtocolError> {
+        let bad = |detail| ProtocolError::malformed("welcome timing", detail);
+        if self.tick_rate == 0 || self.tick_rate > 1000 {
+            return Err(bad("tick rate outside 1..=1000 Hz"));
+        }
+        if self.snapshot_interval == 0 || self.snapshot_interval > self.tick_rate {
+            return Err(bad("snapshot interval outside 1..=tick rate"));
+        }
+        if self.input_redundancy == 0 || self.input_redundancy as usize > super::MAX_INPUT_HISTORY {
+            return Err(bad("input redundancy outside 1..=MAX_INPUT_HISTORY"));
+        }
+        Ok(())
+    }
+}
+
+/// The server's answer to an accepted `Hello`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Welcome {
+    /// The id the server gave this player.
+    pub player_id: PlayerId,
+    /// The room joined (1..=[`MAX_ID_LEN`] bytes, no control characters).
+    pub room: String,
+    /// The level being played (same rules as `room`).
+    pub level_id: String,
+    /// Hash of the level's content, so a client can check its copy.
+    pub level_hash: u64,
+    /// The room's simulation tick when the player joined.
+    pub server_tick: u64,
+    /// Tick and snapshot rates.
+    pub timing: NetTiming,
+    /// The simulation configuration the client must predict with, encoded by
+    /// the world (opaque here), at most [`MAX_SIM_CONFIG_LEN`] bytes.
+    #[serde(with = "bytes")]
+    pub sim_config: Vec<u8>,
+}
+
+/// Why the server refused a `Hello`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub enum RejectReason {
+    /// The client speaks another protocol version.
+    ProtocolVersion {
+        /// The version the server speaks.
+        server: u32,
+        /// The version the client announced.
+        client: u32,
+    },
+    /// The name is empty, too long or contains control characters.
+    InvalidName,
+    /// The room is full.
+    RoomFull,
+    /// The server is shutting down.
+    ShuttingDown,
+    /// Anything else, explained (at most [`MAX_REASON_LEN`] bytes).
+    Other {
+        /// Why.
+        reason: String,
+    },
+}
+
+impl fmt::Display for RejectReason {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RejectReason::ProtocolVersion { server, client } => write!(
+                f,
+                "protocol version mismatch: server speaks {server}, client {client}"
+            ),
+            RejectReason::InvalidName => write!(
+                f,
+                "invalid player name (1..={MAX_NAME_LEN} bytes, no control characters)"
+            ),
+            RejectReason::RoomFull => f.write_str("the room is full"),
+            RejectReason::ShuttingDown => f.write_str("the server is shutting down"),
+            RejectReason::Other { reason } => f.write_str(reason),
+        }
+    }
+}
+
+/// What a [`ServerControl::Notice`] announces.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub enum NoticeKind {
+    /// The server is shutting down; the connection closes next.
+    Shutdown,
+    /// This client is being disconnected.
+    Kick {
+        /// Why (at most [`MAX_REASON_LEN`] bytes).
+        reason: String,
+    },
+    /// Informational text for the player (at most [`MAX_REASON_LEN`] bytes).
+    Info {
+        /// The text.
+        text: String,
+    },
+}
+
+/// Messages the server sends on the control stream.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ServerControl {
+    /// The `Hello` was accepted.
+    Welcome(Welcome),
+    /// The `Hello` was refused; the server closes the connection next.
+    Reject {
+        /// Why.
+        reason: RejectReason,
+    },
+    /// A chat line from a player.
+    Chat {
+        /// Who said it.
+        from: PlayerId,
+        /// The line (same rules as [`ClientControl::Chat`]).
+        text: String,
+    },
+    /// A server announcement.
+    Notice {
+        /// What it announces.
+        kind: NoticeKind,
+    },
+    /// A snapshot too large for one datagram (see [`super::Outgoing`]); it
+    /// is the same [`Snapshot`] (full or delta) a datagram would carry.
+    FullState(Snapshot),
+    /// Answer to [`ClientControl::Ping`] with the same nonce.
+    Pong {
+        /// The ping's nonce.
+        nonce: u64,
+    },
+}
+
+impl Message for ServerControl {
+    const WHAT: &'static str = "server control message";
+    const MAX_LEN: usize = MAX_FRAME;
+
+    fn validate(&self) -> Result<(), ProtocolError> {
+        match self {
+            ServerControl::Welcome(w) => {
+                check_text("room name", &w.room, 1, MAX_ID_LEN)?;
+                check_text("level id", &w.level_id, 1, MAX_ID_LEN)?;
+                w.timing.validate()?;
+                if w.sim_config.len() > MAX_SIM_CONFIG_LEN {
+                    return Err(ProtocolError::too_large(
+                        "welcome sim config",
+                        w.sim_config.len(),
+                        MAX_SIM_CONFIG_LEN,
+                    ));
+                }
+                Ok(())
+            }
+            ServerControl::Reject { reason } => match reason {
+                RejectReason::Other { reason } => {
+                    check_text("reject reason", reason, 0, MAX_REASON_LEN)
+                }
+                _ => Ok(()),
+            },
+            ServerControl::Chat { text, .. } => check_text("chat text", text, 1, MAX_CHAT_LEN),
+            ServerControl::Notice { kind } => match kind {
+                NoticeKind::Shutdown => Ok(()),
+                NoticeKind::Kick { reason } => check_text("kick reason", reason, 0, MAX_REASON_LEN),
+                NoticeKind::Info { text } => check_text("notice text", text, 0, MAX_REASON_LEN),
+            },
+            ServerControl::FullState(snapshot) => snapshot.validate(),
+            ServerControl::Pong { .. } => Ok(()),
+        }
+    }
+}
+
+/// Application close codes of a QUIC connection, so either side can tell
+/// why the other hung up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[repr(u32)]
+pub enum CloseCode {
+    /// Normal end of a session (the client left).
+    Normal = 0,
+    /// The peer sent a malformed or unexpected frame or message.
+    ProtocolViolation = 1,
+    /// The server refused the `Hello` (a [`ServerControl::Reject`] precedes it).
+    Rejected = 2,
+    /// The peer did not send what was due in time.
+    Timeout = 3,
+    /// The server is shutting down.
+    ServerShutdown = 4,
+    /// The server kicked the client (a [`NoticeKind::Kick`] precedes it).
+    Kicked = 5,
+}
+
+impl CloseCode {
+    /// The code as sent on the wire.
+    pub fn to_u32(self) -> u32 {
+        self as u32
+    }
+
+    /// Decodes a wire code; `None` for codes this version does not know.
+    pub fn from_u32(code: u32) -> Option<CloseCode> {
+        Some(match code {
+            0 => CloseCode::Normal,
+            1 => CloseCode::ProtocolViolation,
+            2 => CloseCode::Rejected,
+            3 => CloseCode::Timeout,
+            4 => CloseCode::ServerShutdown,
+            5 => CloseCode::Kicked,
+            _ => return None,
+        })
+    }
+}

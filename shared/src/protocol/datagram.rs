@@ -1,0 +1,246 @@
+//! Unreliable datagrams: inputs (client to server) and snapshots (server to
+//! client), plus the choice between a datagram and the control stream for a
+//! snapshot too large for one.
+
+use serde::{Deserialize, Serialize};
+
+use super::codec::{bytes, Message};
+use super::frame::write_frame;
+use super::snapshot::{decode_delta, encode_delta, peek_delta, StateSnapshot};
+use super::{
+    ProtocolError, ServerControl, MAX_DELTA_LEN, MAX_FRAME, MAX_INPUT_DATAGRAM, MAX_INPUT_HISTORY,
+};
+use crate::input::Buttons;
+
+/// Serde helper: `Vec<Buttons>` as one byte string, one byte per tick.
+mod buttons {
+    use super::Buttons;
+    use serde::{Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &[Buttons], s: S) -> Result<S::Ok, S::Error> {
+        let raw: Vec<u8> = v.iter().map(|b| b.0).collect();
+        super::bytes::serialize(&raw, s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Buttons>, D::Error> {
+        Ok(super::bytes::deserialize(d)?
+            .into_iter()
+            .map(Buttons)
+            .collect())
+    }
+}
+
+/// A client's input datagram, sent every tick: the buttons of the newest
+/// tick and of the ticks before it, so one lost datagram (or several in a
+/// row, up to the redundancy) costs nothing.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct InputPacket {
+    /// The tick of `buttons[0]`.
+    pub newest_tick: u64,
+    /// Buttons newest first: `buttons[i]` is for tick `newest_tick - i`.
+    /// 1..=[`MAX_INPUT_HISTORY`] entries, never before tick 0.
+    #[serde(with = "buttons")]
+    pub buttons: Vec<Buttons>,
+    /// Tick of the newest snapshot the client has decoded (its delta
+    /// baseline), `None` before the first.
+    pub ack_snapshot: Option<u64>,
+}
+
+impl InputPacket {
+    /// A packet for `newest_tick` repeating `newest_first` (truncated to
+    /// [`MAX_INPUT_HISTORY`] and to the ticks that exist).
+    pub fn new(newest_tick: u64, newest_first: &[Buttons], ack_snapshot: Option<u64>) -> Self {
+        let n = newest_first
+            .len()
+            .min(MAX_INPUT_HISTORY)
+            .min(usize::try_from(newest_tick).map_or(usize::MAX, |t| t.saturating_add(1)));
+        InputPacket {
+            newest_tick,
+            buttons: newest_first[..n].to_vec(),
+            ack_snapshot,
+        }
+    }
+
+    /// Oldest tick carried.
+    pub fn oldest_tick(&self) -> u64 {
+        self.newest_tick
+            .saturating_sub(self.buttons.len().saturating_sub(1) as u64)
+    }
+
+    /// `(tick, buttons)` pairs, newest first.
+    pub fn ticks(&self) -> impl Iterator<Item = (u64, Buttons)> + '_ {
+        self.buttons
+            .iter()
+            .enumerate()
+            .map_while(|(i, b)| Some((self.newest_tick.checked_sub(i as u64)?, *b)))
+    }
+
+    /// The buttons carried for `tick`, if any.
+    pub fn get(&self, tick: u64) -> Option<Buttons> {
+        let back = self.newest_tick.checked_sub(tick)?;
+        self.buttons.get(usize::try_from(back).ok()?).copied()
+    }
+}
+
+impl Message for InputPacket {
+    const WHAT: &'static str = "input packet";
+    const MAX_LEN: usize = MAX_INPUT_DATAGRAM;
+
+    fn validate(&self) -> Result<(), ProtocolError> {
+        let n = self.buttons.len();
+        if n == 0 {
+            return Err(ProtocolError::malformed(Self::WHAT, "no buttons"));
+        }
+        if n > MAX_INPUT_HISTORY {
+            return Err(ProtocolError::too_large(
+                "input history",
+                n,
+                MAX_INPUT_HISTORY,
+            ));
+        }
+        if (n - 1) as u64 > self.newest_tick {
+            return Err(ProtocolError::malformed(
+                Self::WHAT,
+                "buttons for ticks before 0",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// How early (positive) or late (negative), in ticks, an input for
+/// `input_tick` arrived when the server was about to simulate `server_tick`
+/// (saturating): the value of [`Snapshot::input_timing`]. Clients steer
+/// their clock to keep it slightly positive.
+pub fn input_timing(input_tick: u64, server_tick: u64) -> i16 {
+    let d = input_tick as i128 - server_tick as i128;
+    d.clamp(i16::MIN as i128, i16::MAX as i128) as i16
+}
+
+/// A snapshot for one client: a delta-encoded [`StateSnapshot`] and that
+/// client's input bookkeeping. Sent as a datagram, or inside
+/// [`ServerControl::FullState`] when it does not fit one.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Snapshot {
+    /// The tick of the state.
+    pub tick: u64,
+    /// The state the delta is against (a snapshot the client acknowledged);
+    /// `None`: a full snapshot.
+    pub baseline_tick: Option<u64>,
+    /// Newest tick of this client's input the server has applied, `None`
+    /// before the first: the client replays its inputs after it.
+    pub last_input_tick: Option<u64>,
+    /// How early (+) or late (-), in ticks, this client's inputs arrive
+    /// (see [`input_timing`]).
+    pub input_timing: i16,
+    /// The state, encoded by [`encode_delta`] (at most [`MAX_DELTA_LEN`]).
+    #[serde(with = "bytes")]
+    pub delta: Vec<u8>,
+}
+
+impl Snapshot {
+    /// Encodes `current` against `baseline` (`None`: full).
+    pub fn new(
+        baseline: Option<&StateSnapshot>,
+        current: &StateSnapshot,
+        last_input_tick: Option<u64>,
+        input_timing: i16,
+    ) -> Result<Self, ProtocolError> {
+        let mut delta = Vec::new();
+        encode_delta(baseline, current, &mut delta)?;
+        if delta.len() > MAX_DELTA_LEN {
+            return Err(ProtocolError::too_large(
+                "snapshot delta",
+                delta.len(),
+                MAX_DELTA_LEN,
+            ));
+        }
+        Ok(Snapshot {
+            tick: current.tick,
+            baseline_tick: baseline.map(|b| b.tick),
+            last_input_tick,
+            input_timing,
+            delta,
+        })
+    }
+
+    /// Decodes the state against `baseline`, which must be the snapshot of
+    /// [`Snapshot::baseline_tick`] (else [`ProtocolError::BaselineMismatch`]).
+    pub fn decode_state(
+        &self,
+        baseline: Option<&StateSnapshot>,
+    ) -> Result<StateSnapshot, ProtocolError> {
+        let given = baseline.map(|b| b.tick);
+        if given != self.baseline_tick {
+            return Err(ProtocolError::BaselineMismatch {
+                needed: self.baseline_tick,
+                given,
+            });
+        }
+        let state = decode_delta(baseline, &self.delta)?;
+        if state.tick != self.tick {
+            return Err(ProtocolError::malformed(
+                Self::WHAT,
+                "delta tick differs from the envelope's",
+            ));
+        }
+        Ok(state)
+    }
+
+    /// Encodes the snapshot for sending: as a datagram if it fits
+    /// `max_datagram_size` (`quinn::Connection::max_datagram_size()`; `None`:
+    /// datagrams unavailable), else as a framed
+    /// [`ServerControl::FullState`] for the control stream.
+    pub fn into_outgoing(
+        self,
+        max_datagram_size: Option<usize>,
+    ) -> Result<Outgoing, ProtocolError> {
+        let datagram = self.encode()?;
+        if max_datagram_size.is_some_and(|max| fits(datagram.len(), max)) {
+            return Ok(Outgoing::Datagram(datagram));
+        }
+        let mut frame = Vec::with_capacity(datagram.len() + 8);
+        write_frame(&ServerControl::FullState(self), &mut frame)?;
+        Ok(Outgoing::Control(frame))
+    }
+}
+
+impl Message for Snapshot {
+    const WHAT: &'static str = "snapshot";
+    // Also carried in a control frame, with a one-byte variant tag.
+    const MAX_LEN: usize = MAX_FRAME - 1;
+
+    fn validate(&self) -> Result<(), ProtocolError> {
+        if self.delta.len() > MAX_DELTA_LEN {
+            return Err(ProtocolError::too_large(
+                "snapshot delta",
+                self.delta.len(),
+                MAX_DELTA_LEN,
+            ));
+        }
+        if peek_delta(&self.delta)? != (self.tick, self.baseline_tick) {
+            return Err(ProtocolError::malformed(
+                Self::WHAT,
+                "delta header disagrees with the envelope's ticks",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Whether an encoded message of `len` bytes fits a datagram of at most
+/// `max_datagram_size` bytes.
+#[inline]
+pub fn fits(len: usize, max_datagram_size: usize) -> bool {
+    len <= max_datagram_size
+}
+
+/// An encoded snapshot and where to send it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Outgoing {
+    /// Send these bytes as one unreliable datagram.
+    Datagram(Vec<u8>),
+    /// Write these bytes (a complete frame, length prefix included) to the
+    /// control stream.
+    Control(Vec<u8>),
+}

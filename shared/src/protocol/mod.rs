@@ -1,0 +1,76 @@
+//! The wire protocol: versioned message types, their encodings, and
+//! delta-compressed snapshots. Pure (sans-IO): bytes in, values out, no
+//! sockets or clocks, and no panic on any input.
+//!
+//! A session is one QUIC connection with
+//!
+//! * one reliable bidirectional **control stream** of length-prefixed frames
+//!   ([`write_frame`], [`FrameDecoder`]) carrying [`ClientControl`] and
+//!   [`ServerControl`] (hello / welcome, chat, notices, pings, and snapshots
+//!   too large for a datagram);
+//! * unreliable **datagrams**: [`InputPacket`] from client to server every
+//!   tick (repeating the last ticks' buttons) and [`Snapshot`] from server to
+//!   client every few ticks, each delta-encoded ([`encode_delta`]) against the
+//!   newest snapshot the client acknowledged.
+//!
+//! Messages and envelopes use bincode 2 through serde with a size limit
+//! ([`Message`]); the entity state inside a snapshot uses a smaller
+//! hand-written varint format ([`snapshot`]). `docs/PROTOCOL.md` documents
+//! the wire format byte by byte.
+
+mod codec;
+mod control;
+mod datagram;
+mod error;
+mod frame;
+pub mod snapshot;
+mod varint;
+
+pub use codec::Message;
+pub use control::{
+    check_name, check_text, check_version, ClientControl, CloseCode, NetTiming, NoticeKind,
+    PlayerId, RejectReason, ServerControl, Welcome, MAX_CHAT_LEN, MAX_ID_LEN, MAX_NAME_LEN,
+    MAX_REASON_LEN, MAX_SIM_CONFIG_LEN,
+};
+pub use datagram::{fits, input_timing, InputPacket, Outgoing, Snapshot};
+pub use error::ProtocolError;
+pub use frame::{write_frame, FrameDecoder, FRAME_HEADER};
+pub use snapshot::{
+    decode_delta, encode_delta, is_replicated, EntityState, SnapshotHistory, StateSnapshot,
+};
+
+/// Version of this protocol, sent in [`ClientControl::Hello`]; the server
+/// rejects any other. Bump it on every change of any encoding.
+pub const PROTOCOL_VERSION: u32 = 2;
+
+/// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
+/// an unrelated QUIC peer. It names the application, not the version:
+/// versions are compared in `Hello`, so a mismatch gets a readable
+/// [`RejectReason::ProtocolVersion`] instead of a failed handshake.
+pub const ALPN: &[u8] = b"ledge";
+
+/// Largest control-stream frame payload either side sends or accepts.
+pub const MAX_FRAME: usize = 64 * 1024;
+
+/// Most entities a [`StateSnapshot`] may hold. With it, even the worst-case
+/// delta fits one control frame (checked at compile time).
+pub const MAX_ENTITIES: usize = 1024;
+
+/// Largest encoded snapshot delta, in bytes.
+pub const MAX_DELTA_LEN: usize = MAX_FRAME - 64;
+
+/// Most ticks of buttons one [`InputPacket`] may carry.
+pub const MAX_INPUT_HISTORY: usize = 64;
+
+/// Ticks of buttons a client repeats in each [`InputPacket`] by default
+/// (16 ticks: a quarter second of loss at 60 Hz costs nothing).
+pub const DEFAULT_INPUT_REDUNDANCY: u8 = 16;
+
+/// Largest accepted input datagram, in bytes (the largest valid
+/// [`InputPacket`] is about 85).
+pub const MAX_INPUT_DATAGRAM: usize = 128;
+
+// Worst case of a delta: header (1 + 10 + 10) + count (5) + removing every
+// baseline entity (id 5 + ctrl 1) + every current entity in full (id 5 +
+// ctrl 1 + kind 1 + five 5-byte varints + flags 5).
+const _: () = assert!(1 + 10 + 10 + 5 + MAX_ENTITIES * 6 + MAX_ENTITIES * 37 <= MAX_DELTA_LEN);
