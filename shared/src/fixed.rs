@@ -205,6 +205,26 @@ pub fn line_order(a: I64Vec2, b: I64Vec2) -> Ordering {
     0.cmp(&cross128(a, b))
 }
 
+/// Orders directions by clockwise (on screen, y down) angle from up
+/// (`-y`), exactly: up first, then right, down, left.
+///
+/// Breaks ties between equally good push directions where only one argument
+/// order exists (a circle centred inside a polygon), preferring the push
+/// closest to up, as the degenerate cases do.
+pub fn dir_order(a: I64Vec2, b: I64Vec2) -> Ordering {
+    // Half 0: angles [0, pi) from up, i.e. x > 0, or straight up.
+    fn half(v: I64Vec2) -> u8 {
+        if v.x > 0 || (v.x == 0 && v.y < 0) {
+            0
+        } else {
+            1
+        }
+    }
+    half(a)
+        .cmp(&half(b))
+        .then_with(|| 0.cmp(&cross128(a, b)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -229,6 +249,23 @@ mod tests {
         assert_eq!(line_order(diag, y), Ordering::Less);
         assert_eq!(line_order(-diag, diag), Ordering::Equal);
         assert_eq!(line_order(y, -x), Ordering::Greater);
+    }
+
+    #[test]
+    fn dir_order_starts_up_and_turns_clockwise() {
+        let up = I64Vec2::new(0, -1);
+        let up_right = I64Vec2::new(1, -1);
+        let right = I64Vec2::new(1, 0);
+        let down = I64Vec2::new(0, 1);
+        let left = I64Vec2::new(-1, 0);
+        let up_left = I64Vec2::new(-1, -1);
+        let seq = [up, up_right, right, down, left, up_left];
+        for i in 0..seq.len() {
+            for j in 0..seq.len() {
+                assert_eq!(dir_order(seq[i], seq[j]), i.cmp(&j), "{i} vs {j}");
+            }
+        }
+        assert_eq!(dir_order(up * 5, up), Ordering::Equal);
     }
 
     proptest! {

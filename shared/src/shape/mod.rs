@@ -31,7 +31,9 @@ use thiserror::Error;
 
 /// The kinds of shape, in the canonical order used to pick which pair file
 /// implements a query (the lower kind comes first).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize,
+)]
 pub enum ShapeKind {
     /// [`Point`].
     Point,
@@ -56,6 +58,14 @@ pub enum ShapeError {
     /// A size that must be positive is not.
     #[error("{what} must be positive, got {value}")]
     NotPositive {
+        /// Which value.
+        what: &'static str,
+        /// The offending value.
+        value: i64,
+    },
+    /// A full size that must be even (a centred box has integer half extents).
+    #[error("{what} must be even, got {value}")]
+    OddSize {
         /// Which value.
         what: &'static str,
         /// The offending value.

@@ -24,7 +24,10 @@ impl Obb {
     /// such as (3, 4) the rectangle is exact.
     pub fn new(half: IVec2, dir: IVec2) -> Result<Self, ShapeError> {
         if half.x <= 0 || half.y <= 0 {
-            return Err(ShapeError::NotPositive { what: "oriented box half extent", value: half.x.min(half.y) as i64 });
+            return Err(ShapeError::NotPositive {
+                what: "oriented box half extent",
+                value: half.x.min(half.y) as i64,
+            });
         }
         if dir == IVec2::ZERO {
             return Err(ShapeError::BadAxes);
@@ -52,7 +55,10 @@ impl Obb {
         if u == IVec2::ZERO || v == IVec2::ZERO || wu.perp_dot(wv) == 0 {
             return Err(ShapeError::BadAxes);
         }
-        for (what, c) in [("oriented box extent x", u.x.abs() as i64 + v.x.abs() as i64), ("oriented box extent y", u.y.abs() as i64 + v.y.abs() as i64)] {
+        for (what, c) in [
+            ("oriented box extent x", (u.x as i64).abs() + (v.x as i64).abs()),
+            ("oriented box extent y", (u.y as i64).abs() + (v.y as i64).abs()),
+        ] {
             check_extent(what, c)?;
         }
         // Positive winding needs cross(u, v) > 0.
@@ -112,6 +118,107 @@ impl Convex for Obb {
             1 => u - v,
             2 => u + v,
             _ => -u + v,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixed::MAX_EXTENT;
+    use crate::shape::convex::tests::check_convex;
+    use proptest::prelude::*;
+
+    fn v(x: i32, y: i32) -> IVec2 {
+        IVec2::new(x, y)
+    }
+
+    #[test]
+    fn pythagorean_and_axis_directions_are_exact() {
+        for dir in [v(3, 4), v(6, 8), v(300, 400)] {
+            let o = Obb::new(v(50, 25), dir).unwrap();
+            assert_eq!((o.u(), o.v()), (v(30, 40), v(-20, 15)), "{dir}");
+            check_convex(&o);
+        }
+        let o = Obb::new(v(7, 3), v(5, 0)).unwrap();
+        assert_eq!((o.u(), o.v()), (v(7, 0), v(0, 3)));
+        // Turned half a turn: the same rectangle, still positively wound.
+        let o = Obb::new(v(7, 3), v(-1, 0)).unwrap();
+        assert_eq!((o.u(), o.v()), (v(-7, 0), v(0, -3)));
+        assert_eq!(o.local_bounds(), (v(-7, -3), v(7, 3)));
+        check_convex(&o);
+    }
+
+    #[test]
+    fn slanted_directions_round_to_nearest() {
+        // 100 / sqrt 2 = 70.71.
+        let o = Obb::new(v(100, 100), v(1, 1)).unwrap();
+        assert_eq!((o.u(), o.v()), (v(71, 71), v(-71, 71)));
+        // 50 / sqrt 2 = 35.36.
+        let o = Obb::new(v(50, 50), v(-2, -2)).unwrap();
+        assert_eq!((o.u(), o.v()), (v(-35, -35), v(35, -35)));
+        check_convex(&o);
+    }
+
+    #[test]
+    fn rejects_bad_input() {
+        assert!(matches!(
+            Obb::new(v(0, 5), v(1, 0)),
+            Err(ShapeError::NotPositive { .. })
+        ));
+        assert!(matches!(
+            Obb::new(v(5, -1), v(1, 0)),
+            Err(ShapeError::NotPositive { .. })
+        ));
+        assert_eq!(Obb::new(v(5, 5), IVec2::ZERO), Err(ShapeError::BadAxes));
+        assert_eq!(
+            Obb::from_axes(IVec2::ZERO, v(1, 0)),
+            Err(ShapeError::BadAxes)
+        );
+        assert_eq!(Obb::from_axes(v(2, 1), v(-4, -2)), Err(ShapeError::BadAxes));
+        assert!(matches!(
+            Obb::from_axes(v(MAX_EXTENT, 0), v(1, 1)),
+            Err(ShapeError::Bounds(_))
+        ));
+        // Turned 45 degrees, a square's extent per axis is sqrt 2 times its half.
+        assert!(matches!(
+            Obb::new(IVec2::splat(MAX_EXTENT), v(1, 1)),
+            Err(ShapeError::Bounds(_))
+        ));
+        assert!(Obb::new(IVec2::splat(MAX_EXTENT), v(1, 0)).is_ok());
+        assert!(Obb::from_axes(v(MAX_EXTENT - 1, 0), v(1, 1)).is_ok());
+        // Extreme components are an error, not an overflow.
+        assert!(Obb::from_axes(v(i32::MIN, 0), v(0, 1)).is_err());
+        assert!(Obb::from_axes(v(1, 0), v(0, i32::MIN)).is_err());
+    }
+
+    #[test]
+    fn from_axes_winds_positively() {
+        let o = Obb::from_axes(v(4, 0), v(0, -2)).unwrap();
+        assert_eq!((o.u(), o.v()), (v(4, 0), v(0, 2)));
+        // A parallelogram is allowed and is exactly what collides.
+        let o = Obb::from_axes(v(5, 1), v(2, 3)).unwrap();
+        assert_eq!((o.u(), o.v()), (v(5, 1), v(2, 3)));
+        check_convex(&o);
+    }
+
+    proptest! {
+        /// Half axes are the ideal turned rectangle's to the nearest unit
+        /// (at most one unit off), and the shape is consistent.
+        #[test]
+        fn rounding_stays_within_a_unit(
+            hx in 1i32..=1 << 24, hy in 1i32..=1 << 24,
+            dx in -(1i32 << 20)..=1 << 20, dy in -(1i32 << 20)..=1 << 20,
+        ) {
+            prop_assume!(dx != 0 || dy != 0);
+            let o = Obb::new(v(hx, hy), v(dx, dy)).unwrap();
+            let l = ((dx as f64).powi(2) + (dy as f64).powi(2)).sqrt();
+            let (ux, uy) = (hx as f64 * dx as f64 / l, hx as f64 * dy as f64 / l);
+            let (vx, vy) = (-(hy as f64) * dy as f64 / l, hy as f64 * dx as f64 / l);
+            for (got, want) in [(o.u().x, ux), (o.u().y, uy), (o.v().x, vx), (o.v().y, vy)] {
+                prop_assert!((got as f64 - want).abs() <= 1.0, "{} vs {}", got, want);
+            }
+            check_convex(&o);
         }
     }
 }

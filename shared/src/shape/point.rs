@@ -4,7 +4,9 @@ use super::{Convex, Shape, ShapeKind};
 use glam::{I64Vec2, IVec2};
 
 /// A point at its collider's origin.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 pub struct Point;
 
 impl Shape for Point {
@@ -35,5 +37,19 @@ impl Convex for Point {
     #[inline]
     fn vertex(&self, _i: usize) -> IVec2 {
         IVec2::ZERO
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::convex::tests::check_convex;
+
+    #[test]
+    fn a_point_is_one_vertex_without_axes() {
+        assert_eq!(Point.local_bounds(), (IVec2::ZERO, IVec2::ZERO));
+        assert_eq!(Point.axis_count(), 0);
+        assert_eq!(Point.project(I64Vec2::new(5, -9)), (0, 0));
+        check_convex(&Point);
     }
 }

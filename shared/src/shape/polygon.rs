@@ -50,7 +50,9 @@ impl ConvexPolygon {
         // Twice the signed area must have the turning sign, and the edge
         // directions must pass the +x direction exactly once (a star polygon
         // turns one way at every vertex but winds twice).
-        let area2: i128 = (0..n).map(|i| cross128(wide(points[i]), wide(points[(i + 1) % n]))).sum();
+        let area2: i128 = (0..n)
+            .map(|i| cross128(wide(points[i]), wide(points[(i + 1) % n])))
+            .sum();
         if area2.signum() != sign {
             return Err(ShapeError::Concave(0));
         }
@@ -71,7 +73,10 @@ impl ConvexPolygon {
         for (i, p) in points.iter().enumerate() {
             verts[if sign > 0 { i } else { n - 1 - i }] = *p;
         }
-        Ok(Self { verts, len: n as u8 })
+        Ok(Self {
+            verts,
+            len: n as u8,
+        })
     }
 
     /// The vertices, positively wound.
@@ -86,7 +91,8 @@ impl Shape for ConvexPolygon {
     #[inline]
     fn local_bounds(&self) -> (IVec2, IVec2) {
         let v = self.vertices();
-        v.iter().fold((v[0], v[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+        v.iter()
+            .fold((v[0], v[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
     }
 }
 
@@ -124,6 +130,8 @@ impl Convex for ConvexPolygon {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::shape::convex::tests::check_convex;
+    use proptest::prelude::*;
 
     fn v(p: &[(i32, i32)]) -> Vec<IVec2> {
         p.iter().map(|&(x, y)| IVec2::new(x, y)).collect()
@@ -146,15 +154,140 @@ mod tests {
 
     #[test]
     fn rejects_degenerate_polygons() {
-        assert_eq!(ConvexPolygon::new(&v(&[(0, 0), (1, 0)])), Err(ShapeError::VertexCount(2)));
-        assert_eq!(ConvexPolygon::new(&v(&[(0, 0), (0, 0), (1, 1)])), Err(ShapeError::DuplicateVertex(1)));
-        assert!(matches!(ConvexPolygon::new(&v(&[(0, 0), (5, 0), (10, 0)])), Err(ShapeError::Collinear(_))));
-        assert!(matches!(ConvexPolygon::new(&v(&[(0, 0), (5, 0), (10, 0), (5, 5)])), Err(ShapeError::Collinear(_))));
+        assert_eq!(
+            ConvexPolygon::new(&v(&[(0, 0), (1, 0)])),
+            Err(ShapeError::VertexCount(2))
+        );
+        assert_eq!(
+            ConvexPolygon::new(&v(&[(0, 0), (0, 0), (1, 1)])),
+            Err(ShapeError::DuplicateVertex(1))
+        );
+        assert!(matches!(
+            ConvexPolygon::new(&v(&[(0, 0), (5, 0), (10, 0)])),
+            Err(ShapeError::Collinear(_))
+        ));
+        assert!(matches!(
+            ConvexPolygon::new(&v(&[(0, 0), (5, 0), (10, 0), (5, 5)])),
+            Err(ShapeError::Collinear(_))
+        ));
         // Concave (an arrow head).
-        assert!(matches!(ConvexPolygon::new(&v(&[(0, 0), (10, 5), (0, 10), (3, 5)])), Err(ShapeError::Concave(_))));
+        assert!(matches!(
+            ConvexPolygon::new(&v(&[(0, 0), (10, 5), (0, 10), (3, 5)])),
+            Err(ShapeError::Concave(_))
+        ));
         // A pentagram turns one way at every vertex but winds twice.
         let star = v(&[(0, -10), (6, 8), (-10, -3), (10, -3), (-6, 8)]);
-        assert!(matches!(ConvexPolygon::new(&star), Err(ShapeError::Concave(_))));
+        assert!(matches!(
+            ConvexPolygon::new(&star),
+            Err(ShapeError::Concave(_))
+        ));
         assert!(ConvexPolygon::new(&v(&[(0, 0), (1 << 28, 0), (0, 1)])).is_err());
+    }
+
+    #[test]
+    fn vertex_count_and_bounds() {
+        let oct = v(&[
+            (2, 0),
+            (5, 0),
+            (7, 2),
+            (7, 5),
+            (5, 7),
+            (2, 7),
+            (0, 5),
+            (0, 2),
+        ]);
+        let p = ConvexPolygon::new(&oct).unwrap();
+        assert_eq!(p.vertices(), &oct[..]);
+        assert_eq!(p.local_bounds(), (IVec2::new(0, 0), IVec2::new(7, 7)));
+        check_convex(&p);
+        let mut nine = oct.clone();
+        nine.insert(1, IVec2::new(3, -1));
+        assert!(matches!(
+            ConvexPolygon::new(&nine),
+            Err(ShapeError::VertexCount(9))
+        ));
+        assert!(matches!(
+            ConvexPolygon::new(&[]),
+            Err(ShapeError::VertexCount(0))
+        ));
+        let m = crate::fixed::MAX_EXTENT;
+        assert!(ConvexPolygon::new(&v(&[(-m, -m), (m, -m), (0, m)])).is_ok());
+        assert!(matches!(
+            ConvexPolygon::new(&v(&[(-m, -m), (m + 1, -m), (0, m)])),
+            Err(ShapeError::Bounds(_))
+        ));
+    }
+
+    #[test]
+    fn negative_winding_is_reversed() {
+        let cw = v(&[(0, 0), (0, 10), (10, 10), (10, 0)]);
+        let p = ConvexPolygon::new(&cw).unwrap();
+        let mut want = cw.clone();
+        want.reverse();
+        assert_eq!(p.vertices(), &want[..]);
+        check_convex(&p);
+    }
+
+    #[test]
+    fn rejects_self_intersecting_quads() {
+        // A bow tie: the vertices of a square in the wrong order.
+        let bow = v(&[(0, 0), (10, 10), (10, 0), (0, 10)]);
+        assert!(matches!(
+            ConvexPolygon::new(&bow),
+            Err(ShapeError::Concave(_))
+        ));
+        // A last vertex back at the start.
+        assert!(matches!(
+            ConvexPolygon::new(&v(&[(0, 0), (10, 0), (0, 10), (0, 0)])),
+            Err(ShapeError::DuplicateVertex(_))
+        ));
+    }
+
+    proptest! {
+        /// The convex hull of random points is accepted, in either winding
+        /// and from any starting vertex; swapping two vertices of a convex
+        /// polygon with at least four (a self-intersecting order) is refused.
+        #[test]
+        fn hulls_are_accepted_and_shuffles_refused(
+            pts in proptest::collection::vec((-1000i32..=1000, -1000i32..=1000), 3..40),
+            rot in 0usize..8, rev in any::<bool>(), swap in 0usize..8,
+        ) {
+            let mut h = hull(&pts);
+            prop_assume!(h.len() >= 3);
+            h.truncate(MAX_POLYGON_VERTICES);
+            if rev {
+                h.reverse();
+            }
+            let k = rot % h.len();
+            h.rotate_left(k);
+            let p = ConvexPolygon::new(&h).unwrap();
+            check_convex(&p);
+            if h.len() >= 4 {
+                let n = h.len();
+                h.swap(swap % n, (swap + 1) % n);
+                prop_assert!(ConvexPolygon::new(&h).is_err(), "{:?}", h);
+            }
+        }
+    }
+
+    /// Strict convex hull by the monotone chain.
+    fn hull(pts: &[(i32, i32)]) -> Vec<IVec2> {
+        let mut p: Vec<IVec2> = pts.iter().map(|&(x, y)| IVec2::new(x, y)).collect();
+        p.sort_by_key(|q| (q.x, q.y));
+        p.dedup();
+        let turn = |a: IVec2, b: IVec2, c: IVec2| cross128(wide(b - a), wide(c - b));
+        let mut out: Vec<IVec2> = Vec::new();
+        for pass in [p.clone(), p.into_iter().rev().collect()] {
+            let start = out.len();
+            for q in pass {
+                while out.len() >= start + 2 && turn(out[out.len() - 2], out[out.len() - 1], q) <= 0
+                {
+                    out.pop();
+                }
+                out.push(q);
+            }
+            out.pop();
+        }
+        out
     }
 }

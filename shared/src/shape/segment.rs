@@ -16,7 +16,12 @@ pub struct Segment {
 impl Segment {
     /// A segment with distinct ends inside the extent bound.
     pub fn new(a: IVec2, b: IVec2) -> Result<Self, ShapeError> {
-        for (what, v) in [("segment a.x", a.x), ("segment a.y", a.y), ("segment b.x", b.x), ("segment b.y", b.y)] {
+        for (what, v) in [
+            ("segment a.x", a.x),
+            ("segment a.y", a.y),
+            ("segment b.x", b.x),
+            ("segment b.y", b.y),
+        ] {
             check_extent(what, v as i64)?;
         }
         if a == b {
@@ -76,6 +81,37 @@ impl Convex for Segment {
             self.a
         } else {
             self.b
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixed::MAX_EXTENT;
+    use crate::shape::convex::tests::check_convex;
+
+    #[test]
+    fn validates_ends() {
+        let s = Segment::new(IVec2::new(4, -2), IVec2::new(-3, 8)).unwrap();
+        assert_eq!((s.a(), s.b()), (IVec2::new(4, -2), IVec2::new(-3, 8)));
+        assert_eq!(s.local_bounds(), (IVec2::new(-3, -2), IVec2::new(4, 8)));
+        check_convex(&s);
+        check_convex(&Segment::new(IVec2::ZERO, IVec2::X).unwrap());
+        check_convex(&Segment::new(IVec2::splat(-MAX_EXTENT), IVec2::splat(MAX_EXTENT)).unwrap());
+        assert_eq!(
+            Segment::new(IVec2::new(1, 1), IVec2::new(1, 1)),
+            Err(ShapeError::ZeroLength)
+        );
+        for (a, b) in [
+            (IVec2::new(MAX_EXTENT + 1, 0), IVec2::ZERO),
+            (IVec2::ZERO, IVec2::new(0, -MAX_EXTENT - 1)),
+            (IVec2::splat(i32::MIN), IVec2::ZERO),
+        ] {
+            assert!(
+                matches!(Segment::new(a, b), Err(ShapeError::Bounds(_))),
+                "{a} {b}"
+            );
         }
     }
 }

@@ -28,3 +28,135 @@ impl Contact<Aabb> for Aabb {
         Proximity::Overlapping(mtv)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::fixed::MAX_COORD;
+    use crate::query::contact::{
+        contact, Contact,
+        Proximity::{self, *},
+    };
+    use crate::shape::Aabb;
+    use glam::IVec2;
+
+    fn v(x: i32, y: i32) -> IVec2 {
+        IVec2::new(x, y)
+    }
+
+    /// Far from the origin, near the world bounds.
+    const FAR: IVec2 = IVec2::new(MAX_COORD - (1 << 20), -(MAX_COORD - (1 << 21)));
+
+    /// `a` against `b` is `want`, the reverse order is `want` reversed, and
+    /// both hold anywhere in the world.
+    fn check<A: Contact<B>, B: Contact<A>>(a: &A, pa: IVec2, b: &B, pb: IVec2, want: Proximity) {
+        for t in [IVec2::ZERO, FAR, -FAR] {
+            assert_eq!(
+                contact(a, pa + t, b, pb + t),
+                want,
+                "a at {pa}, b at {pb}, shifted by {t}"
+            );
+            assert_eq!(
+                contact(b, pb + t, a, pa + t),
+                want.reversed(),
+                "reverse: a at {pa}, b at {pb}, shifted by {t}"
+            );
+        }
+    }
+
+    use crate::query::contact::sat;
+    use proptest::prelude::*;
+
+    fn b(x: i32, y: i32) -> Aabb {
+        Aabb::new(v(x, y)).unwrap()
+    }
+
+    #[test]
+    fn touching_and_apart() {
+        let (a, s) = (b(50, 30), b(20, 20));
+        for p in [v(70, 0), v(70, 50), v(-70, -50), v(0, 50), v(-3, -50)] {
+            check(&a, v(0, 0), &s, p, Touching);
+        }
+        for p in [v(71, 0), v(0, 51), v(71, 51), v(-71, -50)] {
+            check(&a, v(0, 0), &s, p, Apart);
+        }
+    }
+
+    #[test]
+    fn overlapping() {
+        let (a, s) = (b(50, 30), b(20, 20));
+        // Reach (70, 50): overlaps 10 and 10 tie, x wins.
+        check(&a, v(0, 0), &s, v(60, 40), Overlapping(v(-10, 0)));
+        check(&a, v(0, 0), &s, v(65, 40), Overlapping(v(-5, 0)));
+        check(&a, v(0, 0), &s, v(60, 45), Overlapping(v(0, -5)));
+        check(&a, v(0, 0), &s, v(0, 10), Overlapping(v(0, -40)));
+        check(&a, v(0, 0), &s, v(-1, -49), Overlapping(v(0, 1)));
+    }
+
+    #[test]
+    fn centred_boxes_go_up_or_left_both_ways() {
+        let (a, s) = (b(50, 30), b(20, 20));
+        assert_eq!(contact(&a, v(0, 0), &s, v(0, 0)), Overlapping(v(0, -50)));
+        assert_eq!(contact(&s, v(0, 0), &a, v(0, 0)), Overlapping(v(0, -50)));
+        // Equal squares: x and y tie, x wins, pushed left.
+        assert_eq!(
+            contact(&b(10, 10), v(7, 7), &b(10, 10), v(7, 7)),
+            Overlapping(v(-20, 0))
+        );
+        // Centred on x only, with x shallower.
+        assert_eq!(
+            contact(&b(10, 40), v(0, 0), &b(10, 40), v(0, 5)),
+            Overlapping(v(-20, 0))
+        );
+        assert_eq!(
+            contact(&b(10, 40), v(0, 5), &b(10, 40), v(0, 0)),
+            Overlapping(v(-20, 0))
+        );
+    }
+
+    /// The specialised pair is the generic SAT kernel on two boxes: every
+    /// small case exhaustively.
+    #[test]
+    fn specialised_equals_generic_sat_exhaustively() {
+        let sizes = [1, 2, 3, 5];
+        for ax in sizes {
+            for ay in sizes {
+                for bx in sizes {
+                    for by in sizes {
+                        let (a, o) = (b(ax, ay), b(bx, by));
+                        for x in -11..=11 {
+                            for y in -11..=11 {
+                                let p = v(x, y);
+                                assert_eq!(
+                                    contact(&a, v(0, 0), &o, p),
+                                    sat(&a, v(0, 0), &o, p),
+                                    "{a:?} {o:?} at {p}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    proptest! {
+        /// ...and at every scale and anywhere in the world.
+        #[test]
+        fn specialised_equals_generic_sat(
+            e in 0u32..=26,
+            a in (1i32..=1 << 26, 1i32..=1 << 26),
+            o in (1i32..=1 << 26, 1i32..=1 << 26),
+            d in (-(1i32 << 27)..=1 << 27, -(1i32 << 27)..=1 << 27),
+            pa in (-(1i32 << 30)..=1 << 30, -(1i32 << 30)..=1 << 30),
+        ) {
+            // Scale sizes and offset down together so that every class occurs.
+            let k = |c: i32| (c >> (26 - e)).max(1);
+            let a = b(k(a.0), k(a.1));
+            let o = b(k(o.0), k(o.1));
+            let pa = v(pa.0, pa.1);
+            let pb = pa + v(d.0 >> (26 - e), d.1 >> (26 - e));
+            prop_assert_eq!(contact(&a, pa, &o, pb), sat(&a, pa, &o, pb));
+            prop_assert_eq!(contact(&o, pb, &a, pa), sat(&o, pb, &a, pa));
+        }
+    }
+}

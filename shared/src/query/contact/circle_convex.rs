@@ -1,7 +1,7 @@
 //! A circle against any convex vertex shape, by closest feature.
 
 use super::Proximity;
-use crate::fixed::{cmp_mul_u128, div_away, len2, perp, wide};
+use crate::fixed::{cmp_mul_u128, dir_order, div_away, len2, perp, wide};
 use crate::shape::Convex;
 use core::cmp::Ordering;
 use glam::{I64Vec2, IVec2};
@@ -24,7 +24,11 @@ pub(crate) fn circle_convex<B: Convex>(r: i64, pos: IVec2, b: &B, pos_b: IVec2) 
     // Centre relative to b's origin.
     let c = wide(pos) - wide(pos_b);
     let (lo, hi) = b.local_bounds();
-    if c.x + r < lo.x as i64 || c.x - r > hi.x as i64 || c.y + r < lo.y as i64 || c.y - r > hi.y as i64 {
+    if c.x + r < lo.x as i64
+        || c.x - r > hi.x as i64
+        || c.y + r < lo.y as i64
+        || c.y - r > hi.y as i64
+    {
         return Proximity::Apart;
     }
     let f = closest_feature(b, c);
@@ -60,7 +64,9 @@ pub(crate) fn circle_convex<B: Convex>(r: i64, pos: IVec2, b: &B, pos_b: IVec2) 
 /// `Less` means overlapping.
 #[inline]
 fn classify(f: Feature, r: i64) -> Ordering {
-    if f.inside || f.s < 0 {
+    // `w == 0`: the centre is on a point shape (coincident centres), at
+    // distance zero, which the comparison below would call a touch.
+    if f.inside || f.s < 0 || f.w == I64Vec2::ZERO {
         return Ordering::Less;
     }
     // s / |w| against r, both sides non-negative: s^2 against r^2 |w|^2.
@@ -69,8 +75,9 @@ fn classify(f: Feature, r: i64) -> Ordering {
     cmp_mul_u128(s, s, r2, len2(f.w))
 }
 
-/// `w * (r |w| - s) / |w|^2`, with `|w|` to 2^-32 precision, each component
-/// rounded away from zero.
+/// `w * (r |w| - s) / |w|^2`, with `|w|` to 2^-32 precision rounded up (so
+/// the vector is never shorter than the exact one), each component rounded
+/// away from zero.
 #[inline]
 fn push(f: Feature, r: i64) -> I64Vec2 {
     let w2 = len2(f.w);
@@ -78,7 +85,14 @@ fn push(f: Feature, r: i64) -> I64Vec2 {
         // Coincident centres: no geometric direction; push up.
         return I64Vec2::new(0, -r);
     }
-    let l32 = (w2 << 64).isqrt() as i128; // |w| * 2^32
+    // |w| * 2^32, rounded up: with the floor, an overlap thinner than about
+    // r * 2^-32 units made `num` negative and the rounded push point into the
+    // shape.
+    let l32 = {
+        let v = w2 << 64;
+        let q = v.isqrt();
+        (if q * q < v { q + 1 } else { q }) as i128
+    };
     let num = r as i128 * l32 - (f.s << 32);
     let den = (w2 as i128) << 32;
     I64Vec2::new(
@@ -93,7 +107,11 @@ fn closest_feature<B: Convex>(b: &B, c: I64Vec2) -> Feature {
     let n = b.vertex_count();
     if n == 1 {
         let d = c - wide(b.vertex(0));
-        return Feature { w: d, s: len2(d) as i128, inside: false };
+        return Feature {
+            w: d,
+            s: len2(d) as i128,
+            inside: false,
+        };
     }
     // Edge regions: the centre is on the outer side of the edge (or on it)
     // and projects inside it. For n >= 3, all-negative sides mean inside.
@@ -109,7 +127,11 @@ fn closest_feature<B: Convex>(b: &B, c: I64Vec2) -> Feature {
             all_inside = false;
             let t = cv.x as i128 * e.x as i128 + cv.y as i128 * e.y as i128;
             if t >= 0 && t <= len2(e) as i128 {
-                return Feature { w, s, inside: false };
+                return Feature {
+                    w,
+                    s,
+                    inside: false,
+                };
             }
         } else if all_inside {
             // Closest edge from inside: largest s / |w| (s < 0), i.e. the
@@ -119,10 +141,12 @@ fn closest_feature<B: Convex>(b: &B, c: I64Vec2) -> Feature {
                 None => f,
                 Some(d) => {
                     let (s2, d2) = ((s * s) as u128, (d.s * d.s) as u128);
-                    if cmp_mul_u128(s2, len2(d.w), d2, len2(w)) == Ordering::Less {
-                        f
-                    } else {
-                        d
+                    // Equal depths: the push closest to up wins, so the
+                    // answer does not depend on where the vertex list starts.
+                    match cmp_mul_u128(s2, len2(d.w), d2, len2(w)) {
+                        Ordering::Less => f,
+                        Ordering::Equal if dir_order(w, d.w) == Ordering::Less => f,
+                        _ => d,
                     }
                 }
             });
@@ -141,7 +165,11 @@ fn closest_feature<B: Convex>(b: &B, c: I64Vec2) -> Feature {
         let prev = v - wide(b.vertex((i + n - 1) % n));
         let d = c - v;
         if d.dot(next) <= 0 && d.dot(prev) >= 0 {
-            return Feature { w: d, s: len2(d) as i128, inside: false };
+            return Feature {
+                w: d,
+                s: len2(d) as i128,
+                inside: false,
+            };
         }
         let l = len2(d);
         if best.is_none_or(|(bl, _)| l < bl) {
@@ -150,5 +178,9 @@ fn closest_feature<B: Convex>(b: &B, c: I64Vec2) -> Feature {
     }
     // Unreachable for a valid convex shape; the nearest vertex is a safe answer.
     let (l, d) = best.expect("a convex shape has vertices");
-    Feature { w: d, s: l as i128, inside: false }
+    Feature {
+        w: d,
+        s: l as i128,
+        inside: false,
+    }
 }

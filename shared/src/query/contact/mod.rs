@@ -24,7 +24,10 @@
 //! exactly centred in the other along the chosen axis, a circle centred on a
 //! segment) the push goes towards `-y` (up) or along the segment's right-hand
 //! normal; ties between axes of equal depth pick the axis of smallest angle
-//! in `[0, pi)`, so the choice does not depend on argument order.
+//! in `[0, pi)`, so the choice does not depend on argument order. A circle
+//! centred inside a shape with several equally near faces leaves through the
+//! one whose push is closest to up ([`crate::fixed::dir_order`]), whatever
+//! vertex the shape's list starts at.
 
 mod circle_convex;
 mod sat;
@@ -148,7 +151,12 @@ macro_rules! circle_contact {
                 other: &$b,
                 other_pos: glam::IVec2,
             ) -> $crate::query::contact::Proximity {
-                $crate::query::contact::circle_convex::circle_convex(self.radius() as i64, pos, other, other_pos)
+                $crate::query::contact::circle_convex::circle_convex(
+                    self.radius() as i64,
+                    pos,
+                    other,
+                    other_pos,
+                )
             }
         }
         $crate::query::contact::reverse_contact!($crate::shape::Circle, $b);

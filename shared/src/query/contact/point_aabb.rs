@@ -1,5 +1,80 @@
 //! Contact between a point and an axis-aligned box.
 
-use crate::shape::{Point, Aabb};
+use crate::shape::{Aabb, Point};
 
 super::sat_contact!(Point, Aabb);
+
+#[cfg(test)]
+mod tests {
+    use crate::fixed::MAX_COORD;
+    use crate::query::contact::{
+        contact, Contact,
+        Proximity::{self, *},
+    };
+    use crate::shape::{Aabb, Point};
+    use glam::IVec2;
+
+    fn v(x: i32, y: i32) -> IVec2 {
+        IVec2::new(x, y)
+    }
+
+    /// Far from the origin, near the world bounds.
+    const FAR: IVec2 = IVec2::new(MAX_COORD - (1 << 20), -(MAX_COORD - (1 << 21)));
+
+    /// `a` against `b` is `want`, the reverse order is `want` reversed, and
+    /// both hold anywhere in the world.
+    fn check<A: Contact<B>, B: Contact<A>>(a: &A, pa: IVec2, b: &B, pb: IVec2, want: Proximity) {
+        for t in [IVec2::ZERO, FAR, -FAR] {
+            assert_eq!(
+                contact(a, pa + t, b, pb + t),
+                want,
+                "a at {pa}, b at {pb}, shifted by {t}"
+            );
+            assert_eq!(
+                contact(b, pb + t, a, pa + t),
+                want.reversed(),
+                "reverse: a at {pa}, b at {pb}, shifted by {t}"
+            );
+        }
+    }
+
+    fn b() -> Aabb {
+        Aabb::new(v(100, 50)).unwrap()
+    }
+
+    #[test]
+    fn touching_and_apart() {
+        let b = b();
+        for p in [v(100, 0), v(100, 50), v(-100, -50), v(0, -50), v(-37, 50)] {
+            check(&Point, p, &b, v(0, 0), Touching);
+        }
+        for p in [v(101, 0), v(0, 51), v(101, 51), v(-100, -51)] {
+            check(&Point, p, &b, v(0, 0), Apart);
+        }
+    }
+
+    #[test]
+    fn overlapping_pushes_out_through_the_nearest_side() {
+        let b = b();
+        // x: 30 to the right side, y: 40 to the bottom.
+        check(&Point, v(70, 10), &b, v(0, 0), Overlapping(v(30, 0)));
+        // x: 5 to the left side, y: 2 to the bottom.
+        check(&Point, v(-95, 48), &b, v(0, 0), Overlapping(v(0, 2)));
+        check(
+            &Point,
+            v(-95, 48) + v(-3000, 77),
+            &b,
+            v(-3000, 77),
+            Overlapping(v(0, 2)),
+        );
+    }
+
+    #[test]
+    fn centred_point_goes_up_or_left() {
+        // Centred: the shallower axis is y (50 < 100), pushed up.
+        check(&Point, v(0, 0), &b(), v(0, 0), Overlapping(v(0, -50)));
+        // A square: x and y tie, the x axis wins (smallest angle), pushed left.
+        let sq = Aabb::new(v(50, 50)).unwrap();
+        check(&Point, v(9, 9), &sq, v(9, 9), Overlapping(v(-50, 0)));
+    }
+}
