@@ -184,6 +184,10 @@ fn mul_wide(a: u128, b: u128) -> (u128, u128) {
 /// bits.
 #[inline]
 pub fn cmp_mul_u128(a: u128, b: u128, c: u128, d: u128) -> Ordering {
+    // Most products fit 128 bits (small shapes, shallow overlaps).
+    if let (Some(x), Some(y)) = (a.checked_mul(b), c.checked_mul(d)) {
+        return x.cmp(&y);
+    }
     mul_wide(a, b).cmp(&mul_wide(c, d))
 }
 
@@ -282,6 +286,9 @@ mod tests {
             // makes it strictly larger when the other factor is non-zero.
             let a = a >> 12; let b = b >> 12;
             prop_assert_eq!(cmp_mul_u128(a * k, b, a, b * k), Ordering::Equal);
+            // The fast and the wide path agree.
+            prop_assert_eq!(cmp_mul_u128(a, b, b, a), mul_wide(a, b).cmp(&mul_wide(b, a)));
+            prop_assert_eq!(cmp_mul_u128(a, b, a >> 1, b), mul_wide(a, b).cmp(&mul_wide(a >> 1, b)));
             if b > 0 {
                 prop_assert_eq!(cmp_mul_u128(a, b, a + 1, b), Ordering::Less);
             }

@@ -104,7 +104,9 @@ impl Convex for ConvexPolygon {
     #[inline]
     fn axis(&self, i: usize) -> I64Vec2 {
         let n = self.len as usize;
-        perp(wide(self.verts[(i + 1) % n] - self.verts[i]))
+        // A branch, not `% n`: this runs once per SAT axis in the hot loop.
+        let j = if i + 1 == n { 0 } else { i + 1 };
+        perp(wide(self.verts[j] - self.verts[i]))
     }
     #[inline]
     fn project(&self, n: I64Vec2) -> (i64, i64) {

@@ -119,7 +119,7 @@ fn closest_feature<B: Convex>(b: &B, c: I64Vec2) -> Feature {
     let mut deepest: Option<Feature> = None;
     for i in 0..n {
         let v = wide(b.vertex(i));
-        let e = wide(b.vertex((i + 1) % n)) - v;
+        let e = wide(b.vertex(if i + 1 == n { 0 } else { i + 1 })) - v;
         let w = perp(e);
         let cv = c - v;
         let s = cv.x as i128 * w.x as i128 + cv.y as i128 * w.y as i128;
@@ -161,8 +161,8 @@ fn closest_feature<B: Convex>(b: &B, c: I64Vec2) -> Feature {
     let mut best: Option<(u128, I64Vec2)> = None;
     for i in 0..n {
         let v = wide(b.vertex(i));
-        let next = wide(b.vertex((i + 1) % n)) - v;
-        let prev = v - wide(b.vertex((i + n - 1) % n));
+        let next = wide(b.vertex(if i + 1 == n { 0 } else { i + 1 })) - v;
+        let prev = v - wide(b.vertex(if i == 0 { n - 1 } else { i - 1 }));
         let d = c - v;
         if d.dot(next) <= 0 && d.dot(prev) >= 0 {
             return Feature {
