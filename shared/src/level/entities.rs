@@ -1,0 +1,416 @@
+//! The entity name table shared by every loader, entity parameters, and the
+//! bot route.
+
+use glam::IVec2;
+use serde::{Deserialize, Serialize};
+
+use super::mapping::normalize;
+use super::{EntityDef, EntityKind, LevelError, PlatformMotion};
+use crate::fixed::{MAX_COORD, MAX_EXTENT, MAX_SPEED, UNITS_PER_PX};
+
+/// Every entity name the loaders know, for messages (matching is ASCII
+/// case-insensitive, with `-` and spaces read as `_`):
+///
+/// | names | becomes | parameters (OGMO `values`, Tiled `properties`) |
+/// |---|---|---|
+/// | `player`, `spawn`, `player_spawn`, `start` | [`EntityKind::PlayerSpawn`] | |
+/// | `block`, `solid`, `crate` | [`EntityKind::Block`] | |
+/// | `platform`, `moving_platform`, `mover`, `elevator` | [`EntityKind::MovingPlatform`] | `speed` (px/tick, default 1), `one_way` (bool, default false), `loop` (bool, default false); path: OGMO `nodes`, Tiled `path` (object property naming a polyline or polygon) |
+/// | `walker`, `enemy` | [`EntityKind::Walker`] | `speed` (px/tick, default 0.5) |
+/// | `spring`, `springboard`, `trampoline` | [`EntityKind::Springboard`] | `strength` (px/tick, default 10) |
+/// | `coin` | [`EntityKind::Coin`] | |
+/// | `checkpoint` | [`EntityKind::Checkpoint`] | |
+/// | `goal`, `exit`, `flag` | [`EntityKind::Goal`] | |
+/// | `hazard`, `spikes`, `spike` | [`EntityKind::Hazard`] | |
+/// | `waypoint`, `route` | a [`Waypoint`] of the bot route (not an entity) | `action` (`walk`, `jump` or `spring`, default `walk`) |
+pub const ENTITY_NAMES: &[&str] = &[
+    "player",
+    "spawn",
+    "player_spawn",
+    "start",
+    "block",
+    "solid",
+    "crate",
+    "platform",
+    "moving_platform",
+    "mover",
+    "elevator",
+    "walker",
+    "enemy",
+    "spring",
+    "springboard",
+    "trampoline",
+    "coin",
+    "checkpoint",
+    "goal",
+    "exit",
+    "flag",
+    "hazard",
+    "spikes",
+    "spike",
+    "waypoint",
+    "route",
+];
+
+/// Default moving platform speed: 1 px per tick, in units per tick.
+pub const DEFAULT_PLATFORM_SPEED: i32 = UNITS_PER_PX;
+/// Default walker speed: 0.5 px per tick, in units per tick.
+pub const DEFAULT_WALKER_SPEED: i32 = UNITS_PER_PX / 2;
+/// Default springboard strength: 10 px per tick upwards, in units per tick.
+pub const DEFAULT_SPRING_STRENGTH: i32 = 10 * UNITS_PER_PX;
+/// Most nodes a platform path may have.
+pub const MAX_PATH_NODES: usize = 256;
+
+/// What the runner bot does to reach a [`Waypoint`] from the previous one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum RouteAction {
+    /// Walk along the ground (flat, slopes, one-way tiles) to the waypoint.
+    Walk,
+    /// Jump toward the waypoint (over a gap, a hazard or onto a higher or
+    /// one-way surface) and land on it.
+    Jump,
+    /// Walk onto the springboard under the waypoint's x, get launched, and
+    /// steer to land on the waypoint.
+    Spring,
+}
+
+/// One stop of a level's bot route: where the player's foot (the
+/// bottom-centre of its box) should stand, and how to get there from the
+/// previous waypoint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Waypoint {
+    /// Foot position in units: the bottom-centre of the waypoint entity,
+    /// which is placed standing on the ground.
+    pub foot: IVec2,
+    /// How to get here.
+    pub action: RouteAction,
+}
+
+/// A parameter value from an editor (OGMO `values`, Tiled `properties`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum PropValue {
+    /// A boolean.
+    Bool(bool),
+    /// A number (integer or float).
+    Number(f64),
+    /// A string (also OGMO enum and colour values).
+    Text(String),
+}
+
+impl PropValue {
+    fn describe(&self) -> String {
+        match self {
+            PropValue::Bool(b) => b.to_string(),
+            PropValue::Number(n) => n.to_string(),
+            PropValue::Text(s) => format!("{s:?}"),
+        }
+    }
+}
+
+/// An entity as placed in an editor, converted to world units but not yet
+/// classified: what both loaders hand to the entity table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlacedEntity {
+    /// The editor's name (OGMO entity name; Tiled class/type, else name).
+    pub name: String,
+    /// The layer's name.
+    pub layer: String,
+    /// Path of the entity in its file, e.g. `layers[3].entities[1]`.
+    pub field: String,
+    /// Name of the parameter table in the file (`values` or `properties`).
+    pub values_key: &'static str,
+    /// Centre, in units.
+    pub centre: IVec2,
+    /// Full size, in units (even).
+    pub size: IVec2,
+    /// Path nodes (centre positions, in units), not including the entity's
+    /// own position.
+    pub nodes: Vec<IVec2>,
+    /// Parameters, in file order.
+    pub values: Vec<(String, PropValue)>,
+}
+
+/// What an entity became.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Classified {
+    Entity(EntityDef),
+    Waypoint(Waypoint),
+    Unknown,
+}
+
+/// Pixels to units: finite and within the world bounds, rounded to the
+/// nearest unit (exact for whole and 1/256 pixels).
+pub(crate) fn px_to_units(file: &str, field: &str, px: f64) -> Result<i64, LevelError> {
+    let limit = (MAX_COORD / UNITS_PER_PX) as f64;
+    if !px.is_finite() || px.abs() > limit {
+        return Err(LevelError::OutOfBounds {
+            file: file.into(),
+            field: field.into(),
+            message: format!("{px} px is outside the world bound of ±{limit} px"),
+        });
+    }
+    Ok((px * UNITS_PER_PX as f64).round() as i64)
+}
+
+/// A box of `left`, `top` (units, offsets included) and `w`, `h` (pixels) as
+/// an even size and a centre, checked against the bounds.
+pub(crate) fn place_box(
+    file: &str,
+    field: &str,
+    left: i64,
+    top: i64,
+    w_px: f64,
+    h_px: f64,
+) -> Result<(IVec2, IVec2), LevelError> {
+    let mut size = [0i64; 2];
+    for (i, (v, name)) in [(w_px, "width"), (h_px, "height")].into_iter().enumerate() {
+        let f = format!("{field}.{name}");
+        let max = (MAX_EXTENT / UNITS_PER_PX) as f64;
+        if !v.is_finite() || v <= 0.0 || v > max {
+            return Err(LevelError::OutOfBounds {
+                file: file.into(),
+                field: f,
+                message: format!("{v} px is not a size in (0, {max}] px"),
+            });
+        }
+        // Even units, at least 2.
+        size[i] = (2.0 * (v * UNITS_PER_PX as f64 / 2.0).round()).max(2.0) as i64;
+    }
+    let centre = [left + size[0] / 2, top + size[1] / 2];
+    for (c, axis) in centre.iter().zip(["x", "y"]) {
+        check_coord_field(file, &format!("{field}.{axis}"), *c)?;
+    }
+    Ok((
+        IVec2::new(centre[0] as i32, centre[1] as i32),
+        IVec2::new(size[0] as i32, size[1] as i32),
+    ))
+}
+
+/// A coordinate in units within [`MAX_COORD`].
+pub(crate) fn check_coord_field(file: &str, field: &str, v: i64) -> Result<(), LevelError> {
+    if v.abs() > MAX_COORD as i64 {
+        return Err(LevelError::OutOfBounds {
+            file: file.into(),
+            field: field.into(),
+            message: format!("{v} units is outside the world bound of ±{MAX_COORD} units"),
+        });
+    }
+    Ok(())
+}
+
+enum Class {
+    Spawn,
+    Block,
+    Platform,
+    Walker,
+    Spring,
+    Coin,
+    Checkpoint,
+    Goal,
+    Hazard,
+    Waypoint,
+}
+
+fn class_of(name: &str) -> Option<Class> {
+    Some(match normalize(name).as_str() {
+        "player" | "spawn" | "player_spawn" | "playerspawn" | "start" => Class::Spawn,
+        "block" | "solid" | "crate" => Class::Block,
+        "platform" | "moving_platform" | "movingplatform" | "mover" | "elevator" => Class::Platform,
+        "walker" | "enemy" => Class::Walker,
+        "spring" | "springboard" | "trampoline" => Class::Spring,
+        "coin" => Class::Coin,
+        "checkpoint" => Class::Checkpoint,
+        "goal" | "exit" | "flag" => Class::Goal,
+        "hazard" | "spikes" | "spike" => Class::Hazard,
+        "waypoint" | "route" => Class::Waypoint,
+        _ => return None,
+    })
+}
+
+struct Params<'a> {
+    file: &'a str,
+    e: &'a PlacedEntity,
+}
+
+impl Params<'_> {
+    fn find(&self, keys: &[&str]) -> Option<(String, &PropValue)> {
+        self.e.values.iter().find_map(|(k, v)| {
+            let n = normalize(k);
+            keys.contains(&n.as_str())
+                .then(|| (format!("{}.{}.{k}", self.e.field, self.e.values_key), v))
+        })
+    }
+
+    fn bad(&self, field: String, message: String) -> LevelError {
+        LevelError::BadValue {
+            file: self.file.into(),
+            field,
+            message,
+        }
+    }
+
+    fn bool(&self, keys: &[&str]) -> Result<bool, LevelError> {
+        let Some((field, v)) = self.find(keys) else {
+            return Ok(false);
+        };
+        match v {
+            PropValue::Bool(b) => Ok(*b),
+            PropValue::Number(n) if *n == 0.0 || *n == 1.0 => Ok(*n == 1.0),
+            PropValue::Text(s) if s.eq_ignore_ascii_case("true") => Ok(true),
+            PropValue::Text(s) if s.eq_ignore_ascii_case("false") => Ok(false),
+            other => Err(self.bad(
+                field,
+                format!("expected a boolean, got {}", other.describe()),
+            )),
+        }
+    }
+
+    /// A speed in px/tick, as units/tick in `(0, MAX_SPEED]`.
+    fn speed(&self, keys: &[&str], default: i32) -> Result<i32, LevelError> {
+        let Some((field, v)) = self.find(keys) else {
+            return Ok(default);
+        };
+        let n = match v {
+            PropValue::Number(n) => *n,
+            PropValue::Text(s) => s.trim().parse::<f64>().map_err(|_| {
+                self.bad(
+                    field.clone(),
+                    format!("expected a number (px per tick), got {s:?}"),
+                )
+            })?,
+            other => {
+                return Err(self.bad(
+                    field,
+                    format!("expected a number (px per tick), got {}", other.describe()),
+                ));
+            }
+        };
+        let max = (MAX_SPEED / UNITS_PER_PX) as f64;
+        let units = (n * UNITS_PER_PX as f64).round();
+        if !n.is_finite() || units < 1.0 || n > max {
+            return Err(self.bad(
+                field,
+                format!("{n} px/tick is not a speed in (0, {max}] px/tick"),
+            ));
+        }
+        Ok(units as i32)
+    }
+
+    fn action(&self) -> Result<RouteAction, LevelError> {
+        let Some((field, v)) = self.find(&["action"]) else {
+            return Ok(RouteAction::Walk);
+        };
+        match v {
+            PropValue::Text(s) => match normalize(s).as_str() {
+                "walk" | "" => Ok(RouteAction::Walk),
+                "jump" => Ok(RouteAction::Jump),
+                "spring" => Ok(RouteAction::Spring),
+                _ => Err(self.bad(
+                    field,
+                    format!("expected \"walk\", \"jump\" or \"spring\", got {s:?}"),
+                )),
+            },
+            other => Err(self.bad(
+                field,
+                format!(
+                    "expected \"walk\", \"jump\" or \"spring\", got {}",
+                    other.describe()
+                ),
+            )),
+        }
+    }
+}
+
+/// Classifies one placed entity through the name table and reads its
+/// parameters.
+pub(crate) fn classify(file: &str, e: &PlacedEntity) -> Result<Classified, LevelError> {
+    let p = Params { file, e };
+    let Some(class) = class_of(&e.name) else {
+        return Ok(Classified::Unknown);
+    };
+    let kind = match class {
+        Class::Spawn => EntityKind::PlayerSpawn,
+        Class::Block => EntityKind::Block,
+        Class::Coin => EntityKind::Coin,
+        Class::Checkpoint => EntityKind::Checkpoint,
+        Class::Goal => EntityKind::Goal,
+        Class::Hazard => EntityKind::Hazard,
+        Class::Walker => EntityKind::Walker {
+            speed: p.speed(&["speed"], DEFAULT_WALKER_SPEED)?,
+        },
+        Class::Spring => EntityKind::Springboard {
+            strength: p.speed(&["strength", "speed", "power"], DEFAULT_SPRING_STRENGTH)?,
+        },
+        Class::Platform => {
+            let speed = p.speed(&["speed"], DEFAULT_PLATFORM_SPEED)?;
+            let one_way = p.bool(&["one_way", "oneway"])?;
+            let looped = p.bool(&["loop", "looped", "loops"])?;
+            let path = platform_path(file, e, looped)?;
+            EntityKind::MovingPlatform {
+                motion: PlatformMotion {
+                    path,
+                    speed,
+                    looped,
+                },
+                one_way,
+            }
+        }
+        Class::Waypoint => {
+            return Ok(Classified::Waypoint(Waypoint {
+                foot: IVec2::new(e.centre.x, e.centre.y + e.size.y / 2),
+                action: p.action()?,
+            }));
+        }
+    };
+    Ok(Classified::Entity(EntityDef {
+        kind,
+        pos: e.centre,
+        size: e.size,
+    }))
+}
+
+/// The platform's centre followed by its nodes; every leg non-empty. A
+/// looped path whose last node repeats the start is closed by dropping that
+/// node.
+fn platform_path(file: &str, e: &PlacedEntity, looped: bool) -> Result<Vec<IVec2>, LevelError> {
+    let err = |field: String, message: String| LevelError::DegeneratePath {
+        file: file.into(),
+        field,
+        message,
+    };
+    let nodes_field = format!("{}.nodes", e.field);
+    if e.nodes.is_empty() {
+        return Err(err(
+            nodes_field,
+            "a moving platform needs at least one node besides its own position".into(),
+        ));
+    }
+    if e.nodes.len() >= MAX_PATH_NODES {
+        return Err(err(
+            nodes_field,
+            format!(
+                "{} nodes, at most {} allowed",
+                e.nodes.len(),
+                MAX_PATH_NODES - 1
+            ),
+        ));
+    }
+    let mut path = Vec::with_capacity(e.nodes.len() + 1);
+    path.push(e.centre);
+    path.extend_from_slice(&e.nodes);
+    if looped && path.len() > 2 && path.last() == path.first() {
+        path.pop();
+    }
+    for i in 1..path.len() {
+        if path[i] == path[i - 1] {
+            return Err(err(
+                format!("{nodes_field}[{}]", i - 1),
+                format!(
+                    "node at ({}, {}) units repeats the previous point (a zero-length leg)",
+                    path[i].x, path[i].y
+                ),
+            ));
+        }
+    }
+    Ok(path)
+}

@@ -1,0 +1,177 @@
+//! Why a level file was refused: every error names the file and the field.
+
+use thiserror::Error;
+
+/// A level file the loaders refuse. Every variant names the file (as given
+/// to the loader) and, where there is one, the field, as a path into the
+/// document: `layers[2].data`, `layers[3].entities[1].values.speed`, or for
+/// Tiled `layers[1].objects[4].properties.speed`.
+///
+/// The messages read like `levels/uno.json: layers[2].data: expected 300
+/// entries, got 299`.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum LevelError {
+    /// The file could not be read.
+    #[error("{file}: cannot read the file: {message}")]
+    Io {
+        /// The file.
+        file: String,
+        /// What the operating system said.
+        message: String,
+    },
+    /// An extension no loader handles.
+    #[error(
+        "{file}: unsupported level format (expected .json from OGMO Editor 3 or .tmx from Tiled)"
+    )]
+    UnsupportedFormat {
+        /// The file.
+        file: String,
+    },
+    /// Not well-formed JSON or XML, or a document the Tiled reader refuses.
+    #[error("{file}: {field}: malformed {format}: {message}")]
+    Syntax {
+        /// The file.
+        file: String,
+        /// Where: a line and column when known, else the part of the document.
+        field: String,
+        /// "JSON", "OGMO project JSON" or "TMX".
+        format: &'static str,
+        /// What the parser said.
+        message: String,
+    },
+    /// A required field is absent.
+    #[error("{file}: {field}: missing{hint}")]
+    Missing {
+        /// The file.
+        file: String,
+        /// The missing field.
+        field: String,
+        /// Extra context (starts with a separator, may be empty).
+        hint: String,
+    },
+    /// A layer whose kind no loader knows (neither tile, grid, entity nor
+    /// decal for OGMO; an infinite or image layer where a grid is needed...).
+    #[error("{file}: {field}: unknown layer kind {kind:?}")]
+    UnknownLayer {
+        /// The file.
+        file: String,
+        /// The layer.
+        field: String,
+        /// The kind found (or a description of the fields found).
+        kind: String,
+    },
+    /// An array whose length does not match the layer's size.
+    #[error("{file}: {field}: expected {expected} entries, got {got}")]
+    Length {
+        /// The file.
+        file: String,
+        /// The array.
+        field: String,
+        /// The length the layer's size implies.
+        expected: u64,
+        /// The length found.
+        got: u64,
+    },
+    /// A size or position beyond the level limits ([`super::MAX_LEVEL_TILES`]
+    /// per side) or the numeric bounds of [`crate::fixed`].
+    #[error("{file}: {field}: {message}")]
+    OutOfBounds {
+        /// The file.
+        file: String,
+        /// The field.
+        field: String,
+        /// The value and the limit.
+        message: String,
+    },
+    /// A value of the wrong type or outside its range.
+    #[error("{file}: {field}: {message}")]
+    BadValue {
+        /// The file.
+        file: String,
+        /// The field.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A tile id, grid value or `kind` property the [`super::TileMapping`]
+    /// does not map.
+    #[error("{file}: {field}: {tile} is not mapped to a tile kind (tileset {tileset:?})")]
+    UnknownTile {
+        /// The file.
+        file: String,
+        /// The cell.
+        field: String,
+        /// The id or value.
+        tile: String,
+        /// The tileset (or "grid" for grid layers).
+        tileset: String,
+    },
+    /// An entity name (OGMO) or object type/class/name (Tiled) that is not in
+    /// the entity table (see [`super::ENTITY_NAMES`]).
+    #[error("{file}: {field}: unknown entity {name:?} in layer {layer:?} (known: {known})", known = super::ENTITY_NAMES.join(", "))]
+    UnknownEntity {
+        /// The file.
+        file: String,
+        /// The entity.
+        field: String,
+        /// The layer's name.
+        layer: String,
+        /// The entity's name.
+        name: String,
+    },
+    /// A moving platform whose path cannot be followed.
+    #[error("{file}: {field}: degenerate platform path: {message}")]
+    DegeneratePath {
+        /// The file.
+        file: String,
+        /// The platform (or its nodes).
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// No entity is a player spawn.
+    #[error("{file}: {field}: no player spawn (add an entity named \"player\" or \"spawn\")")]
+    MissingSpawn {
+        /// The file.
+        file: String,
+        /// The part of the document searched ("entities" or "layers").
+        field: String,
+    },
+}
+
+impl LevelError {
+    /// The file the error is about.
+    pub fn file(&self) -> &str {
+        match self {
+            LevelError::Io { file, .. }
+            | LevelError::UnsupportedFormat { file }
+            | LevelError::Syntax { file, .. }
+            | LevelError::Missing { file, .. }
+            | LevelError::UnknownLayer { file, .. }
+            | LevelError::Length { file, .. }
+            | LevelError::OutOfBounds { file, .. }
+            | LevelError::BadValue { file, .. }
+            | LevelError::UnknownTile { file, .. }
+            | LevelError::UnknownEntity { file, .. }
+            | LevelError::DegeneratePath { file, .. }
+            | LevelError::MissingSpawn { file, .. } => file,
+        }
+    }
+
+    /// The field the error is about, when there is one.
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            LevelError::Io { .. } | LevelError::UnsupportedFormat { .. } => None,
+            LevelError::Syntax { field, .. }
+            | LevelError::Missing { field, .. }
+            | LevelError::UnknownLayer { field, .. }
+            | LevelError::Length { field, .. }
+            | LevelError::OutOfBounds { field, .. }
+            | LevelError::BadValue { field, .. }
+            | LevelError::UnknownTile { field, .. }
+            | LevelError::UnknownEntity { field, .. }
+            | LevelError::DegeneratePath { field, .. }
+            | LevelError::MissingSpawn { field, .. } => Some(field),
+        }
+    }
+}
