@@ -1,0 +1,513 @@
+//! Broad phase: which pairs of bounding boxes overlap, fast, in a canonical
+//! order, optionally on many threads.
+//!
+//! # Partition: levelled strips with sort-and-sweep
+//! Boxes (integer corners, [`Bounds`]) are kept in *strips*: horizontal bands
+//! of height `S`, each sorted by left edge. A box goes to the finest *level*
+//! whose strip height is at least its own height (levels grow by a factor of
+//! 4 from 64 px by default, up to a single strip for the whole `i32` range),
+//! so a 2 px bullet and a 4096 px platform each sit where they are cheap: a
+//! wide-but-flat platform stays on level 0 (width never matters), a tall one
+//! goes up. Two boxes of one level can only overlap if their strips are equal
+//! or adjacent; inside a strip pair a merge-like sweep on the left edges
+//! tests only boxes that already overlap in x (plus one that ends each scan).
+//! A box of a higher level finds the lower-level boxes it covers by binary
+//! search in each strip it reaches. The whole set is one array sorted by one
+//! `u64` key (level, strip, left edge): no world size to configure, no hash
+//! map, and coordinates anywhere in the `i32` range.
+//!
+//! * **Static bodies** ([`BroadPhase::set_static`]) are sorted once; ticks
+//!   only sweep dynamic strips against them.
+//! * **Temporal coherence**: each update starts from the previous order. A box
+//!   that stayed in its strip is re-sorted in place by an insertion sort
+//!   (bodies move little, so it is linear); the few that changed strip are
+//!   sorted apart and merged in. Results never depend on the previous order,
+//!   only the cost does.
+//! * **Determinism**: the output is sorted by `(first id, second id)` with
+//!   `first < second` (a bucket sort on the first id, then a sort per bucket),
+//!   so it depends only on the input, never on thread count or scheduling.
+//!   The MTV in a contact moves the *first* (smaller id) body.
+//! * **No allocation per tick** in steady state: every buffer is kept and
+//!   reused.
+//! * **Parallel** (`*_par` methods): strips are cut into batches of about
+//!   equal box counts, run with rayon's work stealing into one buffer per
+//!   batch, then sorted into the canonical order (also in parallel); the
+//!   dynamic update is cut the same way. The plain methods never touch
+//!   rayon. They use the *current* rayon pool, so a
+//!   caller picks the thread count with
+//!   `rayon::ThreadPoolBuilder::new().num_threads(n).build()?.install(..)`.
+//!
+//! Pairs are reported only when the interiors overlap (`a.min < b.max` and
+//! `b.min < a.max` on both axes): boxes that share an edge are not a pair.
+//! Static-static pairs are never reported. Ids are the caller's and should be
+//! distinct across the static and dynamic sets.
+//!
+//! [`standard`] is the benchmark scene of `docs/PERFORMANCE.md`.
+
+mod order;
+pub mod standard;
+mod strips;
+mod sweep;
+
+use glam::IVec2;
+use order::{Buffers, Keyed};
+use strips::{Levels, Strips};
+use sweep::Sink;
+
+/// An integer axis-aligned box by its corners, in units: the closed set from
+/// `min` to `max` (`min <= max` on both axes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Bounds {
+    /// Smallest corner (left, top).
+    pub min: IVec2,
+    /// Largest corner (right, bottom).
+    pub max: IVec2,
+}
+
+impl Bounds {
+    /// The box with corners `min` and `max`.
+    #[inline]
+    pub const fn new(min: IVec2, max: IVec2) -> Self {
+        Self { min, max }
+    }
+
+    /// The box of size `size` whose smallest corner is `min`.
+    #[inline]
+    pub fn from_min_size(min: IVec2, size: IVec2) -> Self {
+        Self {
+            min,
+            max: min + size,
+        }
+    }
+
+    /// Whether the interiors overlap (positive overlap on both axes).
+    #[inline]
+    pub fn overlaps(&self, o: &Bounds) -> bool {
+        self.min.x < o.max.x && o.min.x < self.max.x && self.min.y < o.max.y && o.min.y < self.max.y
+    }
+}
+
+/// The minimum translation vector that moves `a` out of `b`, when their
+/// interiors overlap.
+///
+/// The same answer as [`crate::query::Contact`] for two
+/// [`crate::shape::Aabb`] centred in these boxes: the axis of least overlap
+/// (x on ties), pushing `a` away from `b`'s centre (left or up when the
+/// centres coincide on that axis).
+#[inline]
+pub fn aabb_mtv(a: &Bounds, b: &Bounds) -> Option<IVec2> {
+    if !a.overlaps(b) {
+        return None;
+    }
+    Some(mtv_of(
+        (a.min.x, a.max.x, a.min.y, a.max.y),
+        (b.min.x, b.max.x, b.min.y, b.max.y),
+    ))
+}
+
+/// [`aabb_mtv`] for boxes known to overlap, as `(min x, max x, min y, max y)`.
+///
+/// Along each axis the push is away from `b`'s centre (`d`, twice the centre
+/// offset, picks the side; `d == 0` pushes towards `-x`/`-y`) and its length
+/// is what it takes to clear `b` on that side: `a.max - b.min` to the left,
+/// `b.max - a.min` to the right, i.e. the sum of half sizes minus the centre
+/// distance, exactly as the centred-box contact computes it.
+#[inline(always)]
+fn mtv_of(a: (i32, i32, i32, i32), b: (i32, i32, i32, i32)) -> IVec2 {
+    let dx = (b.0 as i64 + b.1 as i64) - (a.0 as i64 + a.1 as i64);
+    let dy = (b.2 as i64 + b.3 as i64) - (a.2 as i64 + a.3 as i64);
+    let ox = if dx >= 0 {
+        a.1 as i64 - b.0 as i64
+    } else {
+        b.1 as i64 - a.0 as i64
+    };
+    let oy = if dy >= 0 {
+        a.3 as i64 - b.2 as i64
+    } else {
+        b.3 as i64 - a.2 as i64
+    };
+    if ox <= oy {
+        IVec2::new(if dx >= 0 { -ox } else { ox } as i32, 0)
+    } else {
+        IVec2::new(0, if dy >= 0 { -oy } else { oy } as i32)
+    }
+}
+
+/// Tuning of a [`BroadPhase`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BroadPhaseConfig {
+    /// `log2` of the finest strip height in units (clamped to `4..=32`).
+    /// Best near the height of the common small body: the default, 14, is
+    /// 64 px.
+    pub strip_shift: u32,
+    /// `log2` of the ratio between the strip heights of consecutive levels
+    /// (clamped to `1..=28`); default 2 (x4).
+    pub level_shift: u32,
+    /// Least number of dynamic boxes per parallel batch; default 1024.
+    pub batch: usize,
+}
+
+impl Default for BroadPhaseConfig {
+    fn default() -> Self {
+        Self {
+            strip_shift: 14,
+            level_shift: 2,
+            batch: 1024,
+        }
+    }
+}
+
+/// What one batch of work covers.
+#[derive(Debug, Clone, Copy)]
+enum Work {
+    /// Dynamic strips (row-table indices): same-level pairs.
+    Rows(u32, u32),
+    /// Dynamic boxes on levels above 0 (entry indices) against lower levels
+    /// of both sets.
+    CrossDynamic(u32, u32),
+    /// Static boxes on levels above 0 against lower dynamic levels.
+    CrossStatic(u32, u32),
+}
+
+/// The broad phase: a static set indexed once, a dynamic set updated every
+/// tick, and the pair search over both. See the [module docs](self).
+#[derive(Debug)]
+pub struct BroadPhase {
+    levels: Levels,
+    batch: usize,
+    statics: Strips,
+    dynamics: Strips,
+    work: Vec<Work>,
+    pairs: Buffers<(u32, u32)>,
+    contacts: Buffers<(u32, u32, IVec2)>,
+}
+
+impl Default for BroadPhase {
+    fn default() -> Self {
+        Self::new(BroadPhaseConfig::default())
+    }
+}
+
+/// Statistics of the last update, for tuning and benchmarks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BroadPhaseStats {
+    /// Static boxes.
+    pub statics: usize,
+    /// Dynamic boxes.
+    pub dynamics: usize,
+    /// Non-empty dynamic strips.
+    pub dynamic_strips: usize,
+    /// Dynamic boxes that changed strip at the last update.
+    pub movers: usize,
+    /// Whether the last update sorted from scratch rather than incrementally.
+    pub full_sort: bool,
+}
+
+impl BroadPhase {
+    /// An empty broad phase.
+    pub fn new(config: BroadPhaseConfig) -> Self {
+        Self {
+            levels: Levels::new(config.strip_shift, config.level_shift),
+            batch: config.batch.max(1),
+            statics: Strips::default(),
+            dynamics: Strips::default(),
+            work: Vec::new(),
+            pairs: Buffers::default(),
+            contacts: Buffers::default(),
+        }
+    }
+
+    /// Replaces the static set (bodies that never move): indexed once here,
+    /// then only read by every tick.
+    pub fn set_static(&mut self, items: &[(u32, Bounds)]) {
+        self.statics.update(&self.levels, items, false, 0);
+    }
+
+    /// Replaces the dynamic set with this tick's boxes. Passing the same
+    /// bodies in the same order every tick (the usual case) makes the update
+    /// incremental; any other input is still correct, just sorted afresh.
+    pub fn update_dynamic(&mut self, items: &[(u32, Bounds)]) {
+        self.dynamics.update(&self.levels, items, false, 0);
+    }
+
+    /// [`Self::update_dynamic`] with the work split over the current rayon
+    /// pool; the resulting state is identical.
+    pub fn update_dynamic_par(&mut self, items: &[(u32, Bounds)]) {
+        let chunk = self.chunk_target(items.len());
+        self.dynamics.update(&self.levels, items, true, chunk);
+    }
+
+    /// Boxes per parallel batch: at least `batch`, about two batches per
+    /// thread (enough for work stealing to even out, few enough that the
+    /// per-batch costs stay small).
+    fn chunk_target(&self, n: usize) -> usize {
+        self.batch
+            .max(n / (2 * rayon::current_num_threads()))
+            .max(1)
+    }
+
+    /// Statistics of the current sets and of the last update.
+    pub fn stats(&self) -> BroadPhaseStats {
+        BroadPhaseStats {
+            statics: self.statics.len(),
+            dynamics: self.dynamics.len(),
+            dynamic_strips: self.dynamics.rows.len(),
+            movers: self.dynamics.last_movers,
+            full_sort: self.dynamics.last_full_sort,
+        }
+    }
+
+    /// Every pair (dynamic-dynamic and dynamic-static) whose boxes overlap,
+    /// as `(smaller id, larger id)`, sorted; on this thread only.
+    pub fn find_pairs(&mut self, out: &mut Vec<(u32, u32)>) {
+        self.run(&PairKernel, out, false);
+    }
+
+    /// [`Self::find_pairs`] on the current rayon pool; same output.
+    pub fn find_pairs_par(&mut self, out: &mut Vec<(u32, u32)>) {
+        self.run(&PairKernel, out, true);
+    }
+
+    /// Every overlapping pair with its box-box MTV ([`aabb_mtv`], moving the
+    /// first body), sorted by ids: the AABB-only fast path, computed straight
+    /// from the sorted box arrays; on this thread only.
+    pub fn contacts_aabb(&mut self, out: &mut Vec<(u32, u32, IVec2)>) {
+        self.run(&AabbKernel, out, false);
+    }
+
+    /// [`Self::contacts_aabb`] on the current rayon pool; same output.
+    pub fn contacts_aabb_par(&mut self, out: &mut Vec<(u32, u32, IVec2)>) {
+        self.run(&AabbKernel, out, true);
+    }
+
+    /// The general path: for every overlapping pair of boxes, asks
+    /// `narrow(first id, second id)` for the MTV of the actual shapes (moving
+    /// the first) and keeps the pairs that answer `Some`; sorted by ids; on
+    /// this thread only.
+    pub fn contacts_with<F>(&mut self, narrow: &F, out: &mut Vec<(u32, u32, IVec2)>)
+    where
+        F: Fn(u32, u32) -> Option<IVec2> + Sync,
+    {
+        self.run(&NarrowKernel(narrow), out, false);
+    }
+
+    /// [`Self::contacts_with`] on the current rayon pool; same output.
+    pub fn contacts_with_par<F>(&mut self, narrow: &F, out: &mut Vec<(u32, u32, IVec2)>)
+    where
+        F: Fn(u32, u32) -> Option<IVec2> + Sync,
+    {
+        self.run(&NarrowKernel(narrow), out, true);
+    }
+
+    /// Plans the batches, runs `kernel` over them and sorts the result.
+    fn run<T, K>(&mut self, kernel: &K, out: &mut Vec<T>, par: bool)
+    where
+        T: Keyed,
+        K: Kernel<T>,
+        Self: HasBuffers<T>,
+    {
+        self.plan(par);
+        let n = self.work.len();
+        let (lv, dy, st) = (&self.levels, &self.dynamics, &self.statics);
+        let (mut id_lo, mut id_hi) = (dy.id_lo, dy.id_hi);
+        if st.len() > 0 {
+            id_lo = id_lo.min(st.id_lo);
+            id_hi = id_hi.max(st.id_hi);
+        }
+        let work = &self.work;
+        let bufs = <Self as HasBuffers<T>>::buffers(&mut self.pairs, &mut self.contacts);
+        bufs.prepare(n);
+        let job = |(w, buf): (&Work, &mut Vec<T>)| {
+            let mut sink = Emit { out: buf, kernel };
+            run_work(lv, dy, st, *w, &mut sink);
+        };
+        if par {
+            use rayon::prelude::*;
+            work.par_iter()
+                .zip(bufs.bufs[..n].par_iter_mut())
+                .for_each(job);
+        } else {
+            work.iter().zip(bufs.bufs[..n].iter_mut()).for_each(job);
+        }
+        bufs.finish(n, id_lo, id_hi, out, par);
+    }
+
+    /// Cuts the work into batches: one of each kind on one thread; batches of
+    /// about `max(batch, dynamics / (2 * threads))` boxes in parallel.
+    fn plan(&mut self, par: bool) {
+        self.work.clear();
+        let (dy, st) = (&self.dynamics, &self.statics);
+        if dy.len() == 0 {
+            return;
+        }
+        let target = if par {
+            self.chunk_target(dy.len())
+        } else {
+            usize::MAX
+        };
+        // Same-level strips, cut at strip boundaries.
+        let mut start = 0usize;
+        let mut count = 0usize;
+        for (ri, r) in dy.rows.iter().enumerate() {
+            count += (r.end - r.start) as usize;
+            if count >= target {
+                self.work.push(Work::Rows(start as u32, ri as u32 + 1));
+                start = ri + 1;
+                count = 0;
+            }
+        }
+        if start < dy.rows.len() {
+            self.work
+                .push(Work::Rows(start as u32, dy.rows.len() as u32));
+        }
+        // Larger levels against smaller ones: fewer boxes, more work each.
+        let cross_target = if par {
+            (target / 16).max(16)
+        } else {
+            usize::MAX
+        };
+        let mut push_cross = |from: usize, to: usize, f: fn(u32, u32) -> Work| {
+            let mut s = from;
+            while s < to {
+                let e = to.min(s.saturating_add(cross_target));
+                self.work.push(f(s as u32, e as u32));
+                s = e;
+            }
+        };
+        push_cross(dy.level_start[1] as usize, dy.slots(), Work::CrossDynamic);
+        push_cross(st.level_start[1] as usize, st.slots(), Work::CrossStatic);
+    }
+}
+
+/// Runs one batch.
+fn run_work<S: Sink>(lv: &Levels, dy: &Strips, st: &Strips, w: Work, sink: &mut S) {
+    match w {
+        Work::Rows(s, e) => sweep::same_level(dy, st, s as usize..e as usize, sink),
+        Work::CrossDynamic(s, e) => {
+            sweep::cross_level(lv, dy, s as usize..e as usize, dy, sink);
+            sweep::cross_level(lv, dy, s as usize..e as usize, st, sink);
+        }
+        Work::CrossStatic(s, e) => sweep::cross_level(lv, st, s as usize..e as usize, dy, sink),
+    }
+}
+
+/// Picks the buffers of one output type.
+trait HasBuffers<T> {
+    fn buffers<'a>(
+        pairs: &'a mut Buffers<(u32, u32)>,
+        contacts: &'a mut Buffers<(u32, u32, IVec2)>,
+    ) -> &'a mut Buffers<T>;
+}
+
+impl HasBuffers<(u32, u32)> for BroadPhase {
+    fn buffers<'a>(
+        pairs: &'a mut Buffers<(u32, u32)>,
+        _: &'a mut Buffers<(u32, u32, IVec2)>,
+    ) -> &'a mut Buffers<(u32, u32)> {
+        pairs
+    }
+}
+
+impl HasBuffers<(u32, u32, IVec2)> for BroadPhase {
+    fn buffers<'a>(
+        _: &'a mut Buffers<(u32, u32)>,
+        contacts: &'a mut Buffers<(u32, u32, IVec2)>,
+    ) -> &'a mut Buffers<(u32, u32, IVec2)> {
+        contacts
+    }
+}
+
+/// What an overlapping pair becomes.
+trait Kernel<T>: Sync {
+    /// Pushes the output for entry `i` of `a` and entry `j` of `b`, if any.
+    fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Vec<T>);
+}
+
+/// A sink writing one kernel's output into one buffer.
+struct Emit<'a, T, K> {
+    out: &'a mut Vec<T>,
+    kernel: &'a K,
+}
+
+impl<T, K: Kernel<T>> Sink for Emit<'_, T, K> {
+    #[inline(always)]
+    fn hit(&mut self, a: &Strips, i: usize, b: &Strips, j: usize) {
+        self.kernel.pair(a, i, b, j, self.out);
+    }
+}
+
+/// Ids only.
+struct PairKernel;
+
+impl Kernel<(u32, u32)> for PairKernel {
+    #[inline(always)]
+    fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Vec<(u32, u32)>) {
+        let (x, y) = (a.id[i], b.id[j]);
+        out.push(if x < y { (x, y) } else { (y, x) });
+    }
+}
+
+/// Ids and the box-box MTV.
+struct AabbKernel;
+
+impl Kernel<(u32, u32, IVec2)> for AabbKernel {
+    #[inline(always)]
+    fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Vec<(u32, u32, IVec2)>) {
+        let ba = (a.minx[i], a.maxx[i], a.miny[i], a.maxy[i]);
+        let bb = (b.minx[j], b.maxx[j], b.miny[j], b.maxy[j]);
+        let (x, y) = (a.id[i], b.id[j]);
+        out.push(if x < y {
+            (x, y, mtv_of(ba, bb))
+        } else {
+            (y, x, mtv_of(bb, ba))
+        });
+    }
+}
+
+/// Ids and the MTV from a caller's narrow phase.
+struct NarrowKernel<'f, F>(&'f F);
+
+impl<F> Kernel<(u32, u32, IVec2)> for NarrowKernel<'_, F>
+where
+    F: Fn(u32, u32) -> Option<IVec2> + Sync,
+{
+    #[inline(always)]
+    fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Vec<(u32, u32, IVec2)>) {
+        let (x, y) = (a.id[i], b.id[j]);
+        let (x, y) = if x < y { (x, y) } else { (y, x) };
+        if let Some(m) = (self.0)(x, y) {
+            out.push((x, y, m));
+        }
+    }
+}
+
+/// The reference answer by testing every pair: dynamic-dynamic and
+/// dynamic-static pairs whose interiors overlap, with their [`aabb_mtv`],
+/// sorted like [`BroadPhase::contacts_aabb`]. Quadratic: for tests and
+/// benchmarks.
+pub fn brute_force(
+    statics: &[(u32, Bounds)],
+    dynamics: &[(u32, Bounds)],
+    out: &mut Vec<(u32, u32, IVec2)>,
+) {
+    out.clear();
+    let mut push = |(ia, a): (u32, Bounds), (ib, b): (u32, Bounds)| {
+        let (ia, a, ib, b) = if ia < ib {
+            (ia, a, ib, b)
+        } else {
+            (ib, b, ia, a)
+        };
+        if let Some(m) = aabb_mtv(&a, &b) {
+            out.push((ia, ib, m));
+        }
+    };
+    for (k, &d) in dynamics.iter().enumerate() {
+        for &e in &dynamics[k + 1..] {
+            push(d, e);
+        }
+        for &s in statics {
+            push(d, s);
+        }
+    }
+    out.sort_unstable_by_key(|c| (c.0, c.1));
+}

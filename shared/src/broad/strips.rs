@@ -1,0 +1,638 @@
+//! The spatial partition: boxes sorted into horizontal strips, one set of
+//! strips per size level, each strip sorted by left edge.
+//!
+//! A box lives in the strip of its level that holds its top edge, at the
+//! place its left edge sorts to. Sorting is by one `u64` key,
+//! `level << 60 | strip << 32 | (min.x as u32 ^ 1 << 31)`, so a whole set is
+//! one sorted array (kept as parallel arrays, SoA) and a strip is a run of
+//! it. Strips are unbounded in x and the key covers the full `i32` range in
+//! y, so no world size is configured and no hash map is needed.
+//!
+//! A box of size `w x h` lives on the finest level whose strip height `S`
+//! satisfies `max(w, h) <= S`. Two boxes of one level can only overlap when
+//! their strips are equal or adjacent (both are at most one strip tall), and
+//! in a strip sorted by left edge each box only has to look forward while the
+//! next left edge is left of its right edge: a sweep. Boxes of different
+//! levels are found by the larger box querying the strips of the smaller
+//! box's level that it can reach.
+//!
+//! In the arrays every strip is followed by a *sentinel* entry whose left
+//! edge is `i32::MAX`, and the arrays end with [`PAD`] more: a forward scan
+//! (`while minx[k] < x`) stops at the end of its strip with no index test,
+//! and fixed blocks of [`BLOCK`] entries can be read anywhere in a strip.
+
+use super::Bounds;
+use core::ops::Range;
+
+/// Most levels a set can have (the level is 4 bits of the key).
+pub(crate) const MAX_LEVELS: usize = 16;
+/// Entries tested at once by the block kernels.
+pub(crate) const BLOCK: usize = 4;
+/// Sentinels after the last strip's sentinel, so a block read from any
+/// entry stays in bounds.
+pub(crate) const PAD: usize = BLOCK;
+/// The left edge of a sentinel.
+pub(crate) const SENTINEL: i32 = i32::MAX;
+
+/// Strip geometry shared by every set of one broad phase.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Levels {
+    /// `log2` of each level's strip height; the last is 32 (one strip).
+    pub shift: [u32; MAX_LEVELS],
+    /// Number of levels in use.
+    pub count: usize,
+}
+
+impl Levels {
+    /// Levels from `base` (`log2` of the finest strip height, at least 4)
+    /// growing by `step` bits per level until one strip covers every `i32`.
+    pub fn new(base: u32, step: u32) -> Self {
+        let base = base.clamp(4, 32);
+        let step = step.clamp(1, 28);
+        let mut shift = [32; MAX_LEVELS];
+        let mut count = 0;
+        let mut s = base;
+        while count < MAX_LEVELS {
+            shift[count] = s.min(32);
+            count += 1;
+            if s >= 32 {
+                break;
+            }
+            s += step;
+        }
+        // Whatever happens, the last level in use holds everything.
+        shift[count - 1] = 32;
+        Self { shift, count }
+    }
+
+    /// The level of a box whose larger side is `h` (units, `h < 2^32`).
+    #[inline(always)]
+    pub fn level_of(&self, h: i64) -> usize {
+        if h <= 1i64 << self.shift[0] {
+            return 0;
+        }
+        let mut l = 1;
+        while l + 1 < self.count && h > 1i64 << self.shift[l] {
+            l += 1;
+        }
+        l
+    }
+
+    /// The strip of coordinate `y` on level `l`: `floor((y + 2^31) / S)`, in
+    /// `[0, 2^(32 - shift))`; `y` is clamped into the `i32` range first.
+    #[inline(always)]
+    pub fn strip(&self, l: usize, y: i64) -> u32 {
+        let y = y.clamp(i32::MIN as i64, i32::MAX as i64);
+        ((y + (1i64 << 31)) >> self.shift[l]) as u32
+    }
+
+    /// Strip height of level `l` in units.
+    #[inline]
+    pub fn height(&self, l: usize) -> i64 {
+        1i64 << self.shift[l]
+    }
+
+    /// The sort key of a box: its level is set by its larger side, so that
+    /// no box of a level is wider than the level's strip height either.
+    #[inline(always)]
+    pub fn key(&self, b: &Bounds) -> u64 {
+        let w = b.max.x as i64 - b.min.x as i64;
+        let h = b.max.y as i64 - b.min.y as i64;
+        let l = self.level_of(w.max(h));
+        ((l as u64) << 60)
+            | ((self.strip(l, b.min.y as i64) as u64) << 32)
+            | ((b.min.x as u32) ^ (1 << 31)) as u64
+    }
+}
+
+/// The strip part of a key: `level << 28 | strip`.
+#[inline]
+pub(crate) fn row_key(key: u64) -> u32 {
+    (key >> 32) as u32
+}
+
+/// The level of a row key.
+#[inline]
+pub(crate) fn row_level(row_key: u32) -> usize {
+    (row_key >> 28) as usize
+}
+
+/// One non-empty strip: a run of the sorted arrays.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Row {
+    /// `level << 28 | strip`.
+    pub key: u32,
+    /// First entry.
+    pub start: u32,
+    /// One past the last entry: the strip's sentinel.
+    pub end: u32,
+    /// Widest box in the strip (units).
+    pub max_w: u32,
+}
+
+/// A box on its way into the sweep arrays.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    key: u64,
+    idx: u32,
+    id: u32,
+    minx: i32,
+    maxx: i32,
+    miny: i32,
+    maxy: i32,
+}
+
+impl Entry {
+    #[inline(always)]
+    fn new(key: u64, idx: u32, id: u32, b: &Bounds) -> Self {
+        Self {
+            key,
+            idx,
+            id,
+            minx: b.min.x,
+            maxx: b.max.x,
+            miny: b.min.y,
+            maxy: b.max.y,
+        }
+    }
+}
+
+/// One slice of the old strips, updated on its own (in parallel with the
+/// others when asked).
+#[derive(Debug, Default)]
+struct Chunk {
+    /// Old row-table indices covered.
+    rows: Range<usize>,
+    /// Boxes that kept their strip, in sorted order.
+    stay: Vec<Entry>,
+    /// Distinct strip keys of `stay`, in order.
+    stay_rows: Vec<u32>,
+    /// Boxes that changed strip.
+    movers: Vec<Entry>,
+    /// Insertion-sort steps taken.
+    steps: usize,
+    /// The movers (indices into the merged, sorted list) whose keys fall in
+    /// this chunk's key range.
+    mv: Range<usize>,
+    /// First output entry.
+    base: usize,
+    /// Output entries (boxes and sentinels).
+    size: usize,
+    /// Output strips (absolute starts).
+    out_rows: Vec<Row>,
+    /// Smallest and largest id laid out.
+    id_lo: u32,
+    id_hi: u32,
+}
+
+impl Chunk {
+    /// Reads this chunk's boxes in their old order, re-keys them and splits
+    /// them into kept (re-sorted by insertion as they come) and movers.
+    fn split(&mut self, lv: &Levels, rows: &[Row], idx: &[u32], items: &[(u32, Bounds)]) {
+        self.stay.clear();
+        self.stay_rows.clear();
+        self.movers.clear();
+        self.steps = 0;
+        for r in &rows[self.rows.clone()] {
+            let before = self.stay.len();
+            for &i in &idx[r.start as usize..r.end as usize] {
+                let (id, b) = &items[i as usize];
+                let key = lv.key(b);
+                let e = Entry::new(key, i, *id, b);
+                if row_key(key) == r.key {
+                    let mut w = self.stay.len();
+                    self.stay.push(e);
+                    while w > 0 && self.stay[w - 1].key > key {
+                        self.stay.swap(w - 1, w);
+                        w -= 1;
+                        self.steps += 1;
+                    }
+                } else {
+                    self.movers.push(e);
+                }
+            }
+            if self.stay.len() > before {
+                self.stay_rows.push(r.key);
+            }
+        }
+    }
+
+    /// Output size: every box plus one sentinel per distinct strip.
+    fn measure(&mut self, movers: &[Entry]) {
+        let mv = &movers[self.mv.clone()];
+        let mut distinct = self.stay_rows.len();
+        let (mut k, mut last) = (0, u32::MAX);
+        for m in mv {
+            let rk = row_key(m.key);
+            if rk == last {
+                continue;
+            }
+            last = rk;
+            while k < self.stay_rows.len() && self.stay_rows[k] < rk {
+                k += 1;
+            }
+            if self.stay_rows.get(k) != Some(&rk) {
+                distinct += 1;
+            }
+        }
+        self.size = self.stay.len() + mv.len() + distinct;
+    }
+
+    /// Merges the kept boxes and this chunk's movers into `out`, one
+    /// sentinel after each strip.
+    fn layout(&mut self, movers: &[Entry], out: Slices<'_>) {
+        self.out_rows.clear();
+        let mut o = Out {
+            s: out,
+            at: 0,
+            base: self.base,
+            rows: &mut self.out_rows,
+            row: Row {
+                key: u32::MAX,
+                ..Row::default()
+            },
+            id_lo: u32::MAX,
+            id_hi: 0,
+        };
+        let (st, mv) = (&self.stay, &movers[self.mv.clone()]);
+        let (mut i, mut j) = (0, 0);
+        while i < st.len() {
+            if j < mv.len() && mv[j].key < st[i].key {
+                o.push(&mv[j]);
+                j += 1;
+            } else {
+                o.push(&st[i]);
+                i += 1;
+            }
+        }
+        for m in &mv[j..] {
+            o.push(m);
+        }
+        o.close_row();
+        debug_assert_eq!(o.at, self.size);
+        self.id_lo = o.id_lo;
+        self.id_hi = o.id_hi;
+    }
+}
+
+/// One set of boxes (the static or the dynamic ones) in strip order.
+#[derive(Debug, Default)]
+pub(crate) struct Strips {
+    /// Left edges in sorted order, strips separated by sentinels.
+    pub minx: Vec<i32>,
+    /// Right edges.
+    pub maxx: Vec<i32>,
+    /// Top edges.
+    pub miny: Vec<i32>,
+    /// Bottom edges.
+    pub maxy: Vec<i32>,
+    /// Caller ids.
+    pub id: Vec<u32>,
+    /// Non-empty strips in key order.
+    pub rows: Vec<Row>,
+    /// `rows[level_rows[l]..level_rows[l + 1]]` are level `l`'s strips.
+    pub level_rows: [u32; MAX_LEVELS + 1],
+    /// Entries `level_start[l]..level_start[l + 1]` are level `l`'s boxes
+    /// (and sentinels).
+    pub level_start: [u32; MAX_LEVELS + 1],
+    /// Smallest id (`u32::MAX` when empty).
+    pub id_lo: u32,
+    /// Largest id (0 when empty).
+    pub id_hi: u32,
+    /// Number of boxes.
+    count: usize,
+    /// Entries in use, sentinels included, padding excluded (the arrays are
+    /// longer: they only grow, and are overwritten in place).
+    used: usize,
+    /// Input index of each entry (`u32::MAX` for sentinels), kept for the
+    /// next update.
+    idx: Vec<u32>,
+    /// Per-chunk scratch.
+    chunks: Vec<Chunk>,
+    /// Scratch: all movers, sorted.
+    movers: Vec<Entry>,
+    /// Scratch for a full sort.
+    full: Vec<(u64, u32)>,
+    /// Boxes that changed strip at the last update (a statistic).
+    pub last_movers: usize,
+    /// Whether the last update sorted from scratch (a statistic).
+    pub last_full_sort: bool,
+}
+
+impl Strips {
+    /// Number of boxes.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    /// Number of entries including sentinels (but not the final padding).
+    #[inline]
+    pub fn slots(&self) -> usize {
+        self.used
+    }
+
+    /// Rebuilds the set from `items`, reusing the previous order as a hint:
+    /// boxes that stayed in their strip keep their order up to local swaps
+    /// (an insertion sort as they are read, linear when few boxes overtake
+    /// each other), the few that changed strip are sorted apart and merged
+    /// in. The result never depends on the hint: only the cost does.
+    ///
+    /// With `par`, the old strips are cut into chunks of about `chunk` boxes
+    /// that are re-keyed and laid out in parallel on the current rayon pool;
+    /// the arrays come out identical either way.
+    pub fn update(&mut self, lv: &Levels, items: &[(u32, Bounds)], par: bool, chunk: usize) {
+        let n = items.len();
+        let mut full = !(n == self.count && n > 0);
+        self.movers.clear();
+        if !full {
+            self.plan_chunks(if par { chunk.max(1) } else { usize::MAX });
+            let nc = self.chunks.len();
+            let (rows, idx) = (&self.rows, &self.idx);
+            let job = |c: &mut Chunk| c.split(lv, rows, idx, items);
+            if par {
+                use rayon::prelude::*;
+                self.chunks[..nc].par_iter_mut().for_each(job);
+            } else {
+                self.chunks[..nc].iter_mut().for_each(job);
+            }
+            let steps: usize = self.chunks[..nc].iter().map(|c| c.steps).sum();
+            for c in &self.chunks[..nc] {
+                self.movers.extend_from_slice(&c.movers);
+            }
+            full = steps > 4 * n + 64 || self.movers.len() > n / 4;
+        }
+        self.last_movers = self.movers.len();
+        self.last_full_sort = full;
+        if full {
+            self.full.clear();
+            self.full.extend(
+                items
+                    .iter()
+                    .enumerate()
+                    .map(|(i, it)| (lv.key(&it.1), i as u32)),
+            );
+            if par {
+                use rayon::prelude::*;
+                self.full.par_sort_unstable_by_key(|e| e.0);
+            } else {
+                self.full.sort_unstable_by_key(|e| e.0);
+            }
+            self.movers.clear();
+            if self.chunks.is_empty() {
+                self.chunks.push(Chunk::default());
+            }
+            let c = &mut self.chunks[0];
+            c.stay.clear();
+            c.stay_rows.clear();
+            for &(key, i) in &self.full {
+                let (id, b) = &items[i as usize];
+                c.stay.push(Entry::new(key, i, *id, b));
+                if c.stay_rows.last() != Some(&row_key(key)) {
+                    c.stay_rows.push(row_key(key));
+                }
+            }
+            c.rows = 0..0;
+            self.chunks.truncate(1);
+        } else if par {
+            use rayon::prelude::*;
+            self.movers.par_sort_unstable_by_key(|m| m.key);
+        } else {
+            self.movers.sort_unstable_by_key(|m| m.key);
+        }
+        self.count = n;
+        self.layout(par);
+    }
+
+    /// Cuts the old strips into chunks of about `target` boxes.
+    fn plan_chunks(&mut self, target: usize) {
+        let mut k = 0;
+        let mut start = 0;
+        let mut count = 0;
+        let nrows = self.rows.len();
+        for (ri, r) in self.rows.iter().enumerate() {
+            count += (r.end - r.start) as usize;
+            if count >= target || ri + 1 == nrows {
+                if self.chunks.len() <= k {
+                    self.chunks.push(Chunk::default());
+                }
+                self.chunks[k].rows = start..ri + 1;
+                k += 1;
+                start = ri + 1;
+                count = 0;
+            }
+        }
+        self.chunks.truncate(k.max(1));
+        if k == 0 {
+            self.chunks[0].rows = 0..0;
+        }
+    }
+
+    /// Merges the kept boxes and the movers into the sweep arrays, adding a
+    /// sentinel after each strip, and indexes the strips.
+    fn layout(&mut self, par: bool) {
+        // Hand each chunk the movers of its key range: from its first old
+        // strip up to the next chunk's first.
+        let nc = self.chunks.len();
+        let mut from = 0;
+        for c in 0..nc {
+            let to = if c + 1 < nc {
+                let first = self.rows[self.chunks[c + 1].rows.start].key;
+                let bound = (first as u64) << 32;
+                from + self.movers[from..].partition_point(|m| m.key < bound)
+            } else {
+                self.movers.len()
+            };
+            self.chunks[c].mv = from..to;
+            from = to;
+        }
+        let mut base = 0;
+        for c in &mut self.chunks {
+            c.measure(&self.movers);
+            c.base = base;
+            base += c.size;
+        }
+        let used = base;
+        let need = used + PAD;
+        for v in [
+            &mut self.minx,
+            &mut self.maxx,
+            &mut self.miny,
+            &mut self.maxy,
+        ] {
+            if v.len() < need {
+                v.resize(need, 0);
+            }
+        }
+        for v in [&mut self.id, &mut self.idx] {
+            if v.len() < need {
+                v.resize(need, 0);
+            }
+        }
+        let out = Slices {
+            minx: &mut self.minx[..used],
+            maxx: &mut self.maxx[..used],
+            miny: &mut self.miny[..used],
+            maxy: &mut self.maxy[..used],
+            id: &mut self.id[..used],
+            idx: &mut self.idx[..used],
+        };
+        lay_chunks(&mut self.chunks, &self.movers, out, par);
+        // Padding sentinels.
+        for k in used..need {
+            self.minx[k] = SENTINEL;
+            self.maxx[k] = SENTINEL;
+            self.miny[k] = 0;
+            self.maxy[k] = 0;
+            self.id[k] = u32::MAX;
+            self.idx[k] = u32::MAX;
+        }
+        self.used = used;
+        self.rows.clear();
+        let (mut id_lo, mut id_hi) = (u32::MAX, 0);
+        for c in &self.chunks {
+            self.rows.extend_from_slice(&c.out_rows);
+            id_lo = id_lo.min(c.id_lo);
+            id_hi = id_hi.max(c.id_hi);
+        }
+        self.id_lo = id_lo;
+        self.id_hi = id_hi;
+        // Level boundaries in the row table and the entries.
+        let mut r = 0usize;
+        for l in 0..=MAX_LEVELS {
+            while r < self.rows.len() && row_level(self.rows[r].key) < l {
+                r += 1;
+            }
+            self.level_rows[l] = r as u32;
+            self.level_start[l] = self.rows.get(r).map_or(used as u32, |row| row.start);
+        }
+    }
+
+    /// Row-table indices of the strips of level `l` whose strip number lies
+    /// in `lo..=hi`.
+    #[inline]
+    pub fn rows_in(&self, l: usize, lo: u32, hi: u32) -> core::ops::Range<usize> {
+        let (a, b) = (self.level_rows[l] as usize, self.level_rows[l + 1] as usize);
+        let rows = &self.rows[a..b];
+        let base = (l as u32) << 28;
+        let s = rows.partition_point(|r| r.key < base | lo);
+        let e = s + rows[s..].partition_point(|r| r.key <= base | hi);
+        a + s..a + e
+    }
+}
+
+/// Disjoint parts of the sweep arrays.
+struct Slices<'a> {
+    minx: &'a mut [i32],
+    maxx: &'a mut [i32],
+    miny: &'a mut [i32],
+    maxy: &'a mut [i32],
+    id: &'a mut [u32],
+    idx: &'a mut [u32],
+}
+
+impl<'a> Slices<'a> {
+    fn split_at(self, k: usize) -> (Slices<'a>, Slices<'a>) {
+        let (a0, b0) = self.minx.split_at_mut(k);
+        let (a1, b1) = self.maxx.split_at_mut(k);
+        let (a2, b2) = self.miny.split_at_mut(k);
+        let (a3, b3) = self.maxy.split_at_mut(k);
+        let (a4, b4) = self.id.split_at_mut(k);
+        let (a5, b5) = self.idx.split_at_mut(k);
+        (
+            Slices {
+                minx: a0,
+                maxx: a1,
+                miny: a2,
+                maxy: a3,
+                id: a4,
+                idx: a5,
+            },
+            Slices {
+                minx: b0,
+                maxx: b1,
+                miny: b2,
+                maxy: b3,
+                id: b4,
+                idx: b5,
+            },
+        )
+    }
+}
+
+/// Lays out `chunks` into `out` (which starts at the first chunk's base),
+/// splitting the work over the rayon pool when `par`.
+fn lay_chunks(chunks: &mut [Chunk], movers: &[Entry], out: Slices<'_>, par: bool) {
+    if chunks.len() == 1 || !par {
+        let mut out = out;
+        for c in chunks {
+            let (mine, rest) = out.split_at(c.size);
+            c.layout(movers, mine);
+            out = rest;
+        }
+        return;
+    }
+    let mid = chunks.len() / 2;
+    let (left, right) = chunks.split_at_mut(mid);
+    let (lo, hi) = out.split_at(right[0].base - left[0].base);
+    rayon::join(
+        || lay_chunks(left, movers, lo, par),
+        || lay_chunks(right, movers, hi, par),
+    );
+}
+
+/// One chunk's output, written from entry `at` of its slices on.
+struct Out<'a, 'r> {
+    s: Slices<'a>,
+    at: usize,
+    base: usize,
+    rows: &'r mut Vec<Row>,
+    row: Row,
+    id_lo: u32,
+    id_hi: u32,
+}
+
+impl Out<'_, '_> {
+    #[inline(always)]
+    fn push(&mut self, e: &Entry) {
+        let rk = row_key(e.key);
+        if rk != self.row.key {
+            self.close_row();
+            self.row = Row {
+                key: rk,
+                start: (self.base + self.at) as u32,
+                end: 0,
+                max_w: 0,
+            };
+        }
+        let w = (e.maxx as i64 - e.minx as i64).clamp(0, u32::MAX as i64) as u32;
+        self.row.max_w = self.row.max_w.max(w);
+        let k = self.at;
+        self.s.minx[k] = e.minx;
+        self.s.maxx[k] = e.maxx;
+        self.s.miny[k] = e.miny;
+        self.s.maxy[k] = e.maxy;
+        self.s.id[k] = e.id;
+        self.s.idx[k] = e.idx;
+        self.at = k + 1;
+        self.id_lo = self.id_lo.min(e.id);
+        self.id_hi = self.id_hi.max(e.id);
+    }
+
+    /// Ends the current strip (if any) with its sentinel.
+    fn close_row(&mut self) {
+        if self.row.key != u32::MAX {
+            self.row.end = (self.base + self.at) as u32;
+            self.rows.push(self.row);
+            let k = self.at;
+            self.s.minx[k] = SENTINEL;
+            self.s.maxx[k] = SENTINEL;
+            self.s.miny[k] = 0;
+            self.s.maxy[k] = 0;
+            self.s.id[k] = u32::MAX;
+            self.s.idx[k] = u32::MAX;
+            self.at = k + 1;
+            self.row.key = u32::MAX;
+        }
+    }
+}

@@ -1,0 +1,233 @@
+//! The pair-finding kernels over [`Strips`], generic over what a found pair
+//! becomes ([`Sink`]) and monomorphised per sink: no trait object or `match`
+//! in the hot loop.
+//!
+//! The scans test [`BLOCK`] entries at a time without branching (each test
+//! is a few compares folded into a bit mask, which the compiler vectorises)
+//! and stop at the first entry that starts too far right; strips end with a
+//! sentinel that always stops a scan. The few hits are then walked bit by
+//! bit. Bodies move little, so most boxes have no or one candidate and a
+//! branchy scan would mispredict on almost every box.
+
+use super::strips::{row_level, Levels, Row, Strips, BLOCK, SENTINEL};
+use core::ops::Range;
+
+/// Receives every pair of boxes whose interiors overlap (strictly, on both
+/// axes): entry `i` of `a` and entry `j` of `b`.
+pub(crate) trait Sink {
+    /// One overlapping pair.
+    fn hit(&mut self, a: &Strips, i: usize, b: &Strips, j: usize);
+}
+
+/// A block of `BLOCK` values starting at `k`.
+#[inline(always)]
+fn block(v: &[i32], k: usize) -> &[i32; BLOCK] {
+    v[k..k + BLOCK].try_into().unwrap()
+}
+
+/// Bit `t` set when `v[k + t] < x`.
+#[inline(always)]
+fn lanes_lt(v: &[i32], k: usize, x: i32) -> u32 {
+    let b = block(v, k);
+    let mut m = 0;
+    for (t, &e) in b.iter().enumerate() {
+        m |= ((e < x) as u32) << t;
+    }
+    m
+}
+
+/// Bit `t` set when `v[k + t] <= x`.
+#[inline(always)]
+fn lanes_le(v: &[i32], k: usize, x: i32) -> u32 {
+    let b = block(v, k);
+    let mut m = 0;
+    for (t, &e) in b.iter().enumerate() {
+        m |= ((e <= x) as u32) << t;
+    }
+    m
+}
+
+/// Bit `t` set when entry `k + t` of `s` ends right of `x0` and overlaps
+/// `(y0, y1)` in y.
+#[inline(always)]
+fn lanes_rest(s: &Strips, k: usize, x0: i32, y0: i32, y1: i32) -> u32 {
+    let (mx, ny, my) = (block(&s.maxx, k), block(&s.miny, k), block(&s.maxy, k));
+    let mut m = 0;
+    for t in 0..BLOCK {
+        m |= (((mx[t] > x0) & (ny[t] < y1) & (my[t] > y0)) as u32) << t;
+    }
+    m
+}
+
+/// The low `n` bits.
+#[inline(always)]
+fn low(n: u32) -> u32 {
+    (1u32 << n) - 1
+}
+
+/// Tests box `(x0, x1, y0, y1)` against the entries of `s` from `k` on while
+/// they start left of `x1`, calling `hit(j)` for each overlap.
+#[inline(always)]
+fn scan(s: &Strips, mut k: usize, x0: i32, x1: i32, y0: i32, y1: i32, mut hit: impl FnMut(usize)) {
+    loop {
+        let run = lanes_lt(&s.minx, k, x1).trailing_ones();
+        let mut h = lanes_rest(s, k, x0, y0, y1) & low(run);
+        while h != 0 {
+            hit(k + h.trailing_zeros() as usize);
+            h &= h - 1;
+        }
+        if run < BLOCK as u32 {
+            return;
+        }
+        k += BLOCK;
+    }
+}
+
+/// Every overlapping pair inside one strip (`r` is a run of `s` sorted by
+/// left edge and followed by a sentinel): each box scans forward.
+#[inline]
+pub(crate) fn sweep_self<S: Sink>(s: &Strips, r: Range<usize>, sink: &mut S) {
+    for i in r {
+        let (x0, x1, y0, y1) = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
+        scan(s, i + 1, x0, x1, y0, y1, |j| sink.hit(s, i, s, j));
+    }
+}
+
+/// Moves cursor `p` of a run of `b` (sorted by left edge, ending in a
+/// sentinel, no box wider than `max_w`) past the boxes that end before `x0`
+/// can be reached: left edge `<= x0 - max_w`.
+#[inline(always)]
+fn advance(b: &Strips, p: &mut usize, x0: i32, max_w: u32) {
+    let lo = x0 as i64 - max_w as i64;
+    if lo >= i32::MIN as i64 {
+        // The sentinel is never <= lo (real edges are below i32::MAX).
+        loop {
+            let c = lanes_le(&b.minx, *p, lo as i32).trailing_ones();
+            *p += c as usize;
+            if c < BLOCK as u32 {
+                break;
+            }
+        }
+    }
+}
+
+/// Every overlapping pair of a box of run `ra` of `a` with a box of run `rb`
+/// of `b` (both sorted by left edge, `rb` followed by a sentinel, no box of
+/// `rb` wider than `max_w`). For each box of `ra`, in order, a cursor in `rb`
+/// skips the boxes that end before it can start (left edge
+/// `<= a.min.x - max_w`, a bound that only grows), then a forward scan tests
+/// the boxes that start before it ends.
+#[inline]
+pub(crate) fn sweep_two<S: Sink>(
+    a: &Strips,
+    ra: Range<usize>,
+    b: &Strips,
+    rb: Range<usize>,
+    max_w: u32,
+    sink: &mut S,
+) {
+    let mut p = rb.start;
+    for i in ra {
+        let (x0, x1, y0, y1) = (a.minx[i], a.maxx[i], a.miny[i], a.maxy[i]);
+        advance(b, &mut p, x0, max_w);
+        scan(b, p, x0, x1, y0, y1, |j| sink.hit(a, i, b, j));
+    }
+}
+
+/// [`sweep_self`] of run `ra` and [`sweep_two`] of `ra` against the next
+/// strip `next` of the same set, in one pass over `ra`. (Skipping the boxes
+/// that end above the next strip's highest top edge was measured: the
+/// unpredictable branch costs more than the scan it saves.)
+#[inline]
+fn sweep_self_and_next<S: Sink>(s: &Strips, ra: Range<usize>, next: &Row, sink: &mut S) {
+    let mut p = next.start as usize;
+    for i in ra {
+        let (x0, x1, y0, y1) = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
+        scan(s, i + 1, x0, x1, y0, y1, |j| sink.hit(s, i, s, j));
+        advance(s, &mut p, x0, next.max_w);
+        scan(s, p, x0, x1, y0, y1, |j| sink.hit(s, i, s, j));
+    }
+}
+
+/// Same-level pairs for the dynamic strips `rows` (row-table indices of
+/// `dy`): inside each strip, with the next strip, and with the static strips
+/// one above, level with and one below.
+pub(crate) fn same_level<S: Sink>(dy: &Strips, st: &Strips, rows: Range<usize>, sink: &mut S) {
+    let mut cursor = None;
+    for ri in rows {
+        let r = dy.rows[ri];
+        let run = r.start as usize..r.end as usize;
+        match dy.rows.get(ri + 1) {
+            Some(next) if next.key == r.key + 1 && row_level(next.key) == row_level(r.key) => {
+                sweep_self_and_next(dy, run.clone(), next, sink);
+            }
+            _ => sweep_self(dy, run.clone(), sink),
+        }
+        if st.rows.is_empty() {
+            continue;
+        }
+        // Static strips with keys r.key - 1 ..= r.key + 1 of the same level;
+        // dynamic strips come in key order, so the cursor only moves forward.
+        let lo = r.key.saturating_sub(1);
+        let c = cursor.get_or_insert_with(|| st.rows.partition_point(|s| s.key < lo));
+        while *c < st.rows.len() && st.rows[*c].key < lo {
+            *c += 1;
+        }
+        let mut k = *c;
+        while k < st.rows.len() && st.rows[k].key <= r.key.saturating_add(1) {
+            let s = st.rows[k];
+            if row_level(s.key) == row_level(r.key) {
+                let srun = s.start as usize..s.end as usize;
+                sweep_two(dy, run.clone(), st, srun, s.max_w, sink);
+            }
+            k += 1;
+        }
+    }
+}
+
+/// Pairs of entries `xs` of `x` (all on levels above 0) with the boxes of
+/// `y` on lower levels. For each box of `x` and each lower level of `y`: the
+/// strips it can reach, and in each a binary search on the left edge bounded
+/// by the strip's widest box, then a scan.
+pub(crate) fn cross_level<S: Sink>(
+    lv: &Levels,
+    x: &Strips,
+    xs: Range<usize>,
+    y: &Strips,
+    sink: &mut S,
+) {
+    for e in xs {
+        if x.minx[e] == SENTINEL {
+            continue;
+        }
+        let lx = level_of_entry(x, e);
+        let (x0, x1, y0, y1) = (x.minx[e], x.maxx[e], x.miny[e], x.maxy[e]);
+        for l in 0..lx {
+            if y.level_rows[l] == y.level_rows[l + 1] {
+                continue;
+            }
+            // A box of level l is at most S tall: it can overlap only if its
+            // top edge is in (y0 - S, y1).
+            let lo = lv.strip(l, y0 as i64 - lv.height(l) + 1);
+            let hi = lv.strip(l, y1 as i64 - 1);
+            for ri in y.rows_in(l, lo, hi) {
+                let r = y.rows[ri];
+                let from = x0 as i64 - r.max_w as i64;
+                let first = r.start as usize
+                    + y.minx[r.start as usize..r.end as usize]
+                        .partition_point(|&m| (m as i64) <= from);
+                scan(y, first, x0, x1, y0, y1, |j| sink.hit(x, e, y, j));
+            }
+        }
+    }
+}
+
+/// The level of entry `e` (from the set's level boundaries).
+#[inline]
+fn level_of_entry(s: &Strips, e: usize) -> usize {
+    let e = e as u32;
+    s.level_start[1..]
+        .iter()
+        .position(|&start| e < start)
+        .unwrap_or(super::strips::MAX_LEVELS - 1)
+}
