@@ -1,16 +1,73 @@
 //! The platformer: players, moving platforms, enemies, pickups and the rules
-//! that tie them to the physics world. (API skeleton with a stand-in
-//! implementation; the platformer issue replaces the internals.)
+//! that tie them to the physics world.
 //!
 //! [`Game`] is what the server runs authoritatively and the client predicts:
-//! `step` is deterministic, `snapshot`/`restore` carry the exact state, and
-//! `state_hash` identifies it.
+//! `step` is deterministic (integer only, players in id order, no hash map),
+//! `snapshot`/`restore` carry the exact state, and `state_hash` identifies it.
+//!
+//! # How a level becomes a world
+//! * The level's tilemap is the [`World`]'s tilemap: collision by lookup, no
+//!   collider per tile ([`World::set_tilemap`]).
+//! * Blocks are static boxes; moving platforms kinematic boxes (one-way ones
+//!   solid from above) whose centre is a pure function of the tick
+//!   ([`PathSchedule`]); walkers and players dynamic boxes that ride
+//!   platforms ([`World::set_rider`]). Players and walkers do not collide
+//!   with each other (layers): stomping and hurting are rules, checked on
+//!   the boxes after the physics step.
+//! * Coins, checkpoints, goals, hazard volumes and springboards are plain
+//!   boxes the rules test against player boxes (no collider).
+//!
+//! # One tick
+//! ```text
+//! platforms: velocity = path(t + 1) - path(t)
+//! players (id order): buttons -> run, jump / drop-through, gravity
+//! walkers: walk, gravity
+//! world.step: carry riders, move, detect (colliders + tiles), restitute
+//! walkers: squished -> defeated; turn at walls and ledges
+//! players (id order): squished / hazard -> respawn; ceiling, wall, ground;
+//!   ground snap; platform exit velocity; enemies (stomp or hurt);
+//!   springboards; coins; checkpoints; goal
+//! ```
+//! Events come out in that order (join and leave events first). The rules
+//! are described in `docs/PLATFORMER.md`.
+//!
+//! # State
+//! Everything that lasts from one tick to the next is in the snapshot:
+//! players (position, velocity, flags and timers packed as in [`state`]),
+//! walkers and coins; platforms are flagged
+//! [`EntityState::CLIENT_SIMULATED`] and recomputed from the tick. The
+//! world's per-tick scratch (touched sides, carriers, pushes) is rebuilt
+//! every tick, and a player's outcome never depends on other players' body
+//! ids, so restoring a snapshot into any game of the same level reproduces
+//! the future exactly.
 
+mod config;
+mod path;
+mod rules;
+pub mod state;
+
+pub use config::{CarryMode, GameConfig, PlayerConfig};
+pub use path::PathSchedule;
+pub use state::{kind, ENTITY_ID_BASE};
+
+use crate::fixed::{check_coord, check_speed};
 use crate::input::Buttons;
 use crate::level::{EntityKind, Level};
-use crate::protocol::{EntityState, PlayerId, StateSnapshot};
+use crate::protocol::{is_replicated, EntityState, PlayerId, StateSnapshot};
+use crate::shape::Aabb;
+use crate::tilemap::Tilemap;
+use crate::world::hash::Fnv1a;
+use crate::world::{BodyDesc, BodyId, ColliderDesc, OneWay, Sides, World, TILEMAP_LAYER};
 use glam::IVec2;
+use state::{coin_flags, platform_flags, walker_flags, PlayerState};
 use thiserror::Error;
+
+/// Collision layer of level geometry (blocks, platforms).
+const LAYER_SOLID: u32 = 1;
+/// Collision layer of players.
+const LAYER_PLAYER: u32 = 2;
+/// Collision layer of walkers.
+const LAYER_WALKER: u32 = 4;
 
 /// Why a game could not be built or changed.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -24,70 +81,449 @@ pub enum GameError {
     /// A snapshot that does not describe this game.
     #[error("snapshot does not fit this game: {0}")]
     BadSnapshot(String),
+    /// A level the game cannot run (names the entity and the problem).
+    #[error("level {level:?}: {message}")]
+    BadLevel {
+        /// The level's name.
+        level: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A configuration value out of range.
+    #[error("bad game configuration: {0}")]
+    BadConfig(String),
+    /// A player id at or above [`ENTITY_ID_BASE`] (reserved for entities).
+    #[error("player id {0} is reserved for level entities")]
+    PlayerIdOutOfRange(PlayerId),
+}
+
+/// What hurt a player.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum HurtCause {
+    /// A walker's body (entity id).
+    Enemy(u32),
+    /// A hazard tile.
+    HazardTile,
+    /// A hazard volume (entity id).
+    Hazard(u32),
 }
 
 /// Something that happened in a tick, for the server, the HUD and tests.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// Entity ids are [`ENTITY_ID_BASE`] plus the entity's index in the level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum GameEvent {
-    /// A player entered the game.
+    /// A player entered the game (reported at the start of the next step).
     Joined(PlayerId),
+    /// A player left the game (reported at the start of the next step).
+    Left(PlayerId),
+    /// A player jumped off the ground (or within coyote time).
+    Jumped(PlayerId),
+    /// A player pressed down + jump on a one-way surface and drops through.
+    DroppedThrough(PlayerId),
+    /// A player picked up a coin.
+    CoinPicked {
+        /// Who.
+        player: PlayerId,
+        /// The coin's entity id.
+        coin: u32,
+        /// Coins that player has picked up so far, this one included.
+        total: u32,
+    },
+    /// A player touched a checkpoint that was not its respawn point: now it is.
+    Checkpoint {
+        /// Who.
+        player: PlayerId,
+        /// The checkpoint's entity id.
+        checkpoint: u32,
+    },
+    /// A player reached a goal (once per player).
+    Won(PlayerId),
+    /// A player was hurt (a [`GameEvent::Respawned`] follows).
+    Hurt {
+        /// Who.
+        player: PlayerId,
+        /// By what.
+        cause: HurtCause,
+    },
+    /// A player landed on a walker's head: the walker is defeated and the
+    /// player bounces.
+    Stomped {
+        /// Who.
+        player: PlayerId,
+        /// The walker's entity id.
+        enemy: u32,
+    },
+    /// A springboard launched a player.
+    Launched {
+        /// Who.
+        player: PlayerId,
+        /// The springboard's entity id.
+        springboard: u32,
+    },
+    /// A player was crushed (a platform pushed it into something solid); a
+    /// [`GameEvent::Respawned`] follows.
+    Squished(PlayerId),
+    /// A player was put back at its respawn point.
+    Respawned {
+        /// Who.
+        player: PlayerId,
+        /// Its new centre.
+        pos: IVec2,
+    },
+    /// A walker was crushed and is defeated.
+    EnemySquished {
+        /// The walker's entity id.
+        enemy: u32,
+    },
+}
+
+/// The type of a level entity, for drawing ([`EntityView`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum EntityType {
+    /// A player spawn point.
+    Spawn,
+    /// A static block.
+    Block,
+    /// A moving platform.
+    Platform,
+    /// A walker enemy.
+    Walker,
+    /// A springboard.
+    Springboard,
+    /// A coin.
+    Coin,
+    /// A checkpoint.
+    Checkpoint,
+    /// A goal.
+    Goal,
+    /// A hazard volume.
+    Hazard,
+}
+
+impl EntityType {
+    /// Its kind byte ([`kind`]).
+    pub fn code(self) -> u8 {
+        match self {
+            EntityType::Spawn => kind::SPAWN,
+            EntityType::Block => kind::BLOCK,
+            EntityType::Platform => kind::PLATFORM,
+            EntityType::Walker => kind::WALKER,
+            EntityType::Springboard => kind::SPRINGBOARD,
+            EntityType::Coin => kind::COIN,
+            EntityType::Checkpoint => kind::CHECKPOINT,
+            EntityType::Goal => kind::GOAL,
+            EntityType::Hazard => kind::HAZARD,
+        }
+    }
+}
+
+/// A level entity as it is now, for drawing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EntityView {
+    /// Its id ([`ENTITY_ID_BASE`] + level index).
+    pub id: u32,
+    /// What it is.
+    pub ty: EntityType,
+    /// Its centre now, in units.
+    pub pos: IVec2,
+    /// Its half extents, in units.
+    pub half: IVec2,
+    /// Still in play: a walker not defeated, a coin not picked up (always
+    /// true for the others).
+    pub active: bool,
+    /// A one-way platform.
+    pub one_way: bool,
+    /// A walker walking left.
+    pub facing_left: bool,
+}
+
+/// A player as it is now, for drawing and the HUD.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PlayerView {
+    /// Its id.
+    pub id: PlayerId,
+    /// Its centre, in units.
+    pub pos: IVec2,
+    /// Its velocity, in units per tick.
+    pub vel: IVec2,
+    /// Half extents of its box.
+    pub half: IVec2,
+    /// Stood on the ground at the end of the last tick.
+    pub grounded: bool,
+    /// Faces left.
+    pub facing_left: bool,
+    /// Coins picked up.
+    pub coins: u32,
+    /// Reached the goal.
+    pub won: bool,
+    /// The checkpoint it respawns at (entity id), `None` for the level spawn.
+    pub checkpoint: Option<u32>,
+    /// Sides its box touched during the last step (a view of the world's
+    /// per-tick scratch: not part of the state, empty after a restore).
+    pub sides: Sides,
+}
+
+/// One level entity at run time.
+#[derive(Debug, Clone)]
+struct Ent {
+    ty: EntityType,
+    /// Centre in the level (a platform's first node).
+    pos: IVec2,
+    half: IVec2,
+    body: Option<BodyId>,
+    /// Walker speed or springboard strength.
+    param: i32,
+    path: Option<PathSchedule>,
+    one_way: bool,
+    /// Walker: not defeated.
+    alive: bool,
+    /// Walker: walking direction, -1 or 1.
+    dir: i32,
+    /// Coin: who picked it up.
+    collector: Option<u32>,
+}
+
+/// One player at run time.
+#[derive(Debug, Clone, Copy)]
+struct Player {
+    id: PlayerId,
+    body: BodyId,
+    st: PlayerState,
 }
 
 /// The running platformer.
 #[derive(Debug, Clone)]
 pub struct Game {
+    config: GameConfig,
+    name: String,
+    world: World,
     tick: u64,
-    spawn: IVec2,
-    players: Vec<(PlayerId, IVec2)>,
+    ents: Vec<Ent>,
+    spawns: Vec<usize>,
+    platforms: Vec<usize>,
+    walkers: Vec<usize>,
+    coins: Vec<usize>,
+    springs: Vec<usize>,
+    checkpoints: Vec<usize>,
+    goals: Vec<usize>,
+    hazards: Vec<usize>,
+    /// Ascending by id.
+    players: Vec<Player>,
     events: Vec<GameEvent>,
+    /// Join and leave events waiting for the next step.
+    pending: Vec<GameEvent>,
+    /// Per-step scratch: bodies the world reported squished / in a hazard tile.
+    squished: Vec<u32>,
+    in_hazard_tile: Vec<u32>,
+    tile_scratch: Vec<crate::tilemap::TileContact>,
 }
 
 impl Game {
-    /// Builds the game for `level`.
+    /// Builds the game for `level` with the default configuration.
     pub fn from_level(level: &Level) -> Result<Self, GameError> {
-        let spawn = level
-            .entities
-            .iter()
-            .find(|e| e.kind == EntityKind::PlayerSpawn)
-            .map(|e| e.pos)
-            .ok_or_else(|| GameError::NoSpawn(level.name.clone()))?;
-        Ok(Self { tick: 0, spawn, players: Vec::new(), events: Vec::new() })
+        Self::with_config(level, GameConfig::default())
     }
 
-    /// Adds a player at the current spawn point.
-    pub fn add_player(&mut self, id: PlayerId) -> Result<(), GameError> {
-        match self.players.binary_search_by_key(&id, |p| p.0) {
-            Ok(_) => Err(GameError::DuplicatePlayer(id)),
-            Err(i) => {
-                self.players.insert(i, (id, self.spawn));
-                self.events.push(GameEvent::Joined(id));
-                Ok(())
-            }
+    /// Builds the game for `level` with `config`.
+    pub fn with_config(level: &Level, config: GameConfig) -> Result<Self, GameError> {
+        config.player.validate().map_err(GameError::BadConfig)?;
+        let mut world = World::new(config.sim).map_err(|e| GameError::BadConfig(e.to_string()))?;
+        world.set_tilemap(level.tilemap.clone());
+        let bad = |i: usize, m: String| GameError::BadLevel {
+            level: level.name.clone(),
+            message: format!("entity {i}: {m}"),
+        };
+        if level.entities.len() >= (1 << 15) - 1 {
+            return Err(GameError::BadLevel {
+                level: level.name.clone(),
+                message: format!("{} entities; at most 32766", level.entities.len()),
+            });
         }
+        let mut g = Game {
+            config,
+            name: level.name.clone(),
+            world,
+            tick: 0,
+            ents: Vec::with_capacity(level.entities.len()),
+            spawns: Vec::new(),
+            platforms: Vec::new(),
+            walkers: Vec::new(),
+            coins: Vec::new(),
+            springs: Vec::new(),
+            checkpoints: Vec::new(),
+            goals: Vec::new(),
+            hazards: Vec::new(),
+            players: Vec::new(),
+            events: Vec::new(),
+            pending: Vec::new(),
+            squished: Vec::new(),
+            in_hazard_tile: Vec::new(),
+            tile_scratch: Vec::new(),
+        };
+        for (i, def) in level.entities.iter().enumerate() {
+            let half = def.size / 2;
+            for v in [def.pos.x, def.pos.y] {
+                check_coord("entity position", v as i64).map_err(|e| bad(i, e.to_string()))?;
+            }
+            let ty = match def.kind {
+                EntityKind::PlayerSpawn => EntityType::Spawn,
+                EntityKind::Block => EntityType::Block,
+                EntityKind::MovingPlatform { .. } => EntityType::Platform,
+                EntityKind::Walker { .. } => EntityType::Walker,
+                EntityKind::Springboard { .. } => EntityType::Springboard,
+                EntityKind::Coin => EntityType::Coin,
+                EntityKind::Checkpoint => EntityType::Checkpoint,
+                EntityKind::Goal => EntityType::Goal,
+                EntityKind::Hazard => EntityType::Hazard,
+            };
+            let needs_box = ty != EntityType::Spawn;
+            let shape = if needs_box {
+                Some(Aabb::new(half).map_err(|e| bad(i, format!("size {}: {e}", def.size)))?)
+            } else {
+                None
+            };
+            let mut e = Ent {
+                ty,
+                pos: def.pos,
+                half,
+                body: None,
+                param: 0,
+                path: None,
+                one_way: false,
+                alive: true,
+                dir: -1,
+                collector: None,
+            };
+            let build =
+                |r: Result<BodyId, crate::world::BuildError>| r.map_err(|x| bad(i, x.to_string()));
+            match &def.kind {
+                EntityKind::PlayerSpawn => g.spawns.push(i),
+                EntityKind::Block => {
+                    let b = build(g.world.add_body(BodyDesc::fixed(def.pos)))?;
+                    let c = ColliderDesc::solid(shape.expect("box")).layers(LAYER_SOLID, u32::MAX);
+                    g.world
+                        .add_collider(b, c)
+                        .map_err(|x| bad(i, x.to_string()))?;
+                    e.body = Some(b);
+                }
+                EntityKind::MovingPlatform { motion, one_way } => {
+                    let path = PathSchedule::new(motion).map_err(|m| bad(i, m))?;
+                    let b = build(g.world.add_body(BodyDesc::kinematic(path.at(0))))?;
+                    let mut c =
+                        ColliderDesc::solid(shape.expect("box")).layers(LAYER_SOLID, u32::MAX);
+                    if *one_way {
+                        c = c.one_way(OneWay::Up);
+                    }
+                    g.world
+                        .add_collider(b, c)
+                        .map_err(|x| bad(i, x.to_string()))?;
+                    e.pos = path.at(0);
+                    e.body = Some(b);
+                    e.path = Some(path);
+                    e.one_way = *one_way;
+                    g.platforms.push(i);
+                }
+                EntityKind::Walker { speed } => {
+                    check_speed("walker speed", *speed as i64)
+                        .map_err(|x| bad(i, x.to_string()))?;
+                    let b = build(g.world.add_body(BodyDesc::dynamic(def.pos)))?;
+                    let c = ColliderDesc::solid(shape.expect("box"))
+                        .layers(LAYER_WALKER, LAYER_SOLID | TILEMAP_LAYER);
+                    g.world
+                        .add_collider(b, c)
+                        .map_err(|x| bad(i, x.to_string()))?;
+                    g.world
+                        .set_rider(b, true)
+                        .map_err(|x| bad(i, x.to_string()))?;
+                    e.body = Some(b);
+                    e.param = speed.abs();
+                    g.walkers.push(i);
+                }
+                EntityKind::Springboard { strength } => {
+                    check_speed("springboard strength", *strength as i64)
+                        .map_err(|x| bad(i, x.to_string()))?;
+                    e.param = strength.abs();
+                    g.springs.push(i);
+                }
+                EntityKind::Coin => g.coins.push(i),
+                EntityKind::Checkpoint => g.checkpoints.push(i),
+                EntityKind::Goal => g.goals.push(i),
+                EntityKind::Hazard => g.hazards.push(i),
+            }
+            g.ents.push(e);
+        }
+        if g.spawns.is_empty() {
+            return Err(GameError::NoSpawn(level.name.clone()));
+        }
+        Ok(g)
     }
 
-    /// Removes a player and its body; returns whether it was there.
+    /// The configuration.
+    pub fn config(&self) -> &GameConfig {
+        &self.config
+    }
+
+    /// The level's name.
+    pub fn level_name(&self) -> &str {
+        &self.name
+    }
+
+    /// The collision grid.
+    pub fn tilemap(&self) -> &Tilemap {
+        self.world
+            .tilemap()
+            .expect("a game's world always has a tilemap")
+    }
+
+    /// The physics world (for debug drawing and tools).
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// Adds a player at its spawn point (spawn `id % spawn count` in level
+    /// order); a [`GameEvent::Joined`] opens the next step's events.
+    pub fn add_player(&mut self, id: PlayerId) -> Result<(), GameError> {
+        if id.0 >= ENTITY_ID_BASE {
+            return Err(GameError::PlayerIdOutOfRange(id));
+        }
+        let at = match self.players.binary_search_by_key(&id, |p| p.id) {
+            Ok(_) => return Err(GameError::DuplicatePlayer(id)),
+            Err(at) => at,
+        };
+        let st = PlayerState::default();
+        let pos = self.respawn_point(id, &st);
+        let body = self.new_player_body(pos)?;
+        self.players.insert(at, Player { id, body, st });
+        self.pending.push(GameEvent::Joined(id));
+        Ok(())
+    }
+
+    fn new_player_body(&mut self, pos: IVec2) -> Result<BodyId, GameError> {
+        let cfg = &self.config.player;
+        let shape = Aabb::new(cfg.half).map_err(|e| GameError::BadConfig(e.to_string()))?;
+        let err = |e: crate::world::BuildError| GameError::BadConfig(e.to_string());
+        let body = self.world.add_body(BodyDesc::dynamic(pos)).map_err(err)?;
+        let c = ColliderDesc::solid(shape).layers(LAYER_PLAYER, LAYER_SOLID | TILEMAP_LAYER);
+        self.world.add_collider(body, c).map_err(err)?;
+        self.world.set_rider(body, true).map_err(err)?;
+        Ok(body)
+    }
+
+    /// Removes a player and its body; returns whether it was there. A
+    /// [`GameEvent::Left`] opens the next step's events. Coins it picked up
+    /// stay picked up.
     pub fn remove_player(&mut self, id: PlayerId) -> bool {
-        match self.players.binary_search_by_key(&id, |p| p.0) {
+        match self.players.binary_search_by_key(&id, |p| p.id) {
             Ok(i) => {
-                self.players.remove(i);
+                let p = self.players.remove(i);
+                self.world
+                    .remove_body(p.body)
+                    .expect("a player's body exists");
+                self.pending.push(GameEvent::Left(id));
                 true
             }
             Err(_) => false,
         }
-    }
-
-    /// Runs one tick. `inputs` holds at most one entry per player, in any
-    /// order; a player without an entry holds no button.
-    pub fn step(&mut self, inputs: &[(PlayerId, Buttons)]) -> &[GameEvent] {
-        self.events.clear();
-        for (id, pos) in &mut self.players {
-            if let Some((_, b)) = inputs.iter().find(|(i, _)| i == id) {
-                *pos += IVec2::new(b.dir_x(), b.dir_y()) * 256;
-            }
-        }
-        self.tick += 1;
-        &self.events
     }
 
     /// Ticks run so far.
@@ -95,44 +531,350 @@ impl Game {
         self.tick
     }
 
-    /// The players and their positions, ascending by id.
-    pub fn players(&self) -> impl Iterator<Item = (PlayerId, IVec2)> + '_ {
-        self.players.iter().copied()
+    /// The last step's events.
+    pub fn events(&self) -> &[GameEvent] {
+        &self.events
     }
 
-    /// The exact state, as entities.
-    pub fn snapshot(&self) -> StateSnapshot {
-        StateSnapshot {
-            tick: self.tick,
-            entities: self
-                .players
-                .iter()
-                .map(|(id, pos)| EntityState { pos: *pos, ..EntityState::zero(id.0) })
-                .collect(),
+    /// The players and their centres (units), ascending by id.
+    pub fn players(&self) -> impl Iterator<Item = (PlayerId, IVec2)> + '_ {
+        self.players.iter().map(|p| (p.id, self.body_pos(p.body)))
+    }
+
+    /// One player's view.
+    pub fn player(&self, id: PlayerId) -> Option<PlayerView> {
+        let i = self.players.binary_search_by_key(&id, |p| p.id).ok()?;
+        Some(self.view_of(&self.players[i]))
+    }
+
+    /// Every player's view, ascending by id.
+    pub fn player_views(&self) -> impl Iterator<Item = PlayerView> + '_ {
+        self.players.iter().map(|p| self.view_of(p))
+    }
+
+    fn view_of(&self, p: &Player) -> PlayerView {
+        let b = self.world.body(p.body).expect("a player's body exists");
+        PlayerView {
+            id: p.id,
+            pos: b.pos(),
+            vel: b.vel(),
+            half: self.config.player.half,
+            grounded: p.st.grounded,
+            facing_left: p.st.facing_left,
+            coins: self.coins_of(p.id),
+            won: p.st.won,
+            checkpoint: (p.st.checkpoint != 0).then(|| ENTITY_ID_BASE + p.st.checkpoint as u32 - 1),
+            sides: b.sides(),
         }
     }
 
-    /// Restores the exact state of a [`Game::snapshot`] of the same level.
+    /// Coins player `id` has picked up.
+    pub fn coins_of(&self, id: PlayerId) -> u32 {
+        self.coins
+            .iter()
+            .filter(|&&i| self.ents[i].collector == Some(id.0))
+            .count() as u32
+    }
+
+    /// Every level entity as it is now, in level order.
+    pub fn entities(&self) -> impl Iterator<Item = EntityView> + '_ {
+        self.ents.iter().enumerate().map(|(i, e)| EntityView {
+            id: ENTITY_ID_BASE + i as u32,
+            ty: e.ty,
+            pos: e.body.map_or(e.pos, |b| self.body_pos(b)),
+            half: e.half,
+            active: match e.ty {
+                EntityType::Walker => e.alive,
+                EntityType::Coin => e.collector.is_none(),
+                _ => true,
+            },
+            one_way: e.one_way,
+            facing_left: e.dir < 0,
+        })
+    }
+
+    fn body_pos(&self, b: BodyId) -> IVec2 {
+        self.world.body(b).map_or(IVec2::ZERO, |b| b.pos())
+    }
+
+    fn body_vel(&self, b: BodyId) -> IVec2 {
+        self.world.body(b).map_or(IVec2::ZERO, |b| b.vel())
+    }
+
+    /// Where player `id` with state `st` respawns: its checkpoint, else its
+    /// spawn; the player's box stands on the bottom of that entity's box,
+    /// centred in x.
+    fn respawn_point(&self, id: PlayerId, st: &PlayerState) -> IVec2 {
+        let i = if st.checkpoint != 0 {
+            st.checkpoint as usize - 1
+        } else {
+            self.spawns[id.0 as usize % self.spawns.len()]
+        };
+        let e = &self.ents[i];
+        IVec2::new(e.pos.x, e.pos.y + e.half.y - self.config.player.half.y)
+    }
+
+    /// Calls `f` with every entity's state, ascending by id: players, then
+    /// walkers, coins and platforms (client-simulated) in level order.
+    fn for_each_state(&self, mut f: impl FnMut(EntityState)) {
+        for p in &self.players {
+            f(EntityState {
+                id: p.id.0,
+                kind: kind::PLAYER,
+                pos: self.body_pos(p.body),
+                vel: self.body_vel(p.body),
+                flags: p.st.flags(),
+                aux: p.st.aux(),
+            });
+        }
+        for (i, e) in self.ents.iter().enumerate() {
+            let id = ENTITY_ID_BASE + i as u32;
+            match e.ty {
+                EntityType::Walker => {
+                    let b = e.body.expect("walker body");
+                    f(EntityState {
+                        id,
+                        kind: kind::WALKER,
+                        pos: self.body_pos(b),
+                        vel: self.body_vel(b),
+                        flags: (e.alive as u32 * walker_flags::ALIVE)
+                            | ((e.dir < 0) as u32 * walker_flags::FACING_LEFT),
+                        aux: 0,
+                    })
+                }
+                EntityType::Coin => f(EntityState {
+                    id,
+                    kind: kind::COIN,
+                    pos: e.pos,
+                    vel: IVec2::ZERO,
+                    flags: e.collector.is_some() as u32 * coin_flags::COLLECTED,
+                    aux: e.collector.unwrap_or(0) as i32,
+                }),
+                EntityType::Platform => {
+                    let b = e.body.expect("platform body");
+                    f(EntityState {
+                        id,
+                        kind: kind::PLATFORM,
+                        pos: self.body_pos(b),
+                        vel: self.platform_step(e),
+                        flags: EntityState::CLIENT_SIMULATED
+                            | (e.one_way as u32 * platform_flags::ONE_WAY),
+                        aux: 0,
+                    })
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// A platform's motion during the next step.
+    fn platform_step(&self, e: &Ent) -> IVec2 {
+        let p = e.path.as_ref().expect("platform path");
+        p.at(self.tick + 1) - p.at(self.tick)
+    }
+
+    /// Every entity with state, ascending by id, platforms included (flagged
+    /// [`EntityState::CLIENT_SIMULATED`]): what a renderer or a custom
+    /// snapshot filter starts from.
+    pub fn entity_states(&self) -> Vec<EntityState> {
+        let mut v = Vec::new();
+        self.for_each_state(|e| v.push(e));
+        v
+    }
+
+    /// The exact state: every entity [`is_replicated`] keeps (players,
+    /// walkers, coins; platforms are recomputed from the tick).
+    pub fn snapshot(&self) -> StateSnapshot {
+        let mut entities =
+            Vec::with_capacity(self.players.len() + self.walkers.len() + self.coins.len());
+        self.for_each_state(|e| {
+            if is_replicated(&e) {
+                entities.push(e)
+            }
+        });
+        StateSnapshot {
+            tick: self.tick,
+            entities,
+        }
+    }
+
+    /// Restores the exact state of a [`Game::snapshot`] of a game of the same
+    /// level and configuration: afterwards `state_hash` and every future tick
+    /// equal the original's. Client-simulated entities in the snapshot are
+    /// ignored (platforms follow the tick). Join and leave events not yet
+    /// reported are dropped. Nothing changes on error.
     pub fn restore(&mut self, snapshot: &StateSnapshot) -> Result<(), GameError> {
+        let bad = |m: String| GameError::BadSnapshot(m);
+        snapshot.validate().map_err(|e| bad(e.to_string()))?;
+        let mut players: Vec<(PlayerId, &EntityState, PlayerState)> = Vec::new();
+        let mut found = vec![None::<&EntityState>; self.ents.len()];
+        for e in &snapshot.entities {
+            for (what, v) in [("x", e.pos.x), ("y", e.pos.y)] {
+                check_coord("position", v as i64)
+                    .map_err(|x| bad(format!("entity {}: {what}: {x}", e.id)))?;
+            }
+            for v in [e.vel.x, e.vel.y] {
+                check_speed("velocity", v as i64)
+                    .map_err(|x| bad(format!("entity {}: {x}", e.id)))?;
+            }
+            if e.id < ENTITY_ID_BASE {
+                if e.kind != kind::PLAYER {
+                    return Err(bad(format!(
+                        "entity {} has kind {}, not a player",
+                        e.id, e.kind
+                    )));
+                }
+                let st = PlayerState::unpack(e.flags, e.aux).ok_or_else(|| {
+                    bad(format!("player {}: unknown flag bits {:#x}", e.id, e.flags))
+                })?;
+                if st.checkpoint != 0 {
+                    let ok = self
+                        .ents
+                        .get(st.checkpoint as usize - 1)
+                        .is_some_and(|c| c.ty == EntityType::Checkpoint);
+                    if !ok {
+                        return Err(bad(format!(
+                            "player {}: no checkpoint {}",
+                            e.id,
+                            st.checkpoint - 1
+                        )));
+                    }
+                }
+                players.push((PlayerId(e.id), e, st));
+                continue;
+            }
+            let i = (e.id - ENTITY_ID_BASE) as usize;
+            let Some(ent) = self.ents.get(i) else {
+                return Err(bad(format!("no entity {}", e.id)));
+            };
+            if e.kind != ent.ty.code() {
+                return Err(bad(format!(
+                    "entity {} has kind {}, expected {}",
+                    e.id,
+                    e.kind,
+                    ent.ty.code()
+                )));
+            }
+            match ent.ty {
+                EntityType::Platform => {}
+                EntityType::Walker | EntityType::Coin => found[i] = Some(e),
+                _ => return Err(bad(format!("entity {} has no state", e.id))),
+            }
+        }
+        for &i in self.walkers.iter().chain(&self.coins) {
+            if found[i].is_none() {
+                return Err(bad(format!(
+                    "entity {} is missing",
+                    ENTITY_ID_BASE + i as u32
+                )));
+            }
+        }
+        // Valid: apply. Players first: drop those not in the snapshot, add
+        // the new ones, then set every state.
+        let old: Vec<Player> = std::mem::take(&mut self.players);
+        let mut kept = Vec::with_capacity(players.len());
+        for p in old {
+            if players.iter().any(|(id, _, _)| *id == p.id) {
+                kept.push(p);
+            } else {
+                self.world
+                    .remove_body(p.body)
+                    .expect("a player's body exists");
+            }
+        }
+        for (id, e, st) in players {
+            let body = match kept.iter().find(|p| p.id == id) {
+                Some(p) => p.body,
+                None => self.new_player_body(e.pos)?,
+            };
+            self.set_body(body, e.pos, e.vel);
+            self.world
+                .set_drop_through(body, false)
+                .expect("player body");
+            self.players.push(Player { id, body, st });
+        }
+        for (i, e) in found.iter().enumerate() {
+            let Some(e) = e else { continue };
+            let body = self.ents[i].body;
+            match self.ents[i].ty {
+                EntityType::Walker => {
+                    let body = body.expect("walker body");
+                    let alive = e.flags & walker_flags::ALIVE != 0;
+                    self.set_body(body, e.pos, e.vel);
+                    self.world.set_enabled(body, alive).expect("walker body");
+                    let ent = &mut self.ents[i];
+                    ent.alive = alive;
+                    ent.dir = if e.flags & walker_flags::FACING_LEFT != 0 {
+                        -1
+                    } else {
+                        1
+                    };
+                }
+                EntityType::Coin => {
+                    self.ents[i].collector =
+                        (e.flags & coin_flags::COLLECTED != 0).then_some(e.aux as u32);
+                }
+                _ => {}
+            }
+        }
         self.tick = snapshot.tick;
-        self.players = snapshot.entities.iter().map(|e| (PlayerId(e.id), e.pos)).collect();
+        self.place_platforms();
+        self.events.clear();
+        self.pending.clear();
         Ok(())
     }
 
-    /// A stable 64-bit hash of the whole state.
-    pub fn state_hash(&self) -> u64 {
-        let mut h = 0xcbf2_9ce4_8422_2325u64;
-        let mut eat = |v: u64| {
-            for b in v.to_le_bytes() {
-                h = (h ^ b as u64).wrapping_mul(0x100_0000_01b3);
-            }
-        };
-        eat(self.tick);
-        for (id, p) in &self.players {
-            eat(id.0 as u64);
-            eat(p.x as u32 as u64);
-            eat(p.y as u32 as u64);
+    /// Sets a body's position and velocity (both validated by the caller).
+    fn set_body(&mut self, body: BodyId, pos: IVec2, vel: IVec2) {
+        self.world
+            .set_position(body, pos)
+            .expect("position checked");
+        self.world
+            .set_velocity(body, vel)
+            .expect("velocity checked");
+    }
+
+    /// Puts every platform where its path says it is at the current tick.
+    fn place_platforms(&mut self) {
+        for &i in &self.platforms {
+            let e = &self.ents[i];
+            let pos = e.path.as_ref().expect("platform path").at(self.tick);
+            let body = e.body.expect("platform body");
+            self.world
+                .set_position(body, pos)
+                .expect("path nodes are checked");
+            self.world
+                .set_velocity(body, IVec2::ZERO)
+                .expect("zero velocity");
         }
-        h
+    }
+
+    /// A stable 64-bit hash of the whole state: FNV-1a over the tick and
+    /// every entity state ([`Game::entity_states`], platforms included), each
+    /// field little-endian. Equal after [`Game::restore`] of a
+    /// [`Game::snapshot`].
+    pub fn state_hash(&self) -> u64 {
+        let mut h = Fnv1a::default();
+        h.u64(self.tick);
+        self.for_each_state(|e| {
+            h.u32(e.id);
+            h.u8(e.kind);
+            h.ivec2(e.pos);
+            h.ivec2(e.vel);
+            h.u32(e.flags);
+            h.i32(e.aux);
+        });
+        h.finish()
+    }
+
+    /// Runs one tick. `inputs` holds at most one entry per player, in any
+    /// order (the first entry of a player counts); a player without an entry
+    /// holds no button. Returns the tick's events (also [`Game::events`]).
+    pub fn step(&mut self, inputs: &[(PlayerId, Buttons)]) -> &[GameEvent] {
+        self.events.clear();
+        self.events.append(&mut self.pending);
+        self.step_rules(inputs);
+        self.tick += 1;
+        &self.events
     }
 }

@@ -6,9 +6,18 @@ use serde::{Deserialize, Serialize};
 
 use super::BuildError;
 
-/// A body's index in its world, in creation order (stable for the world's life).
+/// A body's index in its world: creation order, except that
+/// [`super::World::add_body`] reuses the lowest slot freed by
+/// [`super::World::remove_body`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub struct BodyId(pub u32);
+
+impl BodyId {
+    /// The world's tilemap, as the other body of a tile contact (in
+    /// [`super::Event`]s and [`super::ContactRecord`]s). No real body has
+    /// this id.
+    pub const TILEMAP: BodyId = BodyId(u32::MAX);
+}
 
 /// How a body takes part in the simulation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -192,6 +201,17 @@ pub struct Body {
     /// Sum of the restitution pushes received this tick (saturating; only
     /// the signs matter).
     pub(crate) push: IVec2,
+    /// Takes part in the simulation (a disabled body neither moves nor
+    /// collides, and keeps its state).
+    pub(crate) enabled: bool,
+    /// The slot is free (removed); implies disabled.
+    pub(crate) removed: bool,
+    /// Carried by the kinematic box it stands on.
+    pub(crate) rider: bool,
+    /// Ignores one-way colliders and one-way tiles.
+    pub(crate) drop_through: bool,
+    /// The kinematic body that carried it this tick.
+    pub(crate) carrier: Option<u32>,
 }
 
 impl Body {
@@ -204,7 +224,54 @@ impl Body {
             sides: Sides::NONE,
             start: desc.pos,
             push: IVec2::ZERO,
+            enabled: true,
+            removed: false,
+            rider: false,
+            drop_through: false,
+            carrier: None,
         }
+    }
+
+    /// Whether the body takes part in the simulation (see
+    /// [`super::World::set_enabled`]).
+    #[inline]
+    pub fn is_enabled(&self) -> bool {
+        self.enabled
+    }
+
+    /// Whether the body was removed ([`super::World::remove_body`]): its slot
+    /// is free and will be reused.
+    #[inline]
+    pub fn is_removed(&self) -> bool {
+        self.removed
+    }
+
+    /// Whether kinematic boxes it stands on carry it (see
+    /// [`super::World::set_rider`]).
+    #[inline]
+    pub fn is_rider(&self) -> bool {
+        self.rider
+    }
+
+    /// Whether it falls through one-way colliders and one-way tiles (see
+    /// [`super::World::set_drop_through`]).
+    #[inline]
+    pub fn drops_through(&self) -> bool {
+        self.drop_through
+    }
+
+    /// The kinematic body that carried it during the last tick, if any.
+    #[inline]
+    pub fn carrier(&self) -> Option<BodyId> {
+        self.carrier.map(BodyId)
+    }
+
+    /// The byte of boolean state the world hashes.
+    pub(crate) fn flag_bits(&self) -> u8 {
+        self.enabled as u8
+            | (self.removed as u8) << 1
+            | (self.rider as u8) << 2
+            | (self.drop_through as u8) << 3
     }
 
     /// Static, kinematic or dynamic.

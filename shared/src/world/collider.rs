@@ -8,9 +8,16 @@ use serde::{Deserialize, Serialize};
 use super::body::BodyId;
 
 /// A collider's index in its world, in creation order (stable for the world's
-/// life; also the tie-breaker that makes every ordering deterministic).
+/// life, never reused; also the tie-breaker that makes every ordering
+/// deterministic).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub struct ColliderId(pub u32);
+
+impl ColliderId {
+    /// The world's tilemap, as the other collider of a tile contact. No real
+    /// collider has this id.
+    pub const TILEMAP: ColliderId = ColliderId(u32::MAX);
+}
 
 /// Whether a collider blocks or only reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

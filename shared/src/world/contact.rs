@@ -49,6 +49,9 @@ pub struct ContactRecord {
     /// Area of the overlap of the two bounding boxes: the second sort key.
     pub(crate) area: u64,
     pub(crate) recheck: RecheckFn,
+    /// For a tile contact (B is [`BodyId::TILEMAP`]): the tile's coordinates,
+    /// the last sort key. Zero otherwise.
+    pub(crate) tile: IVec2,
 }
 
 impl ContactRecord {
@@ -83,17 +86,39 @@ impl ContactRecord {
         self.kind
     }
 
+    /// The tile coordinates when B is the world's tilemap.
+    pub fn tile(&self) -> Option<IVec2> {
+        self.is_tile().then_some(self.tile)
+    }
+
+    /// Whether B is the world's tilemap ([`BodyId::TILEMAP`]).
+    #[inline]
+    pub fn is_tile(&self) -> bool {
+        self.b.body == BodyId::TILEMAP.0
+    }
+
     /// Restitution order: `|MTV|^2` descending, then bounding-box overlap area
-    /// descending, then the two collider ids (smaller first). Collider pairs
-    /// are unique within a detection, so this is a total order and an
-    /// unstable sort is deterministic.
+    /// descending, then the two collider ids (smaller first), then (tile
+    /// contacts only: the tilemap is one collider) the tile's row and column.
+    /// Collider pairs and tiles are unique within a detection, so this is a
+    /// total order and an unstable sort is deterministic.
     ///
     /// The area key settles equal depths in favour of the surface the body
     /// rests on: crossing a floor seam, the box being entered can offer a
     /// sideways push exactly as deep as the floor's upward one, and resolving
     /// it first would snag.
     #[inline]
-    pub(crate) fn order_key(&self) -> (core::cmp::Reverse<u64>, core::cmp::Reverse<u64>, u32, u32) {
+    #[allow(clippy::type_complexity)]
+    pub(crate) fn order_key(
+        &self,
+    ) -> (
+        core::cmp::Reverse<u64>,
+        core::cmp::Reverse<u64>,
+        u32,
+        u32,
+        i32,
+        i32,
+    ) {
         let (x, y) = (
             self.mtv.x.unsigned_abs() as u64,
             self.mtv.y.unsigned_abs() as u64,
@@ -109,6 +134,8 @@ impl ContactRecord {
             core::cmp::Reverse(self.area),
             lo,
             hi,
+            self.tile.y,
+            self.tile.x,
         )
     }
 }

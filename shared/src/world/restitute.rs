@@ -26,15 +26,32 @@
 //! 6. **sides** touched are recorded from the MTV's direction for every
 //!    dynamic body of the contact, and every push is logged for events.
 //!
+//! Tile contacts (B is the tilemap, [`super::BodyId::TILEMAP`]) take the same
+//! path: B is static, so A takes the whole push; their re-check is
+//! [`Tilemap::tile_contact`] at A's current position and displacement, which
+//! also applies the tilemap's own one-way rule (one-way tiles are not
+//! `OneWay` colliders here). A body flagged to drop through
+//! ([`super::World::set_drop_through`]) is never pushed by a one-way
+//! collider nor by a one-way tile.
+//!
 //! Triggers are skipped: they only produce events.
 
 use crate::fixed::{div_away, MAX_SPEED};
+use crate::tilemap::Tilemap;
 use glam::{I64Vec2, IVec2};
 
 use super::body::{Body, Sides};
 use super::collider::{Colliders, OneWay};
 use super::contact::{ContactKind, ContactRecord};
+use super::detect::{tile_flags, tile_push_ok};
 use super::event::{Hit, TriggerHit};
+
+/// What re-checks need besides the bodies: the colliders and the tilemap.
+#[derive(Clone, Copy)]
+pub(crate) struct Scene<'a> {
+    pub cols: &'a Colliders,
+    pub tiles: Option<&'a Tilemap>,
+}
 
 /// Slack, in units, of the one-way "came from that side" test. MTVs are
 /// rounded away from zero (SAT: under one unit per axis; circles: at most
@@ -47,7 +64,7 @@ pub const ONE_WAY_SLOP: i64 = 2;
 pub(crate) fn pass(
     contacts: &mut [ContactRecord],
     bodies: &mut [Body],
-    cols: &Colliders,
+    scene: Scene<'_>,
     hits: &mut Vec<Hit>,
 ) -> bool {
     contacts.sort_unstable_by_key(ContactRecord::order_key);
@@ -56,7 +73,7 @@ pub(crate) fn pass(
         if c.kind != ContactKind::Solid {
             continue;
         }
-        let Some(m) = current_mtv(c, bodies, cols) else {
+        let Some(m) = current_mtv(c, bodies, scene) else {
             continue;
         };
         if !one_way_ok(c, m, bodies) {
@@ -99,37 +116,58 @@ pub(crate) fn log_triggers(contacts: &[ContactRecord], out: &mut Vec<TriggerHit>
 pub(crate) fn log_squished(
     contacts: &[ContactRecord],
     bodies: &[Body],
-    cols: &Colliders,
+    scene: Scene<'_>,
     out: &mut Vec<u32>,
 ) {
     for c in contacts {
         if c.kind != ContactKind::Solid {
             continue;
         }
-        let Some(m) = current_mtv(c, bodies, cols) else {
+        let Some(m) = current_mtv(c, bodies, scene) else {
             continue;
         };
         if !one_way_ok(c, m, bodies) {
             continue;
         }
-        for b in [c.a.body, c.b.body] {
-            if bodies[b as usize].is_dynamic() {
-                out.push(b);
-            }
+        if bodies[c.a.body as usize].is_dynamic() {
+            out.push(c.a.body);
+        }
+        if !c.is_tile() && bodies[c.b.body as usize].is_dynamic() {
+            out.push(c.b.body);
         }
     }
 }
 
 /// The contact's MTV at the bodies' current positions: the stored one if
-/// neither body moved since detection, else a fresh narrow phase.
+/// neither body moved since detection, else a fresh narrow phase (for a tile:
+/// [`Tilemap::tile_contact`]).
 #[inline]
-pub(crate) fn current_mtv(c: &ContactRecord, bodies: &[Body], cols: &Colliders) -> Option<IVec2> {
-    let pa = bodies[c.a.body as usize].pos;
+pub(crate) fn current_mtv(c: &ContactRecord, bodies: &[Body], scene: Scene<'_>) -> Option<IVec2> {
+    let a = &bodies[c.a.body as usize];
+    if c.is_tile() {
+        if a.pos == c.pos_a {
+            return Some(c.mtv);
+        }
+        let d = &scene.cols.aabbs.items[c.a.index as usize];
+        let map = scene.tiles?;
+        let centre = a.pos + d.offset;
+        return map
+            .tile_contact(
+                c.tile,
+                centre,
+                d.shape.half(),
+                a.pos - a.start,
+                tile_flags(a),
+            )
+            .filter(|t| tile_push_ok(map, t.tile, t.kind, centre, t.mtv))
+            .map(|t| t.mtv);
+    }
+    let pa = a.pos;
     let pb = bodies[c.b.body as usize].pos;
     if pa == c.pos_a && pb == c.pos_b {
         Some(c.mtv)
     } else {
-        (c.recheck)(cols, c.a.index, pa, c.b.index, pb).mtv()
+        (c.recheck)(scene.cols, c.a.index, pa, c.b.index, pb).mtv()
     }
 }
 
@@ -139,15 +177,16 @@ pub(crate) fn one_way_ok(c: &ContactRecord, m: IVec2, bodies: &[Body]) -> bool {
     if c.a.one_way.is_none() && c.b.one_way.is_none() {
         return true;
     }
-    let da = displacement(&bodies[c.a.body as usize]);
-    let db = displacement(&bodies[c.b.body as usize]);
+    // Tile ends are never one-way colliders: both bodies are real here.
+    let (ba, bb) = (&bodies[c.a.body as usize], &bodies[c.b.body as usize]);
+    let (da, db) = (displacement(ba), displacement(bb));
     if let Some(dir) = c.b.one_way {
-        if !one_way_accepts(m, dir, da - db) {
+        if ba.drop_through || !one_way_accepts(m, dir, da - db) {
             return false;
         }
     }
     if let Some(dir) = c.a.one_way {
-        if !one_way_accepts(-m, dir, db - da) {
+        if bb.drop_through || !one_way_accepts(-m, dir, db - da) {
             return false;
         }
     }
@@ -174,9 +213,17 @@ fn displacement(b: &Body) -> I64Vec2 {
 /// Applies MTV `m` to the contact's bodies; returns whether one moved.
 fn resolve(c: &ContactRecord, m: IVec2, bodies: &mut [Body], hits: &mut Vec<Hit>) -> bool {
     let (ia, ib) = (c.a.body as usize, c.b.body as usize);
-    let (dyn_a, dyn_b) = (bodies[ia].is_dynamic(), bodies[ib].is_dynamic());
-    let (push_a, push_b) = (bodies[ia].push.to_array(), bodies[ib].push.to_array());
-    let (mass_a, mass_b) = (bodies[ia].mass as i128, bodies[ib].mass as i128);
+    let tile = c.is_tile();
+    let dyn_a = bodies[ia].is_dynamic();
+    let push_a = bodies[ia].push.to_array();
+    let mass_a = bodies[ia].mass as i128;
+    // The tilemap end is static: never moves, no push, any mass.
+    let (dyn_b, push_b, mass_b) = if tile {
+        (false, [0; 2], 1)
+    } else {
+        let b = &bodies[ib];
+        (b.is_dynamic(), b.push.to_array(), b.mass as i128)
+    };
     let mv = m.to_array();
     let mut da = [0i32; 2];
     let mut db = [0i32; 2];

@@ -1,0 +1,551 @@
+//! The rules of one tick (see the module docs of [`super`] for the order and
+//! `docs/PLATFORMER.md` for each rule).
+
+use glam::IVec2;
+
+use super::config::{CarryMode, PlayerConfig};
+use super::{EntityType, Game, GameEvent, HurtCause, Player, ENTITY_ID_BASE};
+use crate::fixed::MAX_SPEED;
+use crate::input::Buttons;
+use crate::protocol::PlayerId;
+use crate::tilemap::{ContactFlags, Tile, TileContact, Tilemap};
+use crate::world::{BodyId, Event, Sides};
+
+/// A box by its edges, in `i64` units.
+#[derive(Debug, Clone, Copy)]
+struct Rect {
+    l: i64,
+    t: i64,
+    r: i64,
+    b: i64,
+}
+
+impl Rect {
+    fn new(centre: IVec2, half: IVec2) -> Self {
+        let (c, h) = (centre.as_i64vec2(), half.as_i64vec2());
+        Rect {
+            l: c.x - h.x,
+            t: c.y - h.y,
+            r: c.x + h.x,
+            b: c.y + h.y,
+        }
+    }
+
+    /// Interiors overlap.
+    fn overlaps(&self, o: &Rect) -> bool {
+        self.l < o.r && o.l < self.r && self.t < o.b && o.t < self.b
+    }
+}
+
+/// Horizontal speed after one tick of `dir` (-1, 0, 1) from `vx`.
+fn run(vx: i32, dir: i32, accel: i32, brake: i32, max: i32) -> i32 {
+    let v = vx as i64;
+    if dir == 0 {
+        return if v > 0 {
+            (v - brake as i64).max(0) as i32
+        } else {
+            (v + brake as i64).min(0) as i32
+        };
+    }
+    let (d, accel, brake, max) = (dir as i64, accel as i64, brake as i64, max as i64);
+    let s = v * d;
+    let s = if s < 0 {
+        (s + brake + accel).min(max)
+    } else if s < max {
+        (s + accel).min(max)
+    } else {
+        (s - brake).max(max)
+    };
+    (s * d) as i32
+}
+
+impl Game {
+    pub(super) fn step_rules(&mut self, inputs: &[(PlayerId, Buttons)]) {
+        // Platforms: this tick's motion, from the path.
+        for k in 0..self.platforms.len() {
+            let e = &self.ents[self.platforms[k]];
+            let v = self.platform_step(e);
+            let body = e.body.expect("platform body");
+            self.world
+                .set_velocity(body, v)
+                .expect("path steps are bounded");
+        }
+        for i in 0..self.players.len() {
+            let id = self.players[i].id;
+            let b = inputs
+                .iter()
+                .find(|(p, _)| *p == id)
+                .map_or(Buttons::NONE, |(_, b)| *b);
+            self.player_before(i, b);
+        }
+        for k in 0..self.walkers.len() {
+            let e = &self.ents[self.walkers[k]];
+            if !e.alive {
+                continue;
+            }
+            let body = e.body.expect("walker body");
+            let cfg = &self.config.player;
+            let v = self.body_vel(body);
+            let v = IVec2::new(
+                e.dir * e.param,
+                (v.y as i64 + cfg.gravity as i64).min(cfg.max_fall_speed as i64) as i32,
+            );
+            self.world
+                .set_velocity(body, v)
+                .expect("bounded walker speed");
+        }
+
+        self.world.step(&[]);
+        self.squished.clear();
+        self.in_hazard_tile.clear();
+        for e in self.world.events() {
+            match *e {
+                Event::Squished { body } => self.squished.push(body.0),
+                Event::Trigger {
+                    body, trigger_body, ..
+                } if trigger_body == BodyId::TILEMAP => self.in_hazard_tile.push(body.0),
+                _ => {}
+            }
+        }
+
+        for k in 0..self.walkers.len() {
+            self.walker_after(self.walkers[k]);
+        }
+        for i in 0..self.players.len() {
+            self.player_after(i);
+        }
+    }
+
+    /// Buttons to velocity, before the physics step.
+    fn player_before(&mut self, i: usize, b: Buttons) {
+        let cfg = self.config.player;
+        let mut p = self.players[i];
+        let mut v = self.body_vel(p.body);
+        let s = &mut p.st;
+
+        let held = b.held(Buttons::JUMP);
+        if held && !s.jump_held {
+            s.buffer = cfg.jump_buffer_ticks + 1;
+        }
+        s.jump_held = held;
+
+        let dir = b.dir_x();
+        if dir != 0 {
+            s.facing_left = dir < 0;
+        }
+        v.x = if s.grounded {
+            run(v.x, dir, cfg.run_accel, cfg.run_brake, cfg.max_run_speed)
+        } else {
+            run(v.x, dir, cfg.air_accel, cfg.air_brake, cfg.max_run_speed)
+        };
+
+        let can_jump = s.grounded || s.coyote > 0;
+        if !s.grounded && s.coyote > 0 {
+            s.coyote -= 1;
+        }
+        if s.buffer > 0 && can_jump {
+            let pos = self.body_pos(p.body);
+            if b.held(Buttons::DOWN) && s.grounded && self.drop_allowed(pos, &cfg) {
+                s.drop = cfg.drop_through_ticks;
+                self.events.push(GameEvent::DroppedThrough(p.id));
+            } else {
+                v.y = -cfg.jump_speed;
+                s.hold = cfg.jump_hold_ticks;
+                self.events.push(GameEvent::Jumped(p.id));
+            }
+            s.buffer = 0;
+            s.coyote = 0;
+            s.grounded = false;
+        }
+        s.buffer = s.buffer.saturating_sub(1);
+
+        if !held {
+            s.hold = 0;
+        }
+        let g = if v.y < 0 && s.hold > 0 {
+            s.hold -= 1;
+            cfg.jump_gravity
+        } else {
+            cfg.gravity
+        };
+        v.y = (v.y as i64 + g as i64).min(cfg.max_fall_speed as i64) as i32;
+
+        self.world
+            .set_drop_through(p.body, s.drop > 0)
+            .expect("player body");
+        s.drop = s.drop.saturating_sub(1);
+        self.world
+            .set_velocity(p.body, clamp_speed(v))
+            .expect("clamped player speed");
+        self.players[i] = p;
+    }
+
+    /// Whether a player standing at `pos` stands on a one-way surface (tile
+    /// or platform) and on nothing solid, so down + jump drops through.
+    fn drop_allowed(&self, pos: IVec2, cfg: &PlayerConfig) -> bool {
+        let r = Rect::new(pos, cfg.half);
+        let (mut one_way, mut solid) = (false, false);
+        let map = self.tilemap();
+        let t = map.tile_size() as i64;
+        let origin = map.origin().as_i64vec2();
+        let row = (r.b - origin.y).div_euclid(t);
+        if origin.y + row * t == r.b {
+            let c0 = (r.l - origin.x).div_euclid(t);
+            let c1 = (r.r - 1 - origin.x).div_euclid(t);
+            for c in c0..=c1 {
+                match map.tile(IVec2::new(c as i32, row as i32)) {
+                    Tile::OneWay => one_way = true,
+                    Tile::Solid | Tile::Slope(_) => solid = true,
+                    Tile::Empty | Tile::Hazard => {}
+                }
+            }
+        }
+        // A slope under the foot also holds the player up.
+        if map.is_solid_at(IVec2::new(pos.x, r.b as i32)) {
+            solid = true;
+        }
+        for (i, e) in self.ents.iter().enumerate() {
+            if !matches!(e.ty, EntityType::Platform | EntityType::Block) {
+                continue;
+            }
+            let er = Rect::new(self.entity_pos(i), e.half);
+            if er.t == r.b && er.l < r.r && r.l < er.r {
+                if e.one_way {
+                    one_way = true;
+                } else {
+                    solid = true;
+                }
+            }
+        }
+        one_way && !solid
+    }
+
+    /// An entity's centre now.
+    fn entity_pos(&self, i: usize) -> IVec2 {
+        let e = &self.ents[i];
+        e.body.map_or(e.pos, |b| self.body_pos(b))
+    }
+
+    /// A walker after the physics step: squished walkers are defeated; the
+    /// others turn at walls and ledges.
+    fn walker_after(&mut self, i: usize) {
+        let e = &self.ents[i];
+        if !e.alive {
+            return;
+        }
+        let body = e.body.expect("walker body");
+        if self.squished.contains(&body.0) {
+            self.defeat(i);
+            self.events.push(GameEvent::EnemySquished {
+                enemy: ENTITY_ID_BASE + i as u32,
+            });
+            return;
+        }
+        let b = self.world.body(body).expect("walker body");
+        let (sides, pos, dir) = (b.sides(), b.pos(), e.dir);
+        let wall =
+            (dir > 0 && sides.contains(Sides::RIGHT)) || (dir < 0 && sides.contains(Sides::LEFT));
+        let ledge = sides.contains(Sides::BOTTOM) && !self.ground_ahead(i, pos);
+        if wall || ledge {
+            self.ents[i].dir = -dir;
+        }
+    }
+
+    /// Whether there is ground under the walker's leading bottom corner after
+    /// its next step: solid material there (or just above: the foot of an
+    /// uphill slope), a floor surface at most `half.x + speed` below it (a
+    /// downhill slope), or the top of a block or platform.
+    fn ground_ahead(&self, i: usize, pos: IVec2) -> bool {
+        let e = &self.ents[i];
+        let r = Rect::new(pos, e.half);
+        let x = if e.dir > 0 { r.r - 1 } else { r.l } + (e.dir * e.param) as i64;
+        let (x, y) = (x as i32, r.b as i32);
+        let map = self.tilemap();
+        let reach = e.half.x + e.param;
+        if map.is_solid_at(IVec2::new(x, y))
+            || map.is_solid_at(IVec2::new(x, y - 1))
+            || map.ground_below(IVec2::new(x, y), reach).is_some()
+        {
+            return true;
+        }
+        self.ents.iter().enumerate().any(|(k, o)| {
+            matches!(o.ty, EntityType::Platform | EntityType::Block) && {
+                let or = Rect::new(self.entity_pos(k), o.half);
+                or.l <= x as i64
+                    && (x as i64) < or.r
+                    && or.t >= y as i64
+                    && or.t <= (y + reach) as i64
+            }
+        })
+    }
+
+    /// Defeats walker `i`: it stops and stops colliding.
+    fn defeat(&mut self, i: usize) {
+        let e = &mut self.ents[i];
+        e.alive = false;
+        let body = e.body.expect("walker body");
+        self.world.set_enabled(body, false).expect("walker body");
+        self.world
+            .set_velocity(body, IVec2::ZERO)
+            .expect("zero velocity");
+    }
+
+    /// Puts player `p` back at its respawn point, at rest.
+    fn respawn(&mut self, p: &mut Player) {
+        let pos = self.respawn_point(p.id, &p.st);
+        self.world
+            .set_position(p.body, pos)
+            .expect("respawn point in bounds");
+        self.world
+            .set_velocity(p.body, IVec2::ZERO)
+            .expect("zero velocity");
+        self.world
+            .set_drop_through(p.body, false)
+            .expect("player body");
+        let s = &mut p.st;
+        s.grounded = false;
+        s.on_spring = false;
+        s.coyote = 0;
+        s.buffer = 0;
+        s.hold = 0;
+        s.drop = 0;
+        self.events.push(GameEvent::Respawned { player: p.id, pos });
+    }
+
+    /// The rules after the physics step, for player `i`.
+    fn player_after(&mut self, i: usize) {
+        let cfg = self.config.player;
+        let mut p = self.players[i];
+        let id = p.id;
+        let body = self.world.body(p.body).expect("player body");
+        let (mut pos, mut vel, sides) = (body.pos(), body.vel(), body.sides());
+        let disp = body.displacement();
+        let carrier = body.carrier();
+        let dropping = body.drops_through();
+
+        if self.squished.contains(&p.body.0) {
+            self.events.push(GameEvent::Squished(id));
+            self.respawn(&mut p);
+            self.players[i] = p;
+            return;
+        }
+        let hazard = if self.in_hazard_tile.contains(&p.body.0) {
+            Some(HurtCause::HazardTile)
+        } else {
+            let r = Rect::new(pos, cfg.half);
+            self.hazards
+                .iter()
+                .find(|&&h| Rect::new(self.ents[h].pos, self.ents[h].half).overlaps(&r))
+                .map(|&h| HurtCause::Hazard(ENTITY_ID_BASE + h as u32))
+        };
+        if let Some(cause) = hazard {
+            self.events.push(GameEvent::Hurt { player: id, cause });
+            self.respawn(&mut p);
+            self.players[i] = p;
+            return;
+        }
+
+        let s = &mut p.st;
+        // A ceiling stops the rise; a wall stops the run.
+        if sides.contains(Sides::TOP) {
+            vel.y = vel.y.max(0);
+            s.hold = 0;
+        }
+        if (sides.contains(Sides::LEFT) && vel.x < 0) || (sides.contains(Sides::RIGHT) && vel.x > 0)
+        {
+            vel.x = 0;
+        }
+        let mut grounded = sides.contains(Sides::BOTTOM);
+
+        // Ground snap: walking down a slope (or off a small step) keeps a
+        // grounded player on the ground instead of launching it.
+        if !grounded && s.grounded && vel.y >= 0 && !dropping && carrier.is_none() {
+            let map = self.world.tilemap().expect("a game's world has a tilemap");
+            if let Some(d) = snap_drop(
+                map,
+                pos,
+                cfg.half,
+                cfg.snap_distance,
+                &mut self.tile_scratch,
+            ) {
+                if d != 0 {
+                    self.world
+                        .shift(p.body, IVec2::new(0, d))
+                        .expect("snap within bounds");
+                }
+                pos.y += d;
+                vel.y = 0;
+                grounded = true;
+            }
+        }
+
+        // Leaving a platform keeps (some of) its velocity.
+        if let (Some(c), false) = (carrier, grounded) {
+            let pv = self.body_vel(c);
+            match cfg.carry_mode {
+                CarryMode::Add => vel += pv,
+                CarryMode::AddUpOnly => vel.y += pv.y.min(0),
+                CarryMode::None => {}
+            }
+        }
+
+        // Enemies: land on the head from above to stomp, else get hurt.
+        let r = Rect::new(pos, cfg.half);
+        for k in 0..self.walkers.len() {
+            let w = self.walkers[k];
+            let e = &self.ents[w];
+            if !e.alive {
+                continue;
+            }
+            let wb = self
+                .world
+                .body(e.body.expect("walker body"))
+                .expect("walker body");
+            let wr = Rect::new(wb.pos(), e.half);
+            if !wr.overlaps(&r) {
+                continue;
+            }
+            let start_bottom = r.b - disp.y as i64;
+            let start_top = wr.t - wb.displacement().y as i64;
+            let falling = disp.y > wb.displacement().y;
+            let enemy = ENTITY_ID_BASE + w as u32;
+            if falling && start_bottom <= start_top + cfg.stomp_tolerance as i64 {
+                self.defeat(w);
+                let s = &mut p.st;
+                if s.jump_held {
+                    vel.y = -cfg.jump_speed;
+                    s.hold = cfg.jump_hold_ticks;
+                } else {
+                    vel.y = -cfg.stomp_bounce_speed;
+                    s.hold = 0;
+                }
+                s.coyote = 0;
+                grounded = false;
+                self.events.push(GameEvent::Stomped { player: id, enemy });
+            } else {
+                self.events.push(GameEvent::Hurt {
+                    player: id,
+                    cause: HurtCause::Enemy(enemy),
+                });
+                self.respawn(&mut p);
+                self.players[i] = p;
+                return;
+            }
+        }
+
+        // Springboards launch once per touch.
+        let spring = self
+            .springs
+            .iter()
+            .copied()
+            .find(|&k| Rect::new(self.ents[k].pos, self.ents[k].half).overlaps(&r));
+        if let Some(k) = spring {
+            if !p.st.on_spring {
+                vel.y = -self.ents[k].param;
+                p.st.hold = 0;
+                p.st.coyote = 0;
+                grounded = false;
+                self.events.push(GameEvent::Launched {
+                    player: id,
+                    springboard: ENTITY_ID_BASE + k as u32,
+                });
+            }
+        }
+        p.st.on_spring = spring.is_some();
+
+        for k in 0..self.coins.len() {
+            let c = self.coins[k];
+            let e = &self.ents[c];
+            if e.collector.is_none() && Rect::new(e.pos, e.half).overlaps(&r) {
+                self.ents[c].collector = Some(id.0);
+                let total = self.coins_of(id);
+                self.events.push(GameEvent::CoinPicked {
+                    player: id,
+                    coin: ENTITY_ID_BASE + c as u32,
+                    total,
+                });
+            }
+        }
+        for k in 0..self.checkpoints.len() {
+            let c = self.checkpoints[k];
+            let e = &self.ents[c];
+            if p.st.checkpoint as usize != c + 1 && Rect::new(e.pos, e.half).overlaps(&r) {
+                p.st.checkpoint = (c + 1) as u16;
+                self.events.push(GameEvent::Checkpoint {
+                    player: id,
+                    checkpoint: ENTITY_ID_BASE + c as u32,
+                });
+            }
+        }
+        if !p.st.won
+            && self
+                .goals
+                .iter()
+                .any(|&k| Rect::new(self.ents[k].pos, self.ents[k].half).overlaps(&r))
+        {
+            p.st.won = true;
+            self.events.push(GameEvent::Won(id));
+        }
+
+        let s = &mut p.st;
+        if grounded {
+            s.coyote = cfg.coyote_ticks;
+        }
+        s.grounded = grounded;
+        self.world
+            .set_velocity(p.body, clamp_speed(vel))
+            .expect("clamped player speed");
+        self.players[i] = p;
+    }
+}
+
+/// `v` with each component clamped to the speed bound.
+fn clamp_speed(v: IVec2) -> IVec2 {
+    v.clamp(IVec2::splat(-MAX_SPEED), IVec2::splat(MAX_SPEED))
+}
+
+/// How far down a box at `pos` with half extents `half` can be snapped onto
+/// the floor under its foot: the surface [`Tilemap::ground_below`] finds
+/// within `max` (0: it already rests exactly on it), provided nothing in the
+/// tilemap pushes the box there.
+fn snap_drop(
+    map: &Tilemap,
+    pos: IVec2,
+    half: IVec2,
+    max: i32,
+    out: &mut Vec<TileContact>,
+) -> Option<i32> {
+    let foot = IVec2::new(pos.x, pos.y + half.y);
+    let y = map.ground_below(foot, max)?;
+    let d = y - foot.y;
+    if d < 0 {
+        return None;
+    }
+    out.clear();
+    map.box_contacts(
+        pos + IVec2::new(0, d),
+        half,
+        IVec2::new(0, d),
+        ContactFlags::default(),
+        out,
+    );
+    out.iter().all(|c| c.is_trigger()).then_some(d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::run;
+
+    #[test]
+    fn run_accelerates_brakes_and_caps() {
+        assert_eq!(run(0, 1, 10, 20, 25), 10);
+        assert_eq!(run(20, 1, 10, 20, 25), 25);
+        assert_eq!(run(40, 1, 10, 20, 25), 25);
+        assert_eq!(run(60, 1, 10, 20, 25), 40);
+        assert_eq!(run(-5, 1, 10, 20, 25), 25);
+        assert_eq!(run(-40, 1, 10, 20, 25), -10);
+        assert_eq!(run(15, 0, 10, 20, 25), 0);
+        assert_eq!(run(-35, 0, 10, 20, 25), -15);
+        assert_eq!(run(-20, -1, 10, 20, 25), -25);
+    }
+}

@@ -1,0 +1,169 @@
+//! Helpers for the platformer tests: levels from ASCII art, entities by tile
+//! coordinates, and a one-player driver.
+#![allow(dead_code)]
+
+use glam::IVec2;
+use ledge_shared::game::{Game, GameConfig, GameEvent, PlayerView};
+use ledge_shared::input::Buttons;
+use ledge_shared::level::{EntityDef, EntityKind, Level, PlatformMotion};
+use ledge_shared::protocol::PlayerId;
+use ledge_shared::tilemap::{Slope, Tile, Tilemap};
+
+/// One tile: 16 px.
+pub const T: i32 = 16 * 256;
+
+/// Buttons.
+pub const NONE: Buttons = Buttons::NONE;
+pub const LEFT: Buttons = Buttons(Buttons::LEFT);
+pub const RIGHT: Buttons = Buttons(Buttons::RIGHT);
+pub const JUMP: Buttons = Buttons(Buttons::JUMP);
+pub const DOWN_JUMP: Buttons = Buttons(Buttons::DOWN | Buttons::JUMP);
+pub const RIGHT_JUMP: Buttons = Buttons(Buttons::RIGHT | Buttons::JUMP);
+
+/// A tilemap at the origin from rows of characters: `.` empty, `#` solid,
+/// `=` one-way, `^` hazard, `/` and `\` 45 degree slopes, `a b` a 22.5
+/// degree ramp rising right (low, high), `c d` one rising left (high, low).
+pub fn map(rows: &[&str]) -> Tilemap {
+    let w = rows[0].len();
+    let mut tiles = Vec::new();
+    for r in rows {
+        assert_eq!(r.len(), w, "ragged map row {r:?}");
+        for ch in r.chars() {
+            tiles.push(match ch {
+                '.' => Tile::Empty,
+                '#' => Tile::Solid,
+                '=' => Tile::OneWay,
+                '^' => Tile::Hazard,
+                '/' => Tile::Slope(Slope::Right45),
+                '\\' => Tile::Slope(Slope::Left45),
+                'a' => Tile::Slope(Slope::RightLow22),
+                'b' => Tile::Slope(Slope::RightHigh22),
+                'c' => Tile::Slope(Slope::LeftHigh22),
+                'd' => Tile::Slope(Slope::LeftLow22),
+                _ => panic!("unknown tile {ch:?}"),
+            });
+        }
+    }
+    Tilemap::new(IVec2::ZERO, T, w as u32, rows.len() as u32, tiles).unwrap()
+}
+
+/// Centre of tile `(c, r)`.
+pub fn tile_centre(c: i32, r: i32) -> IVec2 {
+    IVec2::new(c * T + T / 2, r * T + T / 2)
+}
+
+/// An entity of one tile at tile `(c, r)`.
+pub fn ent(kind: EntityKind, c: i32, r: i32) -> EntityDef {
+    EntityDef {
+        kind,
+        pos: tile_centre(c, r),
+        size: IVec2::splat(T),
+    }
+}
+
+/// An entity with an explicit centre and size.
+pub fn ent_at(kind: EntityKind, pos: IVec2, size: IVec2) -> EntityDef {
+    EntityDef { kind, pos, size }
+}
+
+/// A moving platform of `size` following `path` (centres) at `speed`.
+pub fn platform(path: &[IVec2], size: IVec2, speed: i32, one_way: bool) -> EntityDef {
+    EntityDef {
+        kind: EntityKind::MovingPlatform {
+            motion: PlatformMotion {
+                path: path.to_vec(),
+                speed,
+                looped: false,
+            },
+            one_way,
+        },
+        pos: path[0],
+        size,
+    }
+}
+
+/// A level from a map and entities.
+pub fn level(rows: &[&str], entities: Vec<EntityDef>) -> Level {
+    Level {
+        name: "test".into(),
+        tilemap: map(rows),
+        entities,
+    }
+}
+
+/// One player in a game.
+pub struct Sim {
+    pub game: Game,
+    pub id: PlayerId,
+    pub events: Vec<GameEvent>,
+}
+
+impl Sim {
+    /// A game of `level` with `config` and player 1.
+    pub fn with(level: &Level, config: GameConfig) -> Self {
+        let mut game = Game::with_config(level, config).unwrap();
+        let id = PlayerId(1);
+        game.add_player(id).unwrap();
+        Sim {
+            game,
+            id,
+            events: Vec::new(),
+        }
+    }
+
+    /// A game of `level` with the default configuration and player 1.
+    pub fn new(level: &Level) -> Self {
+        Self::with(level, GameConfig::default())
+    }
+
+    /// Steps once with `b`; keeps the tick's events.
+    pub fn step(&mut self, b: Buttons) -> &[GameEvent] {
+        self.events = self.game.step(&[(self.id, b)]).to_vec();
+        &self.events
+    }
+
+    /// Steps `n` times with `b`.
+    pub fn run(&mut self, b: Buttons, n: usize) {
+        for _ in 0..n {
+            self.step(b);
+        }
+    }
+
+    /// The player's view.
+    pub fn view(&self) -> PlayerView {
+        self.game.player(self.id).unwrap()
+    }
+
+    /// The player's centre.
+    pub fn pos(&self) -> IVec2 {
+        self.view().pos
+    }
+
+    /// The player's bottom edge.
+    pub fn bottom(&self) -> i32 {
+        let v = self.view();
+        v.pos.y + v.half.y
+    }
+
+    /// Whether the last step raised an event matching `f`.
+    pub fn saw(&self, f: impl Fn(&GameEvent) -> bool) -> bool {
+        self.events.iter().any(f)
+    }
+
+    /// Steps until the player is grounded (at most `n` ticks); panics if it
+    /// never is.
+    pub fn land(&mut self, n: usize) {
+        for _ in 0..n {
+            self.step(NONE);
+            if self.view().grounded {
+                return;
+            }
+        }
+        panic!("never landed: {:?}", self.view());
+    }
+}
+
+/// Whether `e` is a jump of player 1.
+pub fn jumped(e: &GameEvent) -> bool {
+    matches!(e, GameEvent::Jumped(PlayerId(1)))
+}
