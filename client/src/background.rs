@@ -3,23 +3,33 @@
 //!
 //! [`NetThread::spawn`] starts a thread running a small tokio runtime that
 //! connects, then pings once a second so the front end can show the
-//! round-trip time. The front end polls [`NetThread::try_recv`] once per
-//! frame (never blocking) and folds events into a [`NetStatus`].
+//! round-trip time, sends the inputs the front end hands it
+//! ([`NetThread::send_input`], once per tick) and chat lines, and reports
+//! decoded snapshots, chat and notices as [`NetEvent`]s. The front end polls
+//! [`NetThread::try_recv`] once per frame (never blocking) and folds events
+//! into a [`NetStatus`]. Both directions are bounded queues: when one is
+//! full (a front end that stopped polling), new events or commands are
+//! dropped and counted rather than piling up.
 
 use std::fmt;
-use std::sync::mpsc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{mpsc, Arc};
 use std::thread;
 use std::time::Duration;
 
-use ledge_server::protocol::Welcome;
-use ledge_server::Fingerprint;
+use ledge_shared::input::Buttons;
+use ledge_shared::protocol::{Fingerprint, NoticeKind, PlayerId, Welcome};
 use tokio::sync::oneshot;
 
-use crate::session::connect;
+use crate::session::{connect_with, JoinOptions, SessionEvent, SnapshotUpdate};
 use crate::transport::resolve;
 
 /// How often the background thread pings the server.
 const PING_INTERVAL: Duration = Duration::from_secs(1);
+/// Events waiting for the front end; more are dropped.
+pub const EVENT_QUEUE: usize = 512;
+/// Commands waiting for the network thread; more are dropped.
+pub const COMMAND_QUEUE: usize = 256;
 
 /// Where and as whom to connect.
 #[derive(Debug, Clone)]
@@ -32,6 +42,27 @@ pub struct ConnectRequest {
     pub player_name: String,
 }
 
+/// Extra choices for [`NetThread::spawn_with`].
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct NetOptions {
+    /// The room to join; `None`: the server picks the least full one.
+    pub room: Option<String>,
+}
+
+/// What the front end asks the network thread to do.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum NetCommand {
+    /// Send our buttons for `tick` (with the redundant ticks before it).
+    Input {
+        /// The tick the buttons are for.
+        tick: u64,
+        /// The buttons held.
+        buttons: Buttons,
+    },
+    /// Say something in the room.
+    Chat(String),
+}
+
 /// What the background thread reports.
 #[derive(Debug, Clone, PartialEq)]
 pub enum NetEvent {
@@ -39,6 +70,17 @@ pub enum NetEvent {
     Connected(Welcome),
     /// A fresh round-trip measurement.
     Rtt(Duration),
+    /// A new authoritative snapshot, decoded.
+    Snapshot(SnapshotUpdate),
+    /// A chat line from a player in our room.
+    Chat {
+        /// Who said it.
+        from: PlayerId,
+        /// The line.
+        text: String,
+    },
+    /// A server announcement (shutdown, kick, information).
+    Notice(NoticeKind),
     /// Connecting failed; the thread has ended.
     Failed(String),
     /// An established session ended; the thread has ended.
@@ -50,23 +92,40 @@ pub enum NetEvent {
 #[derive(Debug)]
 pub struct NetThread {
     events: mpsc::Receiver<NetEvent>,
+    commands: tokio::sync::mpsc::Sender<NetCommand>,
+    dropped: Arc<AtomicU64>,
     quit: Option<oneshot::Sender<()>>,
     thread: Option<thread::JoinHandle<()>>,
 }
 
 impl NetThread {
-    /// Starts the thread and begins connecting.
+    /// Starts the thread and begins connecting (to any room).
     pub fn spawn(request: ConnectRequest) -> std::io::Result<NetThread> {
+        NetThread::spawn_with(request, NetOptions::default())
+    }
+
+    /// Starts the thread and begins connecting, with `options`.
+    pub fn spawn_with(request: ConnectRequest, options: NetOptions) -> std::io::Result<NetThread> {
         let runtime = tokio::runtime::Builder::new_current_thread()
             .enable_all()
             .build()?;
-        let (events_tx, events) = mpsc::channel();
+        let (events_tx, events) = mpsc::sync_channel(EVENT_QUEUE);
+        let (commands, commands_rx) = tokio::sync::mpsc::channel(COMMAND_QUEUE);
         let (quit, quit_rx) = oneshot::channel();
+        let dropped = Arc::new(AtomicU64::new(0));
+        let events_tx = Events {
+            tx: events_tx,
+            dropped: dropped.clone(),
+        };
         let thread = thread::Builder::new()
             .name("ledge-net".into())
-            .spawn(move || runtime.block_on(run(request, events_tx, quit_rx)))?;
+            .spawn(move || {
+                runtime.block_on(run(request, options, events_tx, commands_rx, quit_rx))
+            })?;
         Ok(NetThread {
             events,
+            commands,
+            dropped,
             quit: Some(quit),
             thread: Some(thread),
         })
@@ -75,6 +134,31 @@ impl NetThread {
     /// The next pending event, if any; never blocks.
     pub fn try_recv(&self) -> Option<NetEvent> {
         self.events.try_recv().ok()
+    }
+
+    /// Queues a command; `false` if it was dropped (queue full, or the
+    /// network thread has ended). Never blocks.
+    pub fn send(&self, command: NetCommand) -> bool {
+        let sent = self.commands.try_send(command).is_ok();
+        if !sent {
+            self.dropped.fetch_add(1, Ordering::Relaxed);
+        }
+        sent
+    }
+
+    /// Sends our buttons for `tick` (call once per simulated tick).
+    pub fn send_input(&self, tick: u64, buttons: Buttons) -> bool {
+        self.send(NetCommand::Input { tick, buttons })
+    }
+
+    /// Says `text` in the room.
+    pub fn chat(&self, text: &str) -> bool {
+        self.send(NetCommand::Chat(text.to_owned()))
+    }
+
+    /// Events and commands dropped so far because a queue was full.
+    pub fn dropped(&self) -> u64 {
+        self.dropped.load(Ordering::Relaxed)
     }
 
     /// Waits up to `timeout` for the next event (for headless callers).
@@ -94,47 +178,84 @@ impl Drop for NetThread {
     }
 }
 
+/// The bounded event queue to the front end.
+struct Events {
+    tx: mpsc::SyncSender<NetEvent>,
+    dropped: Arc<AtomicU64>,
+}
+
+impl Events {
+    /// Queues an event; `false` once the front end is gone.
+    fn send(&self, event: NetEvent) -> bool {
+        match self.tx.try_send(event) {
+            Ok(()) => true,
+            Err(mpsc::TrySendError::Full(_)) => {
+                self.dropped.fetch_add(1, Ordering::Relaxed);
+                true
+            }
+            Err(mpsc::TrySendError::Disconnected(_)) => false,
+        }
+    }
+}
+
 async fn run(
     request: ConnectRequest,
-    events: mpsc::Sender<NetEvent>,
+    options: NetOptions,
+    events: Events,
+    mut commands: tokio::sync::mpsc::Receiver<NetCommand>,
     mut quit: oneshot::Receiver<()>,
 ) {
     let connecting = async {
         let (addr, server_name) = resolve(&request.server).await?;
-        connect(
-            addr,
-            &server_name,
-            request.cert_fingerprint,
-            &request.player_name,
-        )
-        .await
+        let join = JoinOptions {
+            player_name: request.player_name.clone(),
+            room: options.room.clone(),
+        };
+        connect_with(addr, &server_name, request.cert_fingerprint, &join).await
     };
     let mut session = tokio::select! {
         _ = &mut quit => return,
         result = connecting => match result {
             Ok(session) => session,
             Err(e) => {
-                let _ = events.send(NetEvent::Failed(e.to_string()));
+                events.send(NetEvent::Failed(e.to_string()));
                 return;
             }
         },
     };
-    let _ = events.send(NetEvent::Connected(session.welcome().clone()));
+    events.send(NetEvent::Connected(session.welcome().clone()));
     let mut ticker = tokio::time::interval(PING_INTERVAL);
     loop {
-        tokio::select! {
+        let result = tokio::select! {
             _ = &mut quit => break,
-            _ = ticker.tick() => match session.ping().await {
-                Ok(rtt) => {
-                    if events.send(NetEvent::Rtt(rtt)).is_err() {
-                        break;
+            command = commands.recv() => match command {
+                Some(NetCommand::Input { tick, buttons }) => {
+                    // A full datagram queue is not fatal: the next input
+                    // repeats this one.
+                    if let Err(e) = session.send_input(tick, buttons) {
+                        tracing::debug!("input not sent: {e}");
                     }
+                    Ok(true)
                 }
-                Err(e) => {
-                    let _ = events.send(NetEvent::Disconnected(e.to_string()));
-                    return;
-                }
+                Some(NetCommand::Chat(text)) => session.chat(&text).await.map(|()| true),
+                None => break,
             },
+            _ = ticker.tick() => session.send_ping().await.map(|_| true),
+            event = session.recv() => event.map(|event| match event {
+                SessionEvent::Snapshot(update) => events.send(NetEvent::Snapshot(update)),
+                SessionEvent::Chat { from, text } => events.send(NetEvent::Chat { from, text }),
+                SessionEvent::Notice(kind) => events.send(NetEvent::Notice(kind)),
+                SessionEvent::Pong { rtt: Some(rtt), .. } => events.send(NetEvent::Rtt(rtt)),
+                SessionEvent::Pong { rtt: None, .. } => true,
+            }),
+        };
+        match result {
+            Ok(true) => {}
+            Ok(false) => break,
+            Err(e) => {
+                events.send(NetEvent::Disconnected(e.to_string()));
+                return;
+            }
         }
     }
     session.close().await;
@@ -170,7 +291,13 @@ impl NetStatus {
                 welcome,
                 rtt: Some(rtt),
             },
-            (status, NetEvent::Rtt(_)) => status,
+            (
+                status,
+                NetEvent::Rtt(_)
+                | NetEvent::Snapshot(_)
+                | NetEvent::Chat { .. }
+                | NetEvent::Notice(_),
+            ) => status,
             (_, NetEvent::Failed(reason)) => NetStatus::Failed(reason),
             (_, NetEvent::Disconnected(reason)) => NetStatus::Disconnected(reason),
         };
@@ -185,8 +312,12 @@ impl fmt::Display for NetStatus {
             NetStatus::Connected { welcome, rtt } => {
                 write!(
                     f,
-                    "welcome, player {} (joined at tick {}, hash {:016x}, {} Hz)",
-                    welcome.player_id, welcome.tick, welcome.state_hash, welcome.tick_rate
+                    "welcome, player {} in {} on {} (joined at tick {}, {} Hz)",
+                    welcome.player_id,
+                    welcome.room,
+                    welcome.level_id,
+                    welcome.server_tick,
+                    welcome.timing.tick_rate
                 )?;
                 if let Some(rtt) = rtt {
                     write!(f, ", rtt {:.1} ms", rtt.as_secs_f64() * 1000.0)?;
@@ -202,14 +333,21 @@ impl fmt::Display for NetStatus {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ledge_server::protocol::PlayerId;
+    use ledge_shared::protocol::NetTiming;
 
     fn welcome() -> Welcome {
         Welcome {
             player_id: PlayerId(3),
-            tick: 10,
-            state_hash: 0xabc,
-            tick_rate: 60,
+            room: "room-1".into(),
+            level_id: "level".into(),
+            level_hash: 0xabc,
+            server_tick: 10,
+            timing: NetTiming {
+                tick_rate: 60,
+                snapshot_interval: 2,
+                input_redundancy: 16,
+            },
+            sim_config: vec![],
         }
     }
 
@@ -220,6 +358,10 @@ mod tests {
         assert_eq!(status, NetStatus::Connecting("x:1".into()));
         status.apply(NetEvent::Connected(welcome()));
         status.apply(NetEvent::Rtt(Duration::from_millis(5)));
+        status.apply(NetEvent::Chat {
+            from: PlayerId(1),
+            text: "hi".into(),
+        });
         assert_eq!(
             status,
             NetStatus::Connected {

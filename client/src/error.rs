@@ -1,8 +1,6 @@
 //! Everything that can go wrong on the client side of a connection.
 
-use ledge_server::framing::FrameError;
-use ledge_server::protocol::{CloseCode, RejectReason};
-use ledge_server::Fingerprint;
+use ledge_shared::protocol::{CloseCode, Fingerprint, ProtocolError, RejectReason};
 
 /// Why connecting or talking to a server failed.
 #[derive(Debug, thiserror::Error)]
@@ -41,9 +39,16 @@ pub enum ClientError {
     /// The server refused the hello.
     #[error("server rejected us: {0}")]
     Rejected(RejectReason),
-    /// A frame or message from the server was malformed or the stream broke.
+    /// A message could not be encoded, or one from the server was
+    /// malformed (the control stream is then out of sync).
+    #[error("protocol: {0}")]
+    Protocol(#[from] ProtocolError),
+    /// Reading or writing the control stream failed.
     #[error("control stream: {0}")]
-    Frame(#[from] FrameError),
+    Stream(String),
+    /// A datagram could not be sent.
+    #[error("cannot send a datagram: {0}")]
+    Datagram(#[from] quinn::SendDatagramError),
     /// The server sent a valid message at the wrong time.
     #[error("unexpected message from server: {0}")]
     Unexpected(String),

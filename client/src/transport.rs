@@ -4,8 +4,7 @@ use std::net::{Ipv4Addr, Ipv6Addr, SocketAddr};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use ledge_server::protocol::ALPN;
-use ledge_server::Fingerprint;
+use ledge_shared::protocol::{Fingerprint, ALPN};
 use quinn::crypto::rustls::QuicClientConfig;
 
 use crate::error::ClientError;
@@ -15,6 +14,8 @@ use crate::verifier::PinnedCertVerifier;
 pub const KEEP_ALIVE: Duration = Duration::from_secs(3);
 /// A connection with no traffic for this long is considered lost.
 pub const IDLE_TIMEOUT: Duration = Duration::from_secs(10);
+/// Outgoing datagram buffer, in bytes (a few dozen input packets).
+pub const DATAGRAM_SEND_BUFFER: usize = 2048;
 
 /// A connected QUIC endpoint; the connection is established and the
 /// server's certificate matched the pin.
@@ -46,6 +47,9 @@ fn client_config(pin: Fingerprint) -> Result<(quinn::ClientConfig, RefusedSlot),
     let mut transport = quinn::TransportConfig::default();
     transport
         .keep_alive_interval(Some(KEEP_ALIVE))
+        // Inputs repeat the last ticks, so an old queued one is worthless:
+        // keep the queue short and let quinn drop the oldest.
+        .datagram_send_buffer_size(DATAGRAM_SEND_BUFFER)
         .max_idle_timeout(Some(
             quinn::IdleTimeout::try_from(IDLE_TIMEOUT).expect("constant fits a QUIC varint"),
         ));

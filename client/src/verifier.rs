@@ -10,13 +10,22 @@
 
 use std::sync::{Arc, Mutex};
 
-use ledge_server::Fingerprint;
+use ledge_shared::protocol::Fingerprint;
 use rustls::client::danger::{HandshakeSignatureValid, ServerCertVerified, ServerCertVerifier};
 use rustls::crypto::{
     verify_tls12_signature, verify_tls13_signature, CryptoProvider, WebPkiSupportedAlgorithms,
 };
 use rustls::pki_types::{CertificateDer, ServerName, UnixTime};
 use rustls::{CertificateError, DigitallySignedStruct, SignatureScheme};
+
+/// The SHA-256 fingerprint of a DER-encoded certificate (what the server
+/// prints and players pin).
+pub fn fingerprint_of(der: &[u8]) -> Fingerprint {
+    let digest = ring::digest::digest(&ring::digest::SHA256, der);
+    let mut bytes = [0u8; 32];
+    bytes.copy_from_slice(digest.as_ref());
+    Fingerprint(bytes)
+}
 
 /// A rustls verifier accepting exactly one certificate, by fingerprint.
 #[derive(Debug)]
@@ -54,7 +63,7 @@ impl ServerCertVerifier for PinnedCertVerifier {
         _ocsp_response: &[u8],
         _now: UnixTime,
     ) -> Result<ServerCertVerified, rustls::Error> {
-        let presented = Fingerprint::of_der(end_entity);
+        let presented = fingerprint_of(end_entity);
         if presented == self.pin {
             return Ok(ServerCertVerified::assertion());
         }
@@ -102,7 +111,7 @@ mod tests {
         let cert = CertificateDer::from(b"pretend DER".to_vec());
         let other = CertificateDer::from(b"another DER".to_vec());
         let name = ServerName::try_from("localhost").unwrap();
-        let v = verifier(Fingerprint::of_der(&cert));
+        let v = verifier(fingerprint_of(&cert));
         assert!(v
             .verify_server_cert(&cert, &[], &name, &[], UnixTime::now())
             .is_ok());
@@ -110,9 +119,15 @@ mod tests {
         assert!(v
             .verify_server_cert(&other, &[], &name, &[], UnixTime::now())
             .is_err());
+        assert_eq!(*v.refused().lock().unwrap(), Some(fingerprint_of(&other)));
+    }
+
+    #[test]
+    fn fingerprints_are_sha256() {
+        // SHA-256("abc"), FIPS 180-2 test vector.
         assert_eq!(
-            *v.refused().lock().unwrap(),
-            Some(Fingerprint::of_der(&other))
+            fingerprint_of(b"abc").to_string(),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
         );
     }
 

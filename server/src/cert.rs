@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use rustls::pki_types::pem::PemObject;
 use rustls::pki_types::{CertificateDer, PrivateKeyDer};
 
-use crate::fingerprint::Fingerprint;
+use crate::fingerprint::{self, Fingerprint};
 
 /// File name of the certificate inside the certificate directory.
 pub const CERT_FILE: &str = "cert.pem";
@@ -101,7 +101,7 @@ impl Identity {
             message: e.to_string(),
         })?;
         Ok(Identity {
-            fingerprint: Fingerprint::of_der(&cert),
+            fingerprint: fingerprint::of_der(&cert),
             cert,
             key,
             generated: false,
@@ -122,7 +122,7 @@ impl Identity {
         write_file(cert_path, cert.pem().as_bytes(), false)?;
         let der = cert.der().clone();
         Ok(Identity {
-            fingerprint: Fingerprint::of_der(&der),
+            fingerprint: fingerprint::of_der(&der),
             cert: der,
             key: PrivateKeyDer::Pkcs8(key_pair.serialize_der().into()),
             generated: true,

@@ -1,7 +1,17 @@
-//! Server settings (what the command line sets).
+//! Server settings: command-line flags, an optional TOML file, defaults.
+//!
+//! Precedence: a flag given on the command line wins over the file
+//! (`--config PATH`), which wins over the defaults below. The file uses the
+//! flags' names with underscores (`tick_rate = 60`), plus a `[limits]`
+//! table for the per-client rate limits; unknown keys are errors, so a typo
+//! never silently falls back to a default.
 
 use std::net::SocketAddr;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use clap::Parser;
+use serde::Deserialize;
 
 /// Default UDP address the server listens on.
 pub const DEFAULT_BIND: &str = "0.0.0.0:4433";
@@ -9,39 +19,434 @@ pub const DEFAULT_BIND: &str = "0.0.0.0:4433";
 pub const DEFAULT_CERT_DIR: &str = "certs";
 /// Default simulation rate in Hz.
 pub const DEFAULT_TICK_RATE: u32 = 60;
+/// Default snapshot rate in Hz.
+pub const DEFAULT_SNAPSHOT_RATE: u32 = 30;
+/// Default most players in one room.
+pub const DEFAULT_MAX_PLAYERS: usize = 16;
+/// Default number of rooms.
+pub const DEFAULT_ROOMS: u32 = 1;
+/// Default most simultaneous connections (players and handshakes).
+pub const DEFAULT_MAX_CONNECTIONS: usize = 256;
 /// Default bound on ticks run back to back after a stall (0.25 s at 60 Hz).
 pub const DEFAULT_MAX_CATCH_UP: u32 = 15;
+/// Default QUIC idle timeout: a connection with no traffic for this long is
+/// dropped (clients send keep-alives every [`DEFAULT_IDLE_TIMEOUT`] / 3).
+pub const DEFAULT_IDLE_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Per-client rate limits and abuse thresholds (the file's `[limits]`).
+///
+/// Each limit is a token bucket: `*_per_second` tokens refill it up to
+/// `*_burst`; a message that finds it empty is dropped and counted.
+/// Dropped or malformed messages also drain a *strike* bucket; a client
+/// that empties it is disconnected.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Limits {
+    /// Input datagrams per second (a client sends one per tick).
+    pub datagrams_per_second: f64,
+    /// Input datagrams accepted in a burst.
+    pub datagram_burst: f64,
+    /// Control-stream messages per second (chat, pings).
+    pub control_per_second: f64,
+    /// Control-stream messages accepted in a burst.
+    pub control_burst: f64,
+    /// Malformed messages tolerated in a burst before disconnecting.
+    pub malformed_burst: f64,
+    /// Malformed messages forgiven per second.
+    pub malformed_per_second: f64,
+    /// Rate-limited messages tolerated in a burst before disconnecting.
+    pub flood_burst: f64,
+    /// Rate-limited messages forgiven per second.
+    pub flood_per_second: f64,
+}
+
+impl Default for Limits {
+    fn default() -> Limits {
+        Limits {
+            // Twice the default tick rate: clock corrections and bursts
+            // after a hiccup stay well inside it.
+            datagrams_per_second: 120.0,
+            datagram_burst: 60.0,
+            control_per_second: 10.0,
+            control_burst: 20.0,
+            malformed_burst: 20.0,
+            malformed_per_second: 0.5,
+            flood_burst: 300.0,
+            flood_per_second: 30.0,
+        }
+    }
+}
 
 /// Everything [`crate::Server::bind`] needs.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ServerConfig {
     /// UDP address to listen on; port 0 picks a free port (tests).
     pub bind: SocketAddr,
     /// Where the certificate and key are kept (created if missing).
     pub cert_dir: PathBuf,
+    /// Level file to play; `None`: the embedded default level.
+    pub level: Option<PathBuf>,
     /// Simulation ticks per second.
     pub tick_rate: u32,
+    /// Snapshots per second (rounded to a whole number of ticks between
+    /// snapshots: see [`ServerConfig::snapshot_interval`]).
+    pub snapshot_rate: u32,
+    /// Most players in one room.
+    pub max_players: usize,
+    /// Number of rooms (named `room-1`, `room-2`, ...).
+    pub rooms: u32,
+    /// Most simultaneous connections; more are refused at once.
+    pub max_connections: usize,
+    /// TCP address of the Prometheus metrics endpoint; `None`: no endpoint.
+    pub metrics_bind: Option<SocketAddr>,
     /// Most ticks run back to back after a stall; older ones are skipped.
     pub max_catch_up: u32,
+    /// QUIC idle timeout: silent connections are dropped after it.
+    pub idle_timeout: Duration,
+    /// Per-client rate limits.
+    pub limits: Limits,
 }
 
 impl Default for ServerConfig {
     fn default() -> ServerConfig {
         ServerConfig {
-            bind: SocketAddr::from(([0, 0, 0, 0], 4433)),
+            bind: DEFAULT_BIND.parse().expect("valid default address"),
             cert_dir: PathBuf::from(DEFAULT_CERT_DIR),
+            level: None,
             tick_rate: DEFAULT_TICK_RATE,
+            snapshot_rate: DEFAULT_SNAPSHOT_RATE,
+            max_players: DEFAULT_MAX_PLAYERS,
+            rooms: DEFAULT_ROOMS,
+            max_connections: DEFAULT_MAX_CONNECTIONS,
+            metrics_bind: None,
             max_catch_up: DEFAULT_MAX_CATCH_UP,
+            idle_timeout: DEFAULT_IDLE_TIMEOUT,
+            limits: Limits::default(),
         }
     }
+}
+
+impl ServerConfig {
+    /// Ticks between two snapshots: `tick_rate / snapshot_rate`, rounded to
+    /// the nearest whole tick, at least 1.
+    pub fn snapshot_interval(&self) -> u32 {
+        let rate = self.snapshot_rate.clamp(1, self.tick_rate.max(1));
+        ((self.tick_rate + rate / 2) / rate).max(1)
+    }
+
+    /// Checks the values are usable.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let bad = |what: &str| Err(ConfigError::Invalid(what.to_owned()));
+        if !(1..=1000).contains(&self.tick_rate) {
+            return bad("tick_rate must be 1..=1000 Hz");
+        }
+        if self.snapshot_rate == 0 || self.snapshot_rate > self.tick_rate {
+            return bad("snapshot_rate must be 1..=tick_rate Hz");
+        }
+        if self.max_players == 0 {
+            return bad("max_players must be at least 1");
+        }
+        if self.rooms == 0 || self.rooms > 1000 {
+            return bad("rooms must be 1..=1000");
+        }
+        if self.max_connections == 0 {
+            return bad("max_connections must be at least 1");
+        }
+        if self.idle_timeout < Duration::from_millis(100) {
+            return bad("idle_timeout must be at least 0.1 s");
+        }
+        let l = &self.limits;
+        let rates = [
+            l.datagrams_per_second,
+            l.datagram_burst,
+            l.control_per_second,
+            l.control_burst,
+            l.malformed_burst,
+            l.malformed_per_second,
+            l.flood_burst,
+            l.flood_per_second,
+        ];
+        if rates.iter().any(|r| !r.is_finite() || *r < 0.0) {
+            return bad("limits must be finite and not negative");
+        }
+        if l.datagram_burst < 1.0 || l.control_burst < 1.0 {
+            return bad("datagram_burst and control_burst must be at least 1");
+        }
+        Ok(())
+    }
+}
+
+/// Why the configuration could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The configuration file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The configuration file is not valid TOML of the expected shape.
+    #[error("{path}: {message}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// What the parser said.
+        message: String,
+    },
+    /// A value is out of range.
+    #[error("invalid configuration: {0}")]
+    Invalid(String),
+}
+
+/// Authoritative ledge server (QUIC over UDP).
+///
+/// Every option can also be set in the `--config` TOML file (same names,
+/// with underscores); flags override the file.
+#[derive(Debug, Default, Parser)]
+#[command(version)]
+pub struct Cli {
+    /// TOML configuration file.
+    #[arg(long, value_name = "PATH")]
+    pub config: Option<PathBuf>,
+    /// UDP address to listen on [default: 0.0.0.0:4433].
+    #[arg(long, value_name = "ADDR:PORT")]
+    pub bind: Option<SocketAddr>,
+    /// Level file to play [default: the embedded default level].
+    #[arg(long, value_name = "PATH")]
+    pub level: Option<PathBuf>,
+    /// Simulation ticks per second [default: 60].
+    #[arg(long, value_name = "HZ")]
+    pub tick_rate: Option<u32>,
+    /// Snapshots per second [default: 30].
+    #[arg(long, value_name = "HZ")]
+    pub snapshot_rate: Option<u32>,
+    /// Most players per room [default: 16].
+    #[arg(long, value_name = "N")]
+    pub max_players: Option<usize>,
+    /// Number of rooms [default: 1].
+    #[arg(long, value_name = "N")]
+    pub rooms: Option<u32>,
+    /// Most simultaneous connections [default: 256].
+    #[arg(long, value_name = "N")]
+    pub max_connections: Option<usize>,
+    /// Directory of the certificate and key, created on first start
+    /// [default: certs].
+    #[arg(long, value_name = "DIR")]
+    pub cert_dir: Option<PathBuf>,
+    /// TCP address serving Prometheus metrics at /metrics [default: none].
+    #[arg(long, value_name = "ADDR:PORT")]
+    pub metrics_bind: Option<SocketAddr>,
+}
+
+/// The TOML file: every key optional.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileConfig {
+    bind: Option<SocketAddr>,
+    level: Option<PathBuf>,
+    tick_rate: Option<u32>,
+    snapshot_rate: Option<u32>,
+    max_players: Option<usize>,
+    rooms: Option<u32>,
+    max_connections: Option<usize>,
+    cert_dir: Option<PathBuf>,
+    metrics_bind: Option<SocketAddr>,
+    max_catch_up: Option<u32>,
+    /// Seconds.
+    idle_timeout: Option<f64>,
+    limits: Option<Limits>,
+}
+
+impl Cli {
+    /// The configuration: defaults, then the file (if any), then the flags.
+    pub fn resolve(&self) -> Result<ServerConfig, ConfigError> {
+        let file = match &self.config {
+            Some(path) => {
+                let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+                    path: path.clone(),
+                    source,
+                })?;
+                parse_file(&text, path)?
+            }
+            None => FileConfig::default(),
+        };
+        let mut c = ServerConfig::default();
+        // File values, resolving relative paths against the file's folder.
+        let base = self.config.as_deref().and_then(Path::parent);
+        let relative = |p: PathBuf| match base {
+            Some(dir) if p.is_relative() => dir.join(p),
+            _ => p,
+        };
+        set(&mut c.bind, file.bind);
+        set(&mut c.level, file.level.map(|p| Some(relative(p))));
+        set(&mut c.tick_rate, file.tick_rate);
+        set(&mut c.snapshot_rate, file.snapshot_rate);
+        set(&mut c.max_players, file.max_players);
+        set(&mut c.rooms, file.rooms);
+        set(&mut c.max_connections, file.max_connections);
+        set(&mut c.cert_dir, file.cert_dir.map(relative));
+        set(&mut c.metrics_bind, file.metrics_bind.map(Some));
+        set(&mut c.max_catch_up, file.max_catch_up);
+        if let Some(secs) = file.idle_timeout {
+            c.idle_timeout = Duration::try_from_secs_f64(secs)
+                .map_err(|_| ConfigError::Invalid("idle_timeout must be seconds".into()))?;
+        }
+        set(&mut c.limits, file.limits);
+        // Flags win.
+        set(&mut c.bind, self.bind);
+        set(&mut c.level, self.level.clone().map(Some));
+        set(&mut c.tick_rate, self.tick_rate);
+        set(&mut c.snapshot_rate, self.snapshot_rate);
+        set(&mut c.max_players, self.max_players);
+        set(&mut c.rooms, self.rooms);
+        set(&mut c.max_connections, self.max_connections);
+        set(&mut c.cert_dir, self.cert_dir.clone());
+        set(&mut c.metrics_bind, self.metrics_bind.map(Some));
+        c.validate()?;
+        Ok(c)
+    }
+}
+
+fn set<T>(slot: &mut T, value: Option<T>) {
+    if let Some(v) = value {
+        *slot = v;
+    }
+}
+
+fn parse_file(text: &str, path: &Path) -> Result<FileConfig, ConfigError> {
+    toml::from_str(text).map_err(|e| ConfigError::Parse {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn cli(args: &[&str]) -> Cli {
+        Cli::try_parse_from(std::iter::once("ledge-server").chain(args.iter().copied())).unwrap()
+    }
+
     #[test]
-    fn default_bind_matches_the_documented_one() {
-        assert_eq!(ServerConfig::default().bind, DEFAULT_BIND.parse().unwrap());
+    fn defaults_match_the_documented_ones() {
+        let c = cli(&[]).resolve().unwrap();
+        assert_eq!(c, ServerConfig::default());
+        assert_eq!(c.bind, "0.0.0.0:4433".parse().unwrap());
+        assert_eq!((c.tick_rate, c.snapshot_rate), (60, 30));
+        assert_eq!(c.snapshot_interval(), 2);
+        assert_eq!(c.level, None);
+        assert_eq!(c.metrics_bind, None);
+    }
+
+    #[test]
+    fn file_values_apply_and_flags_override_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("server.toml");
+        std::fs::write(
+            &path,
+            r#"
+bind = "127.0.0.1:5000"
+tick_rate = 120
+snapshot_rate = 20
+max_players = 4
+rooms = 3
+cert_dir = "my-certs"
+level = "levels/one.json"
+metrics_bind = "127.0.0.1:9100"
+idle_timeout = 2.5
+
+[limits]
+datagrams_per_second = 500.0
+"#,
+        )
+        .unwrap();
+        let config = path.to_str().unwrap();
+        let c = cli(&["--config", config]).resolve().unwrap();
+        assert_eq!(c.bind, "127.0.0.1:5000".parse().unwrap());
+        assert_eq!((c.tick_rate, c.snapshot_rate), (120, 20));
+        assert_eq!(c.snapshot_interval(), 6);
+        assert_eq!((c.max_players, c.rooms), (4, 3));
+        assert_eq!(c.cert_dir, dir.path().join("my-certs"));
+        assert_eq!(c.level, Some(dir.path().join("levels/one.json")));
+        assert_eq!(c.metrics_bind, Some("127.0.0.1:9100".parse().unwrap()));
+        assert_eq!(c.idle_timeout, Duration::from_millis(2500));
+        assert_eq!(c.limits.datagrams_per_second, 500.0);
+        // Keys missing from [limits] keep their defaults.
+        assert_eq!(c.limits.control_burst, Limits::default().control_burst);
+
+        let c = cli(&[
+            "--config",
+            config,
+            "--tick-rate",
+            "30",
+            "--snapshot-rate",
+            "30",
+            "--bind",
+            "127.0.0.1:6000",
+            "--max-players",
+            "2",
+            "--cert-dir",
+            "/tmp/c",
+        ])
+        .resolve()
+        .unwrap();
+        assert_eq!(c.bind, "127.0.0.1:6000".parse().unwrap());
+        assert_eq!((c.tick_rate, c.snapshot_rate), (30, 30));
+        assert_eq!(c.snapshot_interval(), 1);
+        assert_eq!(c.max_players, 2);
+        assert_eq!(c.cert_dir, PathBuf::from("/tmp/c"));
+        // Not overridden: still the file's.
+        assert_eq!(c.rooms, 3);
+    }
+
+    #[test]
+    fn bad_files_and_values_are_reported() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, "tick_rat = 60\n").unwrap();
+        let err = cli(&["--config", path.to_str().unwrap()])
+            .resolve()
+            .unwrap_err();
+        assert!(
+            matches!(&err, ConfigError::Parse { message, .. } if message.contains("tick_rat")),
+            "{err}"
+        );
+        std::fs::write(&path, "tick_rate = \"fast\"\n").unwrap();
+        let err = cli(&["--config", path.to_str().unwrap()])
+            .resolve()
+            .unwrap_err();
+        assert!(matches!(err, ConfigError::Parse { .. }), "{err}");
+        let err = cli(&["--config", "/nonexistent/ledge.toml"])
+            .resolve()
+            .unwrap_err();
+        assert!(matches!(err, ConfigError::Read { .. }), "{err}");
+        for args in [
+            &["--tick-rate", "0"][..],
+            &["--snapshot-rate", "61"],
+            &["--max-players", "0"],
+            &["--rooms", "0"],
+        ] {
+            let err = cli(args).resolve().unwrap_err();
+            assert!(matches!(err, ConfigError::Invalid(_)), "{args:?}: {err}");
+        }
+    }
+
+    #[test]
+    fn snapshot_interval_rounds_to_whole_ticks() {
+        let at = |tick_rate, snapshot_rate| {
+            ServerConfig {
+                tick_rate,
+                snapshot_rate,
+                ..ServerConfig::default()
+            }
+            .snapshot_interval()
+        };
+        assert_eq!(at(60, 60), 1);
+        assert_eq!(at(60, 20), 3);
+        assert_eq!(at(60, 25), 2);
+        assert_eq!(at(60, 1), 60);
     }
 }

@@ -1,36 +1,98 @@
-//! One client connection: handshake, then the control-stream loop.
+//! One client connection: handshake, then the control stream and input
+//! datagrams until either side ends it.
 //!
-//! The client opens one bidirectional stream and sends a
-//! [`ClientMessage::Hello`]; the server answers [`ServerMessage::Welcome`]
-//! (after joining the room) or [`ServerMessage::Reject`]. Afterwards the
-//! stream carries control requests until either side ends it. Anything
-//! malformed or out of order closes this connection with
-//! [`CloseCode::ProtocolViolation`] and a reason; it never panics and never
-//! affects other connections.
+//! The client opens one bidirectional stream and sends a `Hello` (or
+//! `HelloRoom`); the server answers `Welcome` after joining a room, or
+//! `Reject` and closes. Afterwards:
+//!
+//! * control messages (chat, ping, leave) arrive on the stream as
+//!   length-prefixed frames ([`FrameDecoder`], at most
+//!   [`CLIENT_MAX_FRAME`] bytes each);
+//! * inputs arrive as datagrams ([`InputPacket`]) and go to the client's
+//!   [`PlayerInbox`], which the room drains one tick at a time;
+//! * everything the server sends on the stream goes through one writer
+//!   task fed by a bounded queue ([`Outbound`]): the room's chat relays and
+//!   oversized snapshots, pongs, notices.
+//!
+//! Robustness: each client has token buckets for datagrams and control
+//! messages (over the limit: dropped and counted), a malformed message is
+//! dropped and counted, and a client that keeps doing either (its strike
+//! bucket runs dry) is disconnected with a reason: a `Notice{Kick}`, then
+//! the close code. A broken control stream (bad length prefix) closes at
+//! once with [`CloseCode::ProtocolViolation`]. Nothing here panics on
+//! input or buffers more than the bounded queues and windows.
 
-use std::time::Duration;
+use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 
+use ledge_shared::protocol::{
+    check_version, write_frame, ClientControl, CloseCode, FrameDecoder, InputPacket, Message,
+    NoticeKind, PlayerId, ProtocolError, RejectReason, ServerControl, PROTOCOL_VERSION,
+};
 use quinn::{Connection, RecvStream, SendStream};
+use tokio::sync::{mpsc, watch};
 use tracing::{debug, info, warn, Instrument};
 
-use crate::framing::{read_message, write_message, FrameError};
-use crate::protocol::{
-    is_valid_name, ClientMessage, CloseCode, Hello, PlayerId, RejectReason, ServerMessage,
-    PROTOCOL_VERSION,
-};
-use crate::room::RoomHandle;
+use crate::config::Limits;
+use crate::metrics::{Channel, ClientBytes, DropReason, KickLabel, KickReason, Metrics};
+use crate::ratelimit::TokenBucket;
+use crate::room::{self, ClientLink, JoinError, Outbound, PlayerInbox, RoomHandle};
 
 /// How long a client has from connecting to finishing its `Hello`.
 pub const HELLO_TIMEOUT: Duration = Duration::from_secs(5);
 
+/// Largest control frame a client may send: every valid client message is
+/// far smaller (a chat line is at most 256 bytes).
+pub const CLIENT_MAX_FRAME: usize = 1024;
+
+/// Frames queued for one client's control stream; more are dropped.
+pub const CONTROL_QUEUE: usize = 64;
+
 /// How long a rejected client gets to receive the `Reject` before the close.
 const REJECT_LINGER: Duration = Duration::from_secs(1);
+/// How long a departing client gets to receive what was queued for it.
+const LEAVE_LINGER: Duration = Duration::from_millis(500);
+/// How long a kicked client gets to receive its `Notice{Kick}`.
+const KICK_LINGER: Duration = Duration::from_millis(250);
+/// How long each client gets to receive `Notice{Shutdown}`.
+pub const SHUTDOWN_LINGER: Duration = Duration::from_secs(1);
 
-/// Serves one incoming connection to its end. Errors are logged, not returned.
-pub async fn serve(incoming: quinn::Incoming, room: RoomHandle) {
+/// What every connection task shares.
+#[derive(Debug)]
+pub struct Shared {
+    /// The rooms, in name order.
+    pub rooms: Vec<RoomHandle>,
+    /// Metrics.
+    pub metrics: Arc<Metrics>,
+    /// Per-client limits.
+    pub limits: Limits,
+    /// The next player id.
+    pub next_player: AtomicU32,
+    /// Open connections (for the connection cap).
+    pub open: AtomicUsize,
+    /// Turns true when the server shuts down.
+    pub shutdown: watch::Receiver<bool>,
+}
+
+/// Counts an open connection for as long as it lives.
+struct OpenGuard<'a>(&'a Shared);
+
+impl Drop for OpenGuard<'_> {
+    fn drop(&mut self) {
+        self.0.open.fetch_sub(1, Ordering::Relaxed);
+        self.0.metrics.connections.dec();
+    }
+}
+
+/// Serves one incoming connection to its end (the caller already counted it
+/// in [`Shared::open`]). Errors are logged, not returned.
+pub async fn serve(incoming: quinn::Incoming, shared: Arc<Shared>) {
+    let _open = OpenGuard(&shared);
+    shared.metrics.connections.inc();
     let remote = incoming.remote_address();
     let span = tracing::info_span!("conn", %remote);
-    async move {
+    async {
         let connection = match incoming.await {
             Ok(connection) => connection,
             Err(e) => {
@@ -39,8 +101,7 @@ pub async fn serve(incoming: quinn::Incoming, room: RoomHandle) {
             }
         };
         debug!("connected");
-        let outcome = session(&connection, &room).await;
-        match outcome {
+        match session(&connection, &shared).await {
             Ok(()) => close(&connection, CloseCode::Normal, "bye"),
             Err(End::Closed(e)) => debug!("connection lost: {e}"),
             Err(End::Close(code, reason)) => {
@@ -58,6 +119,7 @@ pub async fn serve(incoming: quinn::Incoming, room: RoomHandle) {
 }
 
 /// How a session ended abnormally.
+#[derive(Debug)]
 enum End {
     /// The connection is already gone (peer closed, timed out, endpoint shut).
     Closed(String),
@@ -65,40 +127,46 @@ enum End {
     Close(CloseCode, String),
 }
 
-impl End {
-    fn from_frame(error: FrameError, context: &str) -> End {
-        if error.is_protocol_violation() {
-            End::Close(CloseCode::ProtocolViolation, format!("{context}: {error}"))
-        } else {
-            End::Closed(error.to_string())
-        }
-    }
-}
-
-/// Removes the player from the room however the session ends.
+/// Removes the player from its room, and its metric series, however the
+/// session ends.
 struct Membership<'a> {
     room: &'a RoomHandle,
     player_id: PlayerId,
+    metrics: &'a Metrics,
 }
 
 impl Drop for Membership<'_> {
     fn drop(&mut self) {
         self.room.leave(self.player_id);
+        self.metrics.forget_client(self.player_id.0);
     }
 }
 
-async fn session(connection: &Connection, room: &RoomHandle) -> Result<(), End> {
-    let (mut send, mut recv, hello) = tokio::time::timeout(HELLO_TIMEOUT, handshake(connection))
-        .await
-        .map_err(|_| End::Close(CloseCode::Timeout, "no hello in time".into()))??;
+async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
+    let mut shutdown = shared.shutdown.clone();
+    let (mut send, mut recv, hello, mut decoder) = tokio::select! {
+        handshake = tokio::time::timeout(HELLO_TIMEOUT, handshake(connection, shared)) => {
+            handshake.map_err(|_| End::Close(CloseCode::Timeout, "no hello in time".into()))??
+        }
+        () = crate::server::stopped(&mut shutdown) => {
+            return Err(End::Close(CloseCode::ServerShutdown, "server shutting down".into()))
+        }
+    };
 
-    let rejection = if hello.protocol_version != PROTOCOL_VERSION {
+    let (version, name, wanted_room) = match &hello {
+        Ok(hello) => hello.as_hello().expect("handshake returns a hello"),
+        Err(reason) => {
+            reject(&mut send, reason).await;
+            return Err(End::Close(CloseCode::Rejected, reason.to_string()));
+        }
+    };
+    let rejection = if check_version(version).is_err() {
         Some(RejectReason::ProtocolVersion {
             server: PROTOCOL_VERSION,
-            client: hello.protocol_version,
+            client: version,
         })
-    } else if !is_valid_name(&hello.name) {
-        Some(RejectReason::InvalidName)
+    } else if *shutdown.borrow() {
+        Some(RejectReason::ShuttingDown)
     } else {
         None
     };
@@ -107,65 +175,445 @@ async fn session(connection: &Connection, room: &RoomHandle) -> Result<(), End> 
         return Err(End::Close(CloseCode::Rejected, reason.to_string()));
     }
 
-    let welcome = room
-        .join(hello.name)
-        .await
-        .map_err(|_| End::Close(CloseCode::ServerShutdown, "server shutting down".into()))?;
+    let player_id = PlayerId(shared.next_player.fetch_add(1, Ordering::Relaxed));
+    let bytes = shared.metrics.client(player_id.0);
+    let (control, queue) = mpsc::channel(CONTROL_QUEUE);
+    let link = ClientLink {
+        connection: connection.clone(),
+        control: control.clone(),
+        bytes: bytes.clone(),
+    };
+    let (room, joined) = match join(shared, wanted_room, player_id, name, link).await {
+        Ok(joined) => joined,
+        Err(reason) => {
+            shared.metrics.forget_client(player_id.0);
+            reject(&mut send, &reason).await;
+            return Err(End::Close(CloseCode::Rejected, reason.to_string()));
+        }
+    };
     let _membership = Membership {
         room,
-        player_id: welcome.player_id,
+        player_id,
+        metrics: &shared.metrics,
     };
-    write_message(&mut send, &ServerMessage::Welcome(welcome))
+    let mut frame = Vec::new();
+    write_frame(&ServerControl::Welcome(joined.welcome), &mut frame)
+        .map_err(|e| End::Close(CloseCode::ProtocolViolation, format!("welcome: {e}")))?;
+    send.write_all(&frame)
         .await
-        .map_err(|e| End::from_frame(e, "sending welcome"))?;
+        .map_err(|e| End::Closed(e.to_string()))?;
+    shared.metrics.sent(&bytes, Channel::Stream, frame.len());
 
-    loop {
-        let message = read_message::<ClientMessage, _>(&mut recv)
-            .await
-            .map_err(|e| End::from_frame(e, "reading a control message"))?;
-        match message {
-            None => return Ok(()),
-            Some(ClientMessage::Ping(nonce)) => {
-                write_message(&mut send, &ServerMessage::Pong(nonce))
-                    .await
-                    .map_err(|e| End::from_frame(e, "sending pong"))?;
+    let writer = tokio::spawn(write_control(
+        send,
+        queue,
+        shared.metrics.clone(),
+        bytes.clone(),
+    ));
+    let mut client = Client {
+        shared,
+        room,
+        player_id,
+        inbox: joined.inbox,
+        bytes,
+        control,
+        decoder: &mut decoder,
+        buckets: Buckets::new(&shared.limits, Instant::now()),
+    };
+    let ending = client.run(connection, &mut recv, &mut shutdown).await;
+    // Say goodbye on the stream, then let the writer flush it (bounded).
+    let (notice, linger) = match &ending {
+        Ending::Left => (None, LEAVE_LINGER),
+        Ending::Shutdown => (Some(NoticeKind::Shutdown), SHUTDOWN_LINGER),
+        Ending::Kick { notice, .. } => (
+            Some(NoticeKind::Kick {
+                reason: notice.to_string(),
+            }),
+            KICK_LINGER,
+        ),
+        Ending::Lost(_) => (None, Duration::ZERO),
+    };
+    if !linger.is_zero() {
+        let goodbye = async {
+            if let Some(kind) = notice {
+                let mut frame = Vec::new();
+                if write_frame(&ServerControl::Notice { kind }, &mut frame).is_ok() {
+                    let _ = client.control.send(Outbound::Frame(frame)).await;
+                }
             }
-            Some(ClientMessage::Hello(_)) => {
-                return Err(End::Close(
-                    CloseCode::ProtocolViolation,
-                    "second hello".into(),
-                ))
-            }
+            let _ = client.control.send(Outbound::Finish).await;
+            let _ = writer.await;
+        };
+        let _ = tokio::time::timeout(linger, goodbye).await;
+    }
+    match ending {
+        Ending::Left => Ok(()),
+        Ending::Shutdown => Err(End::Close(
+            CloseCode::ServerShutdown,
+            "server shutting down".into(),
+        )),
+        Ending::Kick {
+            code,
+            reason,
+            detail,
+            ..
+        } => {
+            shared
+                .metrics
+                .kicks
+                .get_or_create(&KickLabel { reason })
+                .inc();
+            Err(End::Close(code, detail))
         }
+        Ending::Lost(e) => Err(End::Closed(e)),
     }
 }
 
-/// Accepts the control stream and reads the `Hello`.
-async fn handshake(connection: &Connection) -> Result<(SendStream, RecvStream, Hello), End> {
+/// Joins the wanted room, or the least full one with a free place.
+async fn join<'a>(
+    shared: &'a Shared,
+    wanted: Option<&str>,
+    player_id: PlayerId,
+    name: &str,
+    link: ClientLink,
+) -> Result<(&'a RoomHandle, room::Joined), RejectReason> {
+    let candidates: Vec<&RoomHandle> = match wanted {
+        Some(wanted) => match shared.rooms.iter().find(|r| r.name() == wanted) {
+            Some(room) => vec![room],
+            None => {
+                return Err(RejectReason::Other {
+                    reason: format!("there is no room named {wanted:?}"),
+                })
+            }
+        },
+        None => {
+            let mut rooms: Vec<&RoomHandle> = shared.rooms.iter().collect();
+            // Stable: the first of equally full rooms.
+            rooms.sort_by_key(|r| r.players());
+            rooms
+        }
+    };
+    for room in candidates {
+        if wanted.is_none() && !room.has_room() {
+            continue;
+        }
+        match room.join(player_id, name.to_owned(), link.clone()).await {
+            Ok(joined) => return Ok((room, joined)),
+            Err(JoinError::Rejected(RejectReason::RoomFull)) if wanted.is_none() => continue,
+            Err(JoinError::Rejected(reason)) => return Err(reason),
+            Err(JoinError::Closed) => return Err(RejectReason::ShuttingDown),
+        }
+    }
+    Err(RejectReason::RoomFull)
+}
+
+/// The client's hello, or the polite rejection of a hello that failed
+/// validation.
+type Hello = Result<ClientControl, RejectReason>;
+
+/// Accepts the control stream and reads the first message, which must be a
+/// hello. A hello whose name is invalid is answered with
+/// [`RejectReason::InvalidName`]; anything else malformed closes.
+async fn handshake(
+    connection: &Connection,
+    shared: &Shared,
+) -> Result<(SendStream, RecvStream, Hello, FrameDecoder), End> {
     let (send, mut recv) = connection
         .accept_bi()
         .await
         .map_err(|e| End::Closed(e.to_string()))?;
-    match read_message::<ClientMessage, _>(&mut recv).await {
-        Ok(Some(ClientMessage::Hello(hello))) => Ok((send, recv, hello)),
-        Ok(Some(_)) => Err(End::Close(
-            CloseCode::ProtocolViolation,
-            "expected hello".into(),
-        )),
-        Ok(None) => Err(End::Close(
-            CloseCode::ProtocolViolation,
-            "stream ended before hello".into(),
-        )),
-        Err(e) => Err(End::from_frame(e, "reading hello")),
+    let mut decoder = FrameDecoder::new(CLIENT_MAX_FRAME);
+    let mut buf = [0u8; 2048];
+    let payload = loop {
+        if let Some(payload) = decoder.pop() {
+            break payload;
+        }
+        let n = match recv.read(&mut buf).await {
+            Ok(Some(n)) => n,
+            Ok(None) => {
+                return Err(End::Close(
+                    CloseCode::ProtocolViolation,
+                    "stream ended before hello".into(),
+                ))
+            }
+            Err(e) => return Err(End::Closed(e.to_string())),
+        };
+        shared
+            .metrics
+            .bytes_in
+            .get_or_create(&crate::metrics::ChannelLabel {
+                channel: Channel::Stream,
+            })
+            .inc_by(n as u64);
+        if let Err(e) = decoder.push(&buf[..n]) {
+            shared.metrics.malformed(Channel::Stream);
+            return Err(End::Close(
+                CloseCode::ProtocolViolation,
+                format!("reading hello: {e}"),
+            ));
+        }
+    };
+    let hello = match ClientControl::decode(&payload) {
+        Ok(m) if m.as_hello().is_some() => Ok(m),
+        Ok(_) => {
+            return Err(End::Close(
+                CloseCode::ProtocolViolation,
+                "expected hello".into(),
+            ))
+        }
+        Err(ProtocolError::InvalidString {
+            field: "player name",
+            ..
+        }) => Err(RejectReason::InvalidName),
+        Err(e) => {
+            shared.metrics.malformed(Channel::Stream);
+            return Err(End::Close(
+                CloseCode::ProtocolViolation,
+                format!("reading hello: {e}"),
+            ));
+        }
+    };
+    Ok((send, recv, hello, decoder))
+}
+
+/// How a joined session ends.
+#[derive(Debug)]
+enum Ending {
+    /// The client left (`Leave`, or it finished its stream).
+    Left,
+    /// The server is shutting down.
+    Shutdown,
+    /// The server disconnects the client.
+    Kick {
+        code: CloseCode,
+        reason: KickReason,
+        /// Told to the client in the notice.
+        notice: &'static str,
+        /// Logged and sent as the close reason.
+        detail: String,
+    },
+    /// The connection is gone.
+    Lost(String),
+}
+
+impl Ending {
+    fn malformed(detail: String) -> Ending {
+        Ending::Kick {
+            code: CloseCode::ProtocolViolation,
+            reason: KickReason::Malformed,
+            notice: "too many malformed messages",
+            detail,
+        }
+    }
+
+    fn flooding(detail: String) -> Ending {
+        Ending::Kick {
+            code: CloseCode::Kicked,
+            reason: KickReason::Flooding,
+            notice: "sending too fast",
+            detail,
+        }
+    }
+}
+
+/// A client's token buckets.
+struct Buckets {
+    datagrams: TokenBucket,
+    control: TokenBucket,
+    malformed: TokenBucket,
+    flood: TokenBucket,
+}
+
+impl Buckets {
+    fn new(l: &Limits, now: Instant) -> Buckets {
+        Buckets {
+            datagrams: TokenBucket::new(l.datagram_burst, l.datagrams_per_second, now),
+            control: TokenBucket::new(l.control_burst, l.control_per_second, now),
+            malformed: TokenBucket::new(l.malformed_burst, l.malformed_per_second, now),
+            flood: TokenBucket::new(l.flood_burst, l.flood_per_second, now),
+        }
+    }
+}
+
+/// A joined client's receive side.
+struct Client<'a> {
+    shared: &'a Shared,
+    room: &'a RoomHandle,
+    player_id: PlayerId,
+    inbox: Arc<Mutex<PlayerInbox>>,
+    bytes: ClientBytes,
+    control: mpsc::Sender<Outbound>,
+    decoder: &'a mut FrameDecoder,
+    buckets: Buckets,
+}
+
+impl Client<'_> {
+    async fn run(
+        &mut self,
+        connection: &Connection,
+        recv: &mut RecvStream,
+        shutdown: &mut watch::Receiver<bool>,
+    ) -> Ending {
+        let mut buf = vec![0u8; 4096];
+        // Frames that arrived with the hello.
+        if let Err(ending) = self.drain_frames() {
+            return ending;
+        }
+        loop {
+            let step = tokio::select! {
+                () = crate::server::stopped(shutdown) => Err(Ending::Shutdown),
+                read = recv.read(&mut buf) => match read {
+                    Ok(Some(n)) => {
+                        self.shared.metrics.received(&self.bytes, Channel::Stream, n);
+                        match self.decoder.push(&buf[..n]) {
+                            Ok(()) => self.drain_frames(),
+                            Err(e) => {
+                                self.shared.metrics.malformed(Channel::Stream);
+                                Err(Ending::malformed(format!("control stream: {e}")))
+                            }
+                        }
+                    }
+                    // The client finished its side: it left.
+                    Ok(None) => Err(Ending::Left),
+                    Err(e) => Err(Ending::Lost(e.to_string())),
+                },
+                datagram = connection.read_datagram() => match datagram {
+                    Ok(datagram) => self.datagram(&datagram),
+                    Err(e) => Err(Ending::Lost(e.to_string())),
+                },
+            };
+            if let Err(ending) = step {
+                return ending;
+            }
+        }
+    }
+
+    /// Handles every complete frame buffered.
+    fn drain_frames(&mut self) -> Result<(), Ending> {
+        while let Some(payload) = self.decoder.pop() {
+            let now = Instant::now();
+            if !self.buckets.control.try_take(now) {
+                self.shared
+                    .metrics
+                    .count_drop(DropReason::ControlRateLimited);
+                self.strike_flood(now, "control messages")?;
+                continue;
+            }
+            let message = match ClientControl::decode(&payload) {
+                Ok(m) => m,
+                Err(e) => {
+                    self.shared.metrics.malformed(Channel::Stream);
+                    debug!("malformed control message: {e}");
+                    self.strike_malformed(now, "control message", &e)?;
+                    continue;
+                }
+            };
+            match message {
+                ClientControl::Hello { .. } | ClientControl::HelloRoom { .. } => {
+                    return Err(Ending::malformed("second hello".into()));
+                }
+                ClientControl::Chat { text } => self.room.chat(self.player_id, text),
+                ClientControl::Ping { nonce } => {
+                    let mut frame = Vec::new();
+                    if write_frame(&ServerControl::Pong { nonce }, &mut frame).is_ok()
+                        && self.control.try_send(Outbound::Frame(frame)).is_err()
+                    {
+                        self.shared.metrics.count_drop(DropReason::ControlQueueFull);
+                    }
+                }
+                ClientControl::Leave => return Err(Ending::Left),
+            }
+        }
+        Ok(())
+    }
+
+    fn datagram(&mut self, datagram: &[u8]) -> Result<(), Ending> {
+        let now = Instant::now();
+        self.shared
+            .metrics
+            .received(&self.bytes, Channel::Datagram, datagram.len());
+        if !self.buckets.datagrams.try_take(now) {
+            self.shared
+                .metrics
+                .count_drop(DropReason::DatagramRateLimited);
+            return self.strike_flood(now, "datagrams");
+        }
+        match InputPacket::decode(datagram) {
+            Ok(packet) => {
+                let r = room::lock(&self.inbox).receive(&packet);
+                let m = &self.shared.metrics;
+                m.count_drops(DropReason::InputLate, u64::from(r.late));
+                m.count_drops(DropReason::InputTooEarly, u64::from(r.too_early));
+                Ok(())
+            }
+            Err(e) => {
+                self.shared.metrics.malformed(Channel::Datagram);
+                self.strike_malformed(now, "input datagram", &e)
+            }
+        }
+    }
+
+    fn strike_malformed(
+        &mut self,
+        now: Instant,
+        what: &str,
+        error: &ProtocolError,
+    ) -> Result<(), Ending> {
+        if self.buckets.malformed.try_take(now) {
+            Ok(())
+        } else {
+            Err(Ending::malformed(format!(
+                "too many malformed messages (last: {what}: {error})"
+            )))
+        }
+    }
+
+    fn strike_flood(&mut self, now: Instant, what: &str) -> Result<(), Ending> {
+        if self.buckets.flood.try_take(now) {
+            Ok(())
+        } else {
+            Err(Ending::flooding(format!("flooding the server with {what}")))
+        }
+    }
+}
+
+/// Writes queued frames to the control stream in order; on
+/// [`Outbound::Finish`] (or when every sender is gone) finishes the stream
+/// and waits until the client has everything.
+async fn write_control(
+    mut send: SendStream,
+    mut queue: mpsc::Receiver<Outbound>,
+    metrics: Arc<Metrics>,
+    bytes: ClientBytes,
+) {
+    while let Some(out) = queue.recv().await {
+        match out {
+            Outbound::Frame(frame) => {
+                if send.write_all(&frame).await.is_err() {
+                    return;
+                }
+                metrics.sent(&bytes, Channel::Stream, frame.len());
+            }
+            Outbound::Finish => break,
+        }
+    }
+    if send.finish().is_ok() {
+        let _ = send.stopped().await;
     }
 }
 
 /// Sends a `Reject` and waits (briefly) until the client has it, since
 /// closing the connection discards unacknowledged stream data.
 async fn reject(send: &mut SendStream, reason: &RejectReason) {
-    if write_message(send, &ServerMessage::Reject(reason.clone()))
-        .await
-        .is_err()
+    let mut frame = Vec::new();
+    if write_frame(
+        &ServerControl::Reject {
+            reason: reason.clone(),
+        },
+        &mut frame,
+    )
+    .is_err()
+        || send.write_all(&frame).await.is_err()
         || send.finish().is_err()
     {
         return;
@@ -173,11 +621,11 @@ async fn reject(send: &mut SendStream, reason: &RejectReason) {
     let _ = tokio::time::timeout(REJECT_LINGER, send.stopped()).await;
 }
 
-fn close(connection: &Connection, code: CloseCode, reason: &str) {
-    // Keep the reason well inside one packet.
+/// Closes `connection` with `code` and `reason` (cut to fit one packet).
+pub fn close(connection: &Connection, code: CloseCode, reason: &str) {
     let mut end = reason.len().min(200);
     while !reason.is_char_boundary(end) {
         end -= 1;
     }
-    connection.close(code.into(), &reason.as_bytes()[..end]);
+    connection.close(code.to_u32().into(), &reason.as_bytes()[..end]);
 }

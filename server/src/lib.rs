@@ -1,18 +1,24 @@
 //! `ledge-server`: the authoritative server of ledge.
 //!
-//! A QUIC endpoint (quinn, rustls with ring) serving one room that owns the
-//! deterministic world from `ledge-shared` and steps it on a drift-free
-//! fixed-step loop. The binary is a thin CLI around [`Server`]; tests start
-//! the same server in-process on `127.0.0.1:0`.
+//! A QUIC endpoint (quinn, rustls with ring) serving rooms that each own a
+//! deterministic [`ledge_shared::game::Game`] stepped on a drift-free
+//! fixed-step loop. Clients send inputs in datagrams and receive
+//! delta-compressed snapshots; the wire protocol is
+//! [`ledge_shared::protocol`] (see `docs/PROTOCOL.md`, and `docs/SERVER.md`
+//! for running and operating the server). The binary is a thin CLI around
+//! [`Server`]; tests start the same server in-process on `127.0.0.1:0`.
 //!
-//! * [`config`]: settings ([`ServerConfig`]);
+//! * [`config`]: settings, command line and TOML file ([`ServerConfig`]);
 //! * [`cert`] / [`fingerprint`]: the self-signed identity clients pin;
-//! * [`tls`]: QUIC/TLS endpoint configuration;
-//! * [`protocol`] / [`framing`]: control messages and their frames (shared
-//!   with the client library until the protocol moves into `ledge-shared`);
+//! * [`tls`]: QUIC/TLS endpoint configuration and buffer sizes;
+//! * [`levels`]: the level played, its id and hash;
 //! * [`clock`]: the absolute tick schedule;
-//! * [`room`]: the world and its tick loop;
-//! * [`connection`]: one client's handshake and control stream;
+//! * [`inputs`]: a client's bounded input buffer;
+//! * [`snapshots`]: a room's snapshot history and per-client encoding;
+//! * [`room`]: the game, its tick loop and snapshot sending;
+//! * [`connection`]: one client's handshake, control stream and datagrams;
+//! * [`ratelimit`]: token buckets;
+//! * [`metrics`]: Prometheus metrics and their HTTP endpoint;
 //! * [`server`]: the endpoint, accept loop and graceful shutdown.
 #![deny(missing_docs)]
 
@@ -21,10 +27,13 @@ pub mod clock;
 pub mod config;
 pub mod connection;
 pub mod fingerprint;
-pub mod framing;
-pub mod protocol;
+pub mod inputs;
+pub mod levels;
+pub mod metrics;
+pub mod ratelimit;
 pub mod room;
 pub mod server;
+pub mod snapshots;
 pub mod tls;
 
 pub use config::ServerConfig;

@@ -1,34 +1,14 @@
 //! `ledge-server`: host a ledge game.
 //!
 //! Prints the certificate fingerprint clients must pin, then runs until
-//! Ctrl-C or SIGTERM and shuts down gracefully.
-
-use std::net::SocketAddr;
-use std::path::PathBuf;
+//! Ctrl-C or SIGTERM and shuts down gracefully. Options: `--help`, and
+//! `docs/SERVER.md`.
 
 use anyhow::Context;
 use clap::Parser;
-use ledge_server::config::{
-    DEFAULT_BIND, DEFAULT_CERT_DIR, DEFAULT_MAX_CATCH_UP, DEFAULT_TICK_RATE,
-};
-use ledge_server::{Server, ServerConfig};
+use ledge_server::config::Cli;
+use ledge_server::Server;
 use tracing_subscriber::EnvFilter;
-
-/// Authoritative ledge server (QUIC over UDP).
-#[derive(Debug, Parser)]
-#[command(version)]
-struct Cli {
-    /// UDP address to listen on.
-    #[arg(long, default_value = DEFAULT_BIND)]
-    bind: SocketAddr,
-    /// Directory of the certificate and key (created on first start).
-    #[arg(long, default_value = DEFAULT_CERT_DIR)]
-    cert_dir: PathBuf,
-    /// Simulation ticks per second.
-    #[arg(long, default_value_t = DEFAULT_TICK_RATE,
-          value_parser = clap::value_parser!(u32).range(1..=1000))]
-    tick_rate: u32,
-}
 
 #[tokio::main]
 async fn main() -> anyhow::Result<()> {
@@ -36,13 +16,8 @@ async fn main() -> anyhow::Result<()> {
     tracing_subscriber::fmt()
         .with_env_filter(EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()))
         .init();
+    let config = cli.resolve().context("reading the configuration")?;
 
-    let config = ServerConfig {
-        bind: cli.bind,
-        cert_dir: cli.cert_dir,
-        tick_rate: cli.tick_rate,
-        max_catch_up: DEFAULT_MAX_CATCH_UP,
-    };
     let server = Server::bind(config.clone()).with_context(|| {
         format!(
             "starting the server on {} with certificates in {}",
@@ -53,6 +28,9 @@ async fn main() -> anyhow::Result<()> {
     let fingerprint = server.fingerprint();
     let port = server.local_addr().port();
     println!("ledge server listening on {}", server.local_addr());
+    if let Some(addr) = server.metrics_addr() {
+        println!("metrics at http://{addr}/metrics");
+    }
     println!("certificate SHA-256 fingerprint: {fingerprint}");
     println!(
         "connect with: cargo run --release -p ledge-client -- \

@@ -1,81 +1,253 @@
-//! A room: one authoritative world and its fixed-step tick loop.
+//! A room: one authoritative [`Game`], its fixed-step tick loop, and the
+//! snapshots it sends its players.
 //!
-//! The room runs as its own task and owns its [`World`] outright; the rest
-//! of the server talks to it through a [`RoomHandle`] (commands in, a
-//! [`RoomStatus`] watch out), so connection tasks never lock the world.
-//! The loop follows a [`TickSchedule`]: ticks run on an absolute grid, a
-//! stall is caught up by a bounded number of ticks and logged.
+//! The room runs as its own task and owns its game outright; connection
+//! tasks talk to it through a [`RoomHandle`] (join, leave, chat) and drop
+//! each client's decoded inputs into that client's [`PlayerInbox`], which
+//! the room drains one tick at a time. The loop follows a [`TickSchedule`]:
+//! ticks run on an absolute grid, a stall is caught up by a bounded number
+//! of ticks, and skipped ticks are logged and counted.
+//!
+//! Every tick: take each player's input for this tick from its inbox (or
+//! repeat its last one and count the starvation), step the game, and every
+//! `snapshot_interval` ticks capture a snapshot and send each player a
+//! delta against the snapshot it acknowledged, as a datagram when it fits
+//! and on the control stream when it does not.
 
 use std::collections::BTreeMap;
-use std::time::Instant;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
 
+use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
-use ledge_shared::world::World;
+use ledge_shared::protocol::{
+    write_frame, InputPacket, NetTiming, Outgoing, PlayerId, RejectReason, ServerControl, Welcome,
+};
+use prometheus_client::metrics::counter::Counter;
+use prometheus_client::metrics::histogram::Histogram;
 use tokio::sync::{mpsc, oneshot, watch};
 use tokio::task::JoinHandle;
-use tracing::{debug, info, warn};
+use tracing::{debug, error, info, warn};
 
 use crate::clock::TickSchedule;
-use crate::protocol::{PlayerId, Welcome};
+use crate::inputs::{InputBuffer, Received};
+use crate::metrics::{
+    Channel, ClientBytes, DropReason, Metrics, RoomLabel, SnapshotKind, SnapshotLabel,
+};
+use crate::snapshots::RoomSnapshots;
+use crate::tls::DATAGRAM_SEND_BUFFER;
+
+/// How long the room waits for a client to acknowledge a snapshot sent on
+/// the control stream before it sends another one there.
+const STREAM_SNAPSHOT_RESEND: Duration = Duration::from_millis(1000);
+
+/// Something for a client's control-stream writer.
+#[derive(Debug)]
+pub enum Outbound {
+    /// A complete frame (length prefix included).
+    Frame(Vec<u8>),
+    /// Finish the stream after what was queued before, wait (briefly) until
+    /// the client has it, and stop.
+    Finish,
+}
+
+/// How a room runs.
+#[derive(Debug, Clone)]
+pub struct RoomConfig {
+    /// The room's name (sent in `Welcome`).
+    pub name: String,
+    /// Fixed tick rate in Hz.
+    pub tick_rate: u32,
+    /// Ticks between snapshots.
+    pub snapshot_interval: u32,
+    /// Most players at once.
+    pub max_players: usize,
+    /// Most ticks run back to back after a stall; older ones are skipped.
+    pub max_catch_up: u32,
+    /// Ticks of input accepted ahead of the next simulated tick.
+    pub input_window: usize,
+    /// Ticks of input a client should repeat in each packet.
+    pub input_redundancy: u8,
+    /// Snapshots kept as baselines.
+    pub history: usize,
+    /// Level id sent in `Welcome`.
+    pub level_id: String,
+    /// Level hash sent in `Welcome`.
+    pub level_hash: u64,
+}
 
 /// The room's progress, published after every tick.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RoomStatus {
     /// Ticks simulated so far.
     pub tick: u64,
-    /// The world's state hash after that tick.
+    /// The game's state hash after that tick.
     pub state_hash: u64,
     /// Players currently in the room.
     pub players: usize,
 }
 
-/// How a room runs.
-#[derive(Debug, Clone, Copy)]
-pub struct RoomConfig {
-    /// Fixed tick rate in Hz.
-    pub tick_rate: u32,
-    /// Most ticks run back to back after a stall; older ones are skipped.
-    pub max_catch_up: u32,
+/// What a connection gives the room to reach its client.
+#[derive(Debug, Clone)]
+pub struct ClientLink {
+    /// The connection, for snapshot datagrams.
+    pub connection: quinn::Connection,
+    /// The client's control-stream writer.
+    pub control: mpsc::Sender<Outbound>,
+    /// The client's byte counters.
+    pub bytes: ClientBytes,
+}
+
+/// Inputs and acknowledgements of one client, written by its connection
+/// task, read by the room.
+#[derive(Debug)]
+pub struct PlayerInbox {
+    /// Button bits by tick.
+    pub inputs: InputBuffer,
+    /// Newest snapshot tick the client acknowledged.
+    pub ack: Option<u64>,
+    /// Whether any input arrived yet (starvation counts only after).
+    pub received_any: bool,
+    /// Earliest arrival (most negative timing) since the last snapshot.
+    timing_min: Option<i16>,
+    /// Timing of the last packet.
+    last_timing: i16,
+}
+
+impl PlayerInbox {
+    fn new(window: usize, next_tick: u64) -> PlayerInbox {
+        PlayerInbox {
+            inputs: InputBuffer::new(window, next_tick),
+            ack: None,
+            received_any: false,
+            timing_min: None,
+            last_timing: 0,
+        }
+    }
+
+    /// Stores a decoded input packet.
+    pub fn receive(&mut self, packet: &InputPacket) -> Received {
+        let r = self.inputs.receive(packet);
+        if let Some(ack) = packet.ack_snapshot {
+            self.ack = Some(self.ack.map_or(ack, |a| a.max(ack)));
+        }
+        self.received_any = true;
+        self.last_timing = r.timing;
+        self.timing_min = Some(self.timing_min.map_or(r.timing, |m| m.min(r.timing)));
+        r
+    }
+
+    /// The timing to report: the worst (latest) arrival since the last
+    /// report, or the last one when nothing arrived since.
+    fn take_timing(&mut self) -> i16 {
+        self.timing_min.take().unwrap_or(self.last_timing)
+    }
+}
+
+/// Locks an inbox, ignoring poisoning (the data stays consistent: every
+/// update is a few plain assignments).
+pub fn lock(inbox: &Mutex<PlayerInbox>) -> MutexGuard<'_, PlayerInbox> {
+    inbox.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A successful join.
+#[derive(Debug)]
+pub struct Joined {
+    /// What to send the client.
+    pub welcome: Welcome,
+    /// Where the connection puts the client's inputs.
+    pub inbox: Arc<Mutex<PlayerInbox>>,
+}
+
+/// Why a join failed.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum JoinError {
+    /// The room refused (full, or the game refused the player).
+    #[error("{0}")]
+    Rejected(RejectReason),
+    /// The room task has stopped (the server is shutting down).
+    #[error("the room has stopped")]
+    Closed,
 }
 
 /// Requests to the room task.
 #[derive(Debug)]
 enum Command {
     Join {
+        player_id: PlayerId,
         name: String,
-        reply: oneshot::Sender<Welcome>,
+        link: ClientLink,
+        reply: oneshot::Sender<Result<Joined, RejectReason>>,
     },
     Leave {
         player_id: PlayerId,
     },
+    Chat {
+        from: PlayerId,
+        text: String,
+    },
 }
-
-/// The room task has stopped (the server is shutting down).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-#[error("the room has stopped")]
-pub struct RoomClosed;
 
 /// A cheap, cloneable way to talk to a running room. The room stops when
 /// the last handle is dropped.
 #[derive(Debug, Clone)]
 pub struct RoomHandle {
+    name: Arc<str>,
     commands: mpsc::UnboundedSender<Command>,
+    players: Arc<AtomicUsize>,
+    max_players: usize,
     status: watch::Receiver<RoomStatus>,
 }
 
 impl RoomHandle {
-    /// Adds a player; the answer carries the tick and state hash at joining.
-    pub async fn join(&self, name: String) -> Result<Welcome, RoomClosed> {
+    /// The room's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Players in the room now (or about to be).
+    pub fn players(&self) -> usize {
+        self.players.load(Ordering::Relaxed)
+    }
+
+    /// Whether the room has a free place now.
+    pub fn has_room(&self) -> bool {
+        self.players() < self.max_players
+    }
+
+    /// Adds a player. Commands are unbounded but each connection sends one
+    /// join, one leave and rate-limited chat, so the queue stays small.
+    pub async fn join(
+        &self,
+        player_id: PlayerId,
+        name: String,
+        link: ClientLink,
+    ) -> Result<Joined, JoinError> {
         let (reply, answer) = oneshot::channel();
         self.commands
-            .send(Command::Join { name, reply })
-            .map_err(|_| RoomClosed)?;
-        answer.await.map_err(|_| RoomClosed)
+            .send(Command::Join {
+                player_id,
+                name,
+                link,
+                reply,
+            })
+            .map_err(|_| JoinError::Closed)?;
+        match answer.await {
+            Ok(Ok(joined)) => Ok(joined),
+            Ok(Err(reason)) => Err(JoinError::Rejected(reason)),
+            Err(_) => Err(JoinError::Closed),
+        }
     }
 
     /// Removes a player (no-op if unknown or the room has stopped).
     pub fn leave(&self, player_id: PlayerId) {
         let _ = self.commands.send(Command::Leave { player_id });
+    }
+
+    /// Relays a chat line to everyone in the room.
+    pub fn chat(&self, from: PlayerId, text: String) {
+        let _ = self.commands.send(Command::Chat { from, text });
     }
 
     /// The latest published status.
@@ -84,52 +256,95 @@ impl RoomHandle {
     }
 }
 
-/// Starts a room owning `world` on the current tokio runtime.
-pub fn spawn(world: World, config: RoomConfig) -> (RoomHandle, JoinHandle<()>) {
+/// Starts a room owning `game` on the current tokio runtime.
+pub fn spawn(
+    game: Game,
+    config: RoomConfig,
+    metrics: Arc<Metrics>,
+) -> (RoomHandle, JoinHandle<()>) {
     let (commands, command_rx) = mpsc::unbounded_channel();
     let (status_tx, status) = watch::channel(RoomStatus {
-        tick: world.tick(),
-        state_hash: world.state_hash(),
+        tick: game.tick(),
+        state_hash: game.state_hash(),
         players: 0,
     });
+    let players = Arc::new(AtomicUsize::new(0));
+    let label = RoomLabel {
+        room: config.name.clone(),
+    };
     let room = Room {
-        world,
-        players: BTreeMap::new(),
-        next_player: 1,
-        // The warm-up room has one controller slot; players get their own
-        // slots once the world supports them.
-        inputs: vec![Buttons::NONE],
-        tick_rate: config.tick_rate.max(1),
-        max_catch_up: config.max_catch_up,
+        tick_duration: metrics.tick_duration.get_or_create_owned(&label),
+        missed_ticks: metrics.missed_ticks.get_or_create_owned(&label),
+        starvation: metrics.input_starvation.get_or_create_owned(&label),
+        players_gauge: metrics.players.get_or_create_owned(&label),
+        game,
+        members: BTreeMap::new(),
+        inputs: Vec::new(),
+        snapshots: RoomSnapshots::new(config.history),
+        players: players.clone(),
         commands: command_rx,
         status: status_tx,
+        metrics,
+        config: config.clone(),
     };
-    let task = tokio::spawn(room.run());
-    (RoomHandle { commands, status }, task)
+    let handle = RoomHandle {
+        name: config.name.as_str().into(),
+        commands,
+        players,
+        max_players: config.max_players,
+        status,
+    };
+    (handle, tokio::spawn(room.run()))
 }
 
-/// A joined player.
+/// Counts a snapshot datagram sent to a client.
+fn record_snapshot(metrics: &Metrics, bytes: &ClientBytes, kind: SnapshotKind, len: usize) {
+    metrics.sent(bytes, Channel::Datagram, len);
+    metrics
+        .snapshot_bytes
+        .get_or_create(&SnapshotLabel {
+            kind,
+            channel: Channel::Datagram,
+        })
+        .observe(len as f64);
+}
+
+/// A player in the room.
 #[derive(Debug)]
-struct Player {
+struct Member {
     name: String,
+    link: ClientLink,
+    inbox: Arc<Mutex<PlayerInbox>>,
+    /// Buttons applied last tick (repeated when an input is missing).
+    buttons: Buttons,
+    /// Newest tick of this client's own input applied.
+    last_applied: Option<u64>,
+    /// A snapshot sent on the control stream and when, until acknowledged.
+    stream_pending: Option<(u64, Instant)>,
 }
 
 /// The room task's state.
 struct Room {
-    world: World,
-    players: BTreeMap<PlayerId, Player>,
-    next_player: u32,
-    inputs: Vec<Buttons>,
-    tick_rate: u32,
-    max_catch_up: u32,
+    config: RoomConfig,
+    game: Game,
+    members: BTreeMap<PlayerId, Member>,
+    inputs: Vec<(PlayerId, Buttons)>,
+    snapshots: RoomSnapshots,
+    players: Arc<AtomicUsize>,
     commands: mpsc::UnboundedReceiver<Command>,
     status: watch::Sender<RoomStatus>,
+    metrics: Arc<Metrics>,
+    tick_duration: Histogram,
+    missed_ticks: Counter,
+    starvation: Counter,
+    players_gauge: prometheus_client::metrics::gauge::Gauge,
 }
 
 impl Room {
     async fn run(mut self) {
-        let mut schedule = TickSchedule::new(Instant::now(), self.tick_rate, self.max_catch_up);
-        info!(tick_rate = self.tick_rate, "room started");
+        let rate = self.config.tick_rate.max(1);
+        let mut schedule = TickSchedule::new(Instant::now(), rate, self.config.max_catch_up);
+        info!(room = %self.config.name, tick_rate = rate, "room started");
         loop {
             let deadline = tokio::time::Instant::from_std(schedule.next_deadline());
             tokio::select! {
@@ -140,96 +355,244 @@ impl Room {
                 () = tokio::time::sleep_until(deadline) => {
                     let due = schedule.poll(Instant::now());
                     for _ in 0..due.run {
-                        self.world.step(&self.inputs);
+                        self.tick();
                     }
                     if due.skipped > 0 {
+                        self.missed_ticks.inc_by(due.skipped);
                         warn!(
+                            room = %self.config.name,
                             caught_up = due.run,
                             skipped = due.skipped,
-                            tick = self.world.tick(),
+                            tick = self.game.tick(),
                             "tick loop fell behind; skipped ticks"
                         );
                     } else if due.run > 1 {
-                        debug!(caught_up = due.run, "tick loop caught up");
+                        debug!(room = %self.config.name, caught_up = due.run, "tick loop caught up");
                     }
                     self.publish();
                 }
             }
         }
-        info!(tick = self.world.tick(), "room stopped");
+        self.players_gauge.set(0);
+        info!(room = %self.config.name, tick = self.game.tick(), "room stopped");
     }
 
     fn handle(&mut self, command: Command) {
         match command {
-            Command::Join { name, reply } => {
-                let player_id = PlayerId(self.next_player);
-                self.next_player = self.next_player.wrapping_add(1);
-                let welcome = Welcome {
-                    player_id,
-                    tick: self.world.tick(),
-                    state_hash: self.world.state_hash(),
-                    tick_rate: self.tick_rate,
-                };
-                info!(%player_id, %name, "player joined");
-                self.players.insert(player_id, Player { name });
-                // Publish before answering, so a joiner sees itself counted.
-                self.publish();
+            Command::Join {
+                player_id,
+                name,
+                link,
+                reply,
+            } => {
+                let answer = self.join(player_id, name, link);
+                let joined = answer.is_ok();
                 // The joiner may have gone while the command was queued.
-                if reply.send(welcome).is_err() {
-                    self.players.remove(&player_id);
+                if reply.send(answer).is_err() && joined {
                     debug!(%player_id, "joiner gone before the welcome");
+                    self.remove(player_id);
                 }
             }
-            Command::Leave { player_id } => {
-                if let Some(player) = self.players.remove(&player_id) {
-                    info!(%player_id, name = %player.name, "player left");
+            Command::Leave { player_id } => self.remove(player_id),
+            Command::Chat { from, text } => {
+                let mut frame = Vec::new();
+                if write_frame(&ServerControl::Chat { from, text }, &mut frame).is_err() {
+                    return;
+                }
+                for m in self.members.values() {
+                    self.send_control(m, frame.clone());
                 }
             }
         }
         self.publish();
     }
 
-    fn publish(&self) {
-        self.status.send_replace(RoomStatus {
-            tick: self.world.tick(),
-            state_hash: self.world.state_hash(),
-            players: self.players.len(),
-        });
+    fn join(
+        &mut self,
+        player_id: PlayerId,
+        name: String,
+        link: ClientLink,
+    ) -> Result<Joined, RejectReason> {
+        if self.members.len() >= self.config.max_players {
+            return Err(RejectReason::RoomFull);
+        }
+        if let Err(e) = self.game.add_player(player_id) {
+            warn!(%player_id, "game refused the player: {e}");
+            return Err(RejectReason::Other {
+                reason: "the game refused the player".into(),
+            });
+        }
+        let tick = self.game.tick();
+        let inbox = Arc::new(Mutex::new(PlayerInbox::new(self.config.input_window, tick)));
+        info!(room = %self.config.name, %player_id, %name, tick, "player joined");
+        self.members.insert(
+            player_id,
+            Member {
+                name,
+                link,
+                inbox: inbox.clone(),
+                buttons: Buttons::NONE,
+                last_applied: None,
+                stream_pending: None,
+            },
+        );
+        self.players.store(self.members.len(), Ordering::Relaxed);
+        self.players_gauge.set(self.members.len() as i64);
+        Ok(Joined {
+            welcome: Welcome {
+                player_id,
+                room: self.config.name.clone(),
+                level_id: self.config.level_id.clone(),
+                level_hash: self.config.level_hash,
+                server_tick: tick,
+                timing: NetTiming {
+                    tick_rate: self.config.tick_rate,
+                    snapshot_interval: self.config.snapshot_interval,
+                    input_redundancy: self.config.input_redundancy,
+                },
+                sim_config: Vec::new(),
+            },
+            inbox,
+        })
     }
-}
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use std::time::Duration;
+    fn remove(&mut self, player_id: PlayerId) {
+        if let Some(member) = self.members.remove(&player_id) {
+            self.game.remove_player(player_id);
+            info!(room = %self.config.name, %player_id, name = %member.name, "player left");
+        }
+        self.players.store(self.members.len(), Ordering::Relaxed);
+        self.players_gauge.set(self.members.len() as i64);
+    }
 
-    fn config() -> RoomConfig {
-        RoomConfig {
-            tick_rate: 100,
-            max_catch_up: 5,
+    fn tick(&mut self) {
+        let started = Instant::now();
+        let tick = self.game.tick();
+        self.inputs.clear();
+        for (&id, m) in &mut self.members {
+            let mut inbox = lock(&m.inbox);
+            match inbox.inputs.take(tick) {
+                Some(buttons) => {
+                    m.buttons = buttons;
+                    m.last_applied = Some(tick);
+                }
+                None if inbox.received_any => {
+                    self.starvation.inc();
+                }
+                None => {}
+            }
+            drop(inbox);
+            self.inputs.push((id, m.buttons));
+        }
+        self.game.step(&self.inputs);
+        let interval = u64::from(self.config.snapshot_interval.max(1));
+        if self.game.tick() % interval == 0 && !self.members.is_empty() {
+            self.send_snapshots();
+        }
+        self.tick_duration.observe(started.elapsed().as_secs_f64());
+    }
+
+    fn send_snapshots(&mut self) {
+        let tick = self.game.tick();
+        let state = self.game.snapshot();
+        if let Err(e) = self.snapshots.capture(tick, state.entities) {
+            error!(room = %self.config.name, tick, "cannot capture a snapshot: {e}");
+            return;
+        }
+        let now = Instant::now();
+        for m in self.members.values_mut() {
+            let (ack, timing) = {
+                let mut inbox = lock(&m.inbox);
+                (inbox.ack, inbox.take_timing())
+            };
+            if let Some((pending, _)) = m.stream_pending {
+                if ack.is_some_and(|a| a >= pending) {
+                    m.stream_pending = None;
+                }
+            }
+            let snapshot = match self.snapshots.encode_for(ack, m.last_applied, timing) {
+                Ok(s) => s,
+                Err(e) => {
+                    error!(tick, "cannot encode a snapshot: {e}");
+                    return;
+                }
+            };
+            let kind = if snapshot.baseline_tick.is_some() {
+                SnapshotKind::Delta
+            } else {
+                SnapshotKind::Full
+            };
+            let max = m
+                .link
+                .connection
+                .max_datagram_size()
+                .map(|max| max.min(DATAGRAM_SEND_BUFFER / 2));
+            let outgoing = match snapshot.into_outgoing(max) {
+                Ok(o) => o,
+                Err(e) => {
+                    error!(tick, "cannot encode a snapshot: {e}");
+                    continue;
+                }
+            };
+            match outgoing {
+                Outgoing::Datagram(bytes) => {
+                    let len = bytes.len();
+                    match m.link.connection.send_datagram(bytes.into()) {
+                        Ok(()) => {
+                            record_snapshot(&self.metrics, &m.link.bytes, kind, len);
+                        }
+                        Err(quinn::SendDatagramError::ConnectionLost(_)) => {}
+                        Err(e) => {
+                            debug!(tick, "snapshot datagram not sent: {e}");
+                            self.metrics.count_drop(DropReason::SnapshotSendFailed);
+                        }
+                    }
+                }
+                Outgoing::Control(frame) => {
+                    if m.stream_pending
+                        .is_some_and(|(_, at)| now.duration_since(at) < STREAM_SNAPSHOT_RESEND)
+                    {
+                        self.metrics.count_drop(DropReason::SnapshotDeferred);
+                        continue;
+                    }
+                    let len = frame.len();
+                    match m.link.control.try_send(Outbound::Frame(frame)) {
+                        Ok(()) => {
+                            m.stream_pending = Some((tick, now));
+                            // Bytes are counted by the writer when written.
+                            self.metrics
+                                .snapshot_bytes
+                                .get_or_create(&SnapshotLabel {
+                                    kind,
+                                    channel: Channel::Stream,
+                                })
+                                .observe(len as f64);
+                        }
+                        Err(mpsc::error::TrySendError::Full(_)) => {
+                            self.metrics.count_drop(DropReason::ControlQueueFull);
+                        }
+                        Err(mpsc::error::TrySendError::Closed(_)) => {}
+                    }
+                }
+            }
         }
     }
 
-    #[tokio::test]
-    async fn ticks_advance_and_players_join_and_leave() {
-        let (room, task) = spawn(ledge_shared::scene::warmup_room(), config());
-        tokio::time::sleep(Duration::from_millis(100)).await;
-        let first = room.join("ada".into()).await.unwrap();
-        assert!(first.tick >= 1, "no tick ran in 100 ms at 100 Hz");
-        assert_eq!(first.tick_rate, 100);
-        let second = room.join("bob".into()).await.unwrap();
-        assert_ne!(first.player_id, second.player_id);
-        assert!(second.tick >= first.tick);
-        assert_eq!(room.status().players, 2);
-        room.leave(first.player_id);
-        // A round trip through the room orders us after the leave.
-        let third = room.join("cy".into()).await.unwrap();
-        assert_eq!(room.status().players, 2);
-        assert_ne!(third.player_id, first.player_id);
-        drop(room);
-        tokio::time::timeout(Duration::from_secs(1), task)
-            .await
-            .expect("room did not stop when its last handle dropped")
-            .unwrap();
+    /// Queues a frame for a member's control stream; drops it (counted)
+    /// when that client's queue is full.
+    fn send_control(&self, m: &Member, frame: Vec<u8>) {
+        if let Err(mpsc::error::TrySendError::Full(_)) =
+            m.link.control.try_send(Outbound::Frame(frame))
+        {
+            self.metrics.count_drop(DropReason::ControlQueueFull);
+        }
+    }
+
+    fn publish(&self) {
+        self.status.send_replace(RoomStatus {
+            tick: self.game.tick(),
+            state_hash: self.game.state_hash(),
+            players: self.members.len(),
+        });
     }
 }

@@ -1,33 +1,51 @@
-//! The server: endpoint, room and connection tasks, and their shutdown.
+//! The server: endpoint, rooms, connection tasks, metrics, and their
+//! graceful shutdown.
 
 use std::net::SocketAddr;
+use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
+use ledge_shared::game::{Game, GameError};
+use ledge_shared::level::Level;
+use ledge_shared::protocol::{CloseCode, DEFAULT_INPUT_REDUNDANCY};
+use prometheus_client::registry::Registry;
 use tokio::sync::watch;
 use tokio::task::JoinSet;
 use tracing::{error, info, warn};
 
 use crate::cert::{CertError, Identity};
-use crate::config::ServerConfig;
-use crate::connection;
+use crate::config::{ConfigError, ServerConfig};
+use crate::connection::{self, Shared, SHUTDOWN_LINGER};
 use crate::fingerprint::Fingerprint;
-use crate::protocol::CloseCode;
+use crate::levels::{self, LevelLoadError};
+use crate::metrics::{self, Metrics};
 use crate::room::{self, RoomConfig};
+use crate::snapshots::DEFAULT_HISTORY;
 use crate::tls::{self, TlsError};
 
-/// How long shutdown waits for connection tasks and the endpoint to finish.
+/// How long shutdown waits for connection tasks, then for the endpoint.
 const SHUTDOWN_GRACE: Duration = Duration::from_secs(3);
 
 /// Why the server could not start.
 #[derive(Debug, thiserror::Error)]
 pub enum ServerError {
+    /// The configuration is invalid.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// The level could not be loaded.
+    #[error(transparent)]
+    Level(#[from] LevelLoadError),
+    /// The level cannot be played.
+    #[error("cannot start the game: {0}")]
+    Game(#[from] GameError),
     /// The certificate could not be loaded or created.
     #[error(transparent)]
     Cert(#[from] CertError),
     /// The TLS/QUIC configuration was refused.
     #[error(transparent)]
     Tls(#[from] TlsError),
-    /// The UDP socket could not be bound.
+    /// A socket could not be bound.
     #[error("cannot bind {addr}: {source}")]
     Bind {
         /// The address asked for.
@@ -37,16 +55,27 @@ pub enum ServerError {
     },
 }
 
+/// Resolves once the shutdown flag is true (at once if it already is, or if
+/// the sender is gone).
+pub(crate) async fn stopped(flag: &mut watch::Receiver<bool>) {
+    let _ = flag.wait_for(|&stop| stop).await;
+}
+
 /// A bound, not yet running server.
 ///
 /// `bind` then `run`; keep a [`ShutdownHandle`] to stop it. Tests bind to
-/// `127.0.0.1:0` and read the real port from [`Server::local_addr`].
+/// `127.0.0.1:0` and read the real ports from [`Server::local_addr`] and
+/// [`Server::metrics_addr`].
 #[derive(Debug)]
 pub struct Server {
     endpoint: quinn::Endpoint,
     local_addr: SocketAddr,
     fingerprint: Fingerprint,
     config: ServerConfig,
+    level: Level,
+    metrics: Arc<Metrics>,
+    registry: Arc<Registry>,
+    metrics_listener: Option<(tokio::net::TcpListener, SocketAddr)>,
     shutdown: watch::Sender<bool>,
 }
 
@@ -55,41 +84,65 @@ pub struct Server {
 pub struct ShutdownHandle(watch::Sender<bool>);
 
 impl ShutdownHandle {
-    /// Requests shutdown: [`Server::run`] closes every connection and returns.
+    /// Requests shutdown: every client gets `Notice{Shutdown}`, connections
+    /// close with [`CloseCode::ServerShutdown`] and [`Server::run`] returns.
     pub fn shutdown(&self) {
         self.0.send_replace(true);
     }
 }
 
 impl Server {
-    /// Loads or creates the certificate and binds the QUIC endpoint.
+    /// Checks the configuration, loads the level, loads or creates the
+    /// certificate and binds the QUIC endpoint (and the metrics listener).
     ///
-    /// Must be called inside a tokio runtime (the endpoint registers its
-    /// socket with it).
+    /// Must be called inside a tokio runtime (the sockets register with it).
     pub fn bind(config: ServerConfig) -> Result<Server, ServerError> {
+        config.validate()?;
+        let level = levels::load(config.level.as_deref())?;
+        Game::from_level(&level)?;
         let identity = Identity::load_or_generate(&config.cert_dir)?;
         if identity.generated {
             info!(dir = %config.cert_dir.display(), "generated a new self-signed certificate");
         }
-        let quic = tls::server_config(&identity)?;
-        let bind_err = |source| ServerError::Bind {
-            addr: config.bind,
-            source,
+        let quic = tls::server_config(&identity, config.idle_timeout)?;
+        let bind_err = |addr| move |source| ServerError::Bind { addr, source };
+        let endpoint = quinn::Endpoint::server(quic, config.bind).map_err(bind_err(config.bind))?;
+        let local_addr = endpoint.local_addr().map_err(bind_err(config.bind))?;
+        let metrics_listener = match config.metrics_bind {
+            Some(addr) => {
+                let listener = metrics::bind(addr).map_err(bind_err(addr))?;
+                let bound = listener.local_addr().map_err(bind_err(addr))?;
+                Some((listener, bound))
+            }
+            None => None,
         };
-        let endpoint = quinn::Endpoint::server(quic, config.bind).map_err(bind_err)?;
-        let local_addr = endpoint.local_addr().map_err(bind_err)?;
+        let (metrics, registry) = Metrics::new();
         Ok(Server {
             endpoint,
             local_addr,
             fingerprint: identity.fingerprint,
             config,
+            level,
+            metrics,
+            registry: Arc::new(registry),
+            metrics_listener,
             shutdown: watch::Sender::new(false),
         })
     }
 
-    /// The address actually bound (the real port when binding port 0).
+    /// The UDP address actually bound (the real port when binding port 0).
     pub fn local_addr(&self) -> SocketAddr {
         self.local_addr
+    }
+
+    /// The metrics endpoint's address, if one is configured.
+    pub fn metrics_addr(&self) -> Option<SocketAddr> {
+        self.metrics_listener.as_ref().map(|(_, addr)| *addr)
+    }
+
+    /// The metrics registry (render it with [`metrics::encode`]).
+    pub fn registry(&self) -> Arc<Registry> {
+        self.registry.clone()
     }
 
     /// SHA-256 of the certificate: what clients pin.
@@ -97,39 +150,96 @@ impl Server {
         self.fingerprint
     }
 
+    /// The configuration in use.
+    pub fn config(&self) -> &ServerConfig {
+        &self.config
+    }
+
+    /// The level played.
+    pub fn level(&self) -> &Level {
+        &self.level
+    }
+
     /// A handle that stops [`Server::run`].
     pub fn shutdown_handle(&self) -> ShutdownHandle {
         ShutdownHandle(self.shutdown.clone())
     }
 
-    /// Runs the room and serves connections until shutdown is requested,
-    /// then closes every connection and waits (bounded) for the endpoint to
-    /// go idle.
+    /// Runs the rooms and serves connections until shutdown is requested,
+    /// then says goodbye to every client, closes the endpoint and waits
+    /// (bounded) for it to go idle.
     pub async fn run(self) -> Result<(), ServerError> {
         let Server {
             endpoint,
             local_addr,
             config,
+            level,
+            metrics,
+            registry,
+            metrics_listener,
             shutdown,
             ..
         } = self;
         let mut stop = shutdown.subscribe();
-        let (room, room_task) = room::spawn(
-            ledge_shared::scene::warmup_room(),
-            RoomConfig {
+
+        let level_id = levels::level_id(&level);
+        let level_hash = levels::level_hash(&level);
+        let mut rooms = Vec::new();
+        let mut room_tasks = Vec::new();
+        for i in 1..=config.rooms {
+            let game = Game::from_level(&level)?;
+            let room_config = RoomConfig {
+                name: format!("room-{i}"),
                 tick_rate: config.tick_rate,
+                snapshot_interval: config.snapshot_interval(),
+                max_players: config.max_players,
                 max_catch_up: config.max_catch_up,
-            },
+                input_window: config.tick_rate.max(32) as usize,
+                input_redundancy: DEFAULT_INPUT_REDUNDANCY,
+                history: DEFAULT_HISTORY,
+                level_id: level_id.clone(),
+                level_hash,
+            };
+            let (handle, task) = room::spawn(game, room_config, metrics.clone());
+            rooms.push(handle);
+            room_tasks.push(task);
+        }
+        let metrics_task = metrics_listener.map(|(listener, addr)| {
+            info!(%addr, "serving metrics at /metrics");
+            tokio::spawn(metrics::serve(listener, registry, stop.clone()))
+        });
+        let shared = Arc::new(Shared {
+            rooms,
+            metrics: metrics.clone(),
+            limits: config.limits,
+            next_player: AtomicU32::new(1),
+            open: AtomicUsize::new(0),
+            shutdown: stop.clone(),
+        });
+
+        info!(
+            %local_addr,
+            level = %level_id,
+            rooms = config.rooms,
+            tick_rate = config.tick_rate,
+            snapshot_interval = config.snapshot_interval(),
+            "listening"
         );
-        info!(%local_addr, "listening");
         let mut connections = JoinSet::new();
         loop {
             tokio::select! {
                 // `shutdown` lives until the end of `run`, so this never errs.
-                _ = stop.wait_for(|&stop| stop) => break,
+                () = stopped(&mut stop) => break,
                 incoming = endpoint.accept() => match incoming {
                     Some(incoming) => {
-                        connections.spawn(connection::serve(incoming, room.clone()));
+                        if shared.open.load(Ordering::Relaxed) >= config.max_connections {
+                            metrics.connections_refused.inc();
+                            warn!(remote = %incoming.remote_address(), "connection cap reached; refusing");
+                            incoming.refuse();
+                            continue;
+                        }
+                        shared.open.fetch_add(1, Ordering::Relaxed);
+                        connections.spawn(connection::serve(incoming, shared.clone()));
                     }
                     None => break,
                 },
@@ -141,26 +251,45 @@ impl Server {
             }
         }
 
-        info!("shutting down");
-        endpoint.close(CloseCode::ServerShutdown.into(), b"server shutting down");
-        let drained = tokio::time::timeout(SHUTDOWN_GRACE, async {
-            while connections.join_next().await.is_some() {}
+        info!(
+            clients = connections.len(),
+            "shutting down: notifying clients"
+        );
+        // Connection tasks see the same signal: each sends Notice{Shutdown}
+        // and closes with ServerShutdown.
+        let drained = tokio::time::timeout(SHUTDOWN_GRACE + SHUTDOWN_LINGER, async {
+            loop {
+                tokio::select! {
+                    done = connections.join_next() => if done.is_none() { break },
+                    // Newcomers are refused at once rather than left waiting.
+                    Some(incoming) = endpoint.accept() => incoming.refuse(),
+                }
+            }
         })
         .await;
         if drained.is_err() {
-            warn!("connection tasks still running after {SHUTDOWN_GRACE:?}; aborting them");
+            warn!("connection tasks still running after the grace period; aborting them");
             connections.shutdown().await;
         }
+        endpoint.close(
+            CloseCode::ServerShutdown.to_u32().into(),
+            b"server shutting down",
+        );
         if tokio::time::timeout(SHUTDOWN_GRACE, endpoint.wait_idle())
             .await
             .is_err()
         {
             warn!("endpoint not idle after {SHUTDOWN_GRACE:?}");
         }
-        // The room stops once its last handle is gone.
-        drop(room);
-        if let Err(e) = room_task.await {
-            error!("room task failed: {e}");
+        // Rooms stop once their last handle is gone.
+        drop(shared);
+        for task in room_tasks {
+            if let Err(e) = task.await {
+                error!("room task failed: {e}");
+            }
+        }
+        if let Some(task) = metrics_task {
+            let _ = task.await;
         }
         drop(shutdown);
         info!("stopped");

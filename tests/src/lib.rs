@@ -2,16 +2,29 @@
 //!
 //! [`TestServer::start`] runs the real server in-process on `127.0.0.1:0`
 //! with a throw-away certificate directory; tests connect to it with the
-//! headless client library exactly as players and bots do.
+//! headless client library exactly as players and bots do. [`UdpRelay`]
+//! sits between a client and the server and can drop everything, to make a
+//! client go silent without closing; [`scrape`] reads the metrics endpoint.
 
+use std::collections::BTreeSet;
 use std::net::SocketAddr;
-use std::time::Duration;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
+use ledge_client::{connect, Session, SessionEvent, SnapshotUpdate};
+use ledge_server::metrics::Registry;
 use ledge_server::{Fingerprint, Server, ServerConfig, ServerError, ShutdownHandle};
+use ledge_shared::protocol::StateSnapshot;
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio::net::UdpSocket;
 use tokio::task::JoinHandle;
 
 /// How long [`TestServer::stop`] may take before it counts as hung.
 pub const STOP_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// How long helpers wait for something that should happen promptly.
+pub const WAIT: Duration = Duration::from_secs(3);
 
 /// A server running in-process on loopback, stopped on [`TestServer::stop`]
 /// (or aborted when dropped).
@@ -21,13 +34,17 @@ pub struct TestServer {
     pub addr: SocketAddr,
     /// SHA-256 of its freshly generated certificate.
     pub fingerprint: Fingerprint,
+    /// The metrics endpoint, when configured.
+    pub metrics_addr: Option<SocketAddr>,
+    registry: Arc<Registry>,
     shutdown: ShutdownHandle,
     task: Option<JoinHandle<Result<(), ServerError>>>,
     _cert_dir: tempfile::TempDir,
 }
 
 impl TestServer {
-    /// Starts a server at the default tick rate. Call inside a tokio runtime.
+    /// Starts a server with the default settings. Call inside a tokio
+    /// runtime.
     pub async fn start() -> TestServer {
         Self::start_with(|_| {}).await
     }
@@ -46,10 +63,24 @@ impl TestServer {
         TestServer {
             addr: server.local_addr(),
             fingerprint: server.fingerprint(),
+            metrics_addr: server.metrics_addr(),
+            registry: server.registry(),
             shutdown: server.shutdown_handle(),
             task: Some(tokio::spawn(server.run())),
             _cert_dir: cert_dir,
         }
+    }
+
+    /// Joins as `name` (any room).
+    pub async fn join(&self, name: &str) -> Session {
+        connect(self.addr, "localhost", self.fingerprint, name)
+            .await
+            .unwrap_or_else(|e| panic!("{name} is welcomed: {e}"))
+    }
+
+    /// The metrics in the Prometheus text format, read in-process.
+    pub fn metrics(&self) -> String {
+        ledge_server::metrics::encode(&self.registry)
     }
 
     /// Shuts the server down gracefully and returns what `run` returned.
@@ -63,6 +94,11 @@ impl TestServer {
             .expect("server shut down in time")
             .expect("server task did not panic")
     }
+
+    /// Asks the server to shut down without waiting.
+    pub fn begin_shutdown(&self) {
+        self.shutdown.shutdown();
+    }
 }
 
 impl Drop for TestServer {
@@ -71,5 +107,146 @@ impl Drop for TestServer {
             self.shutdown.shutdown();
             task.abort();
         }
+    }
+}
+
+/// The value of the metric sample `series` (name and labels exactly as
+/// printed, e.g. `ledge_malformed_messages_total{channel="Datagram"}`) in a
+/// text exposition; 0 when absent.
+pub fn metric(text: &str, series: &str) -> f64 {
+    text.lines()
+        .filter_map(|line| line.strip_prefix(series))
+        .filter_map(|rest| rest.strip_prefix(' '))
+        .filter_map(|value| value.trim().parse().ok())
+        .next()
+        .unwrap_or(0.0)
+}
+
+/// `GET /metrics` over plain HTTP/1.1; returns the status line and body.
+pub async fn scrape(addr: SocketAddr) -> (String, String) {
+    let mut stream = tokio::net::TcpStream::connect(addr)
+        .await
+        .expect("metrics endpoint accepts");
+    stream
+        .write_all(b"GET /metrics HTTP/1.1\r\nHost: localhost\r\n\r\n")
+        .await
+        .unwrap();
+    let mut response = String::new();
+    tokio::time::timeout(WAIT, stream.read_to_string(&mut response))
+        .await
+        .expect("metrics answer in time")
+        .unwrap();
+    let (head, body) = response.split_once("\r\n\r\n").expect("an HTTP response");
+    let status = head.lines().next().unwrap_or_default().to_owned();
+    (status, body.to_owned())
+}
+
+/// Receives events until a snapshot arrives (others are returned too).
+pub async fn next_snapshot(
+    session: &mut Session,
+    within: Duration,
+) -> (SnapshotUpdate, Vec<SessionEvent>) {
+    let mut others = Vec::new();
+    let found = tokio::time::timeout(within, async {
+        loop {
+            match session.recv().await.expect("session stays up") {
+                SessionEvent::Snapshot(update) => return update,
+                other => others.push(other),
+            }
+        }
+    })
+    .await
+    .expect("a snapshot in time");
+    (found, others)
+}
+
+/// Receives snapshots until one satisfies `done`; returns it.
+pub async fn snapshot_where(
+    session: &mut Session,
+    within: Duration,
+    mut done: impl FnMut(&StateSnapshot) -> bool,
+) -> StateSnapshot {
+    let deadline = Instant::now() + within;
+    loop {
+        let left = deadline.saturating_duration_since(Instant::now());
+        let (update, _) = next_snapshot(session, left).await;
+        if done(&update.state) {
+            return update.state;
+        }
+    }
+}
+
+/// Every event that arrives within `window`.
+pub async fn drain(session: &mut Session, window: Duration) -> Vec<SessionEvent> {
+    let mut events = Vec::new();
+    let deadline = tokio::time::Instant::now() + window;
+    while let Ok(event) = tokio::time::timeout_at(deadline, session.recv()).await {
+        events.push(event.expect("session stays up"));
+    }
+    events
+}
+
+/// The entity ids of a snapshot.
+pub fn ids(state: &StateSnapshot) -> BTreeSet<u32> {
+    state.entities.iter().map(|e| e.id).collect()
+}
+
+/// A UDP relay on loopback between one client and a server. While
+/// [`UdpRelay::blackhole`] is on, it drops every datagram both ways, as a
+/// dead network or a frozen client would.
+#[derive(Debug)]
+pub struct UdpRelay {
+    /// Where clients connect instead of the server.
+    pub addr: SocketAddr,
+    drop_all: Arc<AtomicBool>,
+    task: JoinHandle<()>,
+}
+
+impl UdpRelay {
+    /// Starts relaying to `server`.
+    pub async fn start(server: SocketAddr) -> UdpRelay {
+        let front = UdpSocket::bind("127.0.0.1:0").await.unwrap();
+        let back = UdpSocket::bind("127.0.0.1:0").await.unwrap();
+        back.connect(server).await.unwrap();
+        let addr = front.local_addr().unwrap();
+        let drop_all = Arc::new(AtomicBool::new(false));
+        let dropping = drop_all.clone();
+        let task = tokio::spawn(async move {
+            let mut client: Option<SocketAddr> = None;
+            let (mut up, mut down) = (vec![0u8; 65536], vec![0u8; 65536]);
+            loop {
+                tokio::select! {
+                    r = front.recv_from(&mut up) => {
+                        let Ok((n, from)) = r else { return };
+                        client = Some(from);
+                        if !dropping.load(Ordering::Relaxed) {
+                            let _ = back.send(&up[..n]).await;
+                        }
+                    }
+                    r = back.recv(&mut down) => {
+                        let Ok(n) = r else { return };
+                        if let (Some(to), false) = (client, dropping.load(Ordering::Relaxed)) {
+                            let _ = front.send_to(&down[..n], to).await;
+                        }
+                    }
+                }
+            }
+        });
+        UdpRelay {
+            addr,
+            drop_all,
+            task,
+        }
+    }
+
+    /// Drops all traffic from now on.
+    pub fn blackhole(&self) {
+        self.drop_all.store(true, Ordering::Relaxed);
+    }
+}
+
+impl Drop for UdpRelay {
+    fn drop(&mut self) {
+        self.task.abort();
     }
 }

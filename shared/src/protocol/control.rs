@@ -104,6 +104,33 @@ pub enum ClientControl {
     },
     /// The client is leaving; the server closes the connection normally.
     Leave,
+    /// Like [`ClientControl::Hello`] (and instead of it, as the first
+    /// message), asking to join the named room rather than the least full
+    /// one. Added in protocol version 3.
+    HelloRoom {
+        /// The client's [`PROTOCOL_VERSION`], checked by the server.
+        version: u32,
+        /// Display name, checked by [`check_name`].
+        name: String,
+        /// The room to join: 1..=[`MAX_ID_LEN`] bytes, no control characters.
+        room: String,
+    },
+}
+
+impl ClientControl {
+    /// The protocol version and name of a `Hello` or `HelloRoom`, and the
+    /// room asked for (`None`: any).
+    pub fn as_hello(&self) -> Option<(u32, &str, Option<&str>)> {
+        match self {
+            ClientControl::Hello { version, name } => Some((*version, name, None)),
+            ClientControl::HelloRoom {
+                version,
+                name,
+                room,
+            } => Some((*version, name, Some(room))),
+            _ => None,
+        }
+    }
 }
 
 impl Message for ClientControl {
@@ -113,6 +140,10 @@ impl Message for ClientControl {
     fn validate(&self) -> Result<(), ProtocolError> {
         match self {
             ClientControl::Hello { name, .. } => check_name(name),
+            ClientControl::HelloRoom { name, room, .. } => {
+                check_name(name)?;
+                check_text("room name", room, 1, MAX_ID_LEN)
+            }
             ClientControl::Chat { text } => check_text("chat text", text, 1, MAX_CHAT_LEN),
             ClientControl::Ping { .. } | ClientControl::Leave => Ok(()),
         }
@@ -331,5 +362,47 @@ impl CloseCode {
             5 => CloseCode::Kicked,
             _ => return None,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hello_room_round_trips_and_is_checked() {
+        let m = ClientControl::HelloRoom {
+            version: PROTOCOL_VERSION,
+            name: "ana".into(),
+            room: "room-2".into(),
+        };
+        let back = ClientControl::decode(&m.encode().unwrap()).unwrap();
+        assert_eq!(back, m);
+        assert_eq!(
+            back.as_hello(),
+            Some((PROTOCOL_VERSION, "ana", Some("room-2")))
+        );
+        // Appended after the existing variants: their encodings are unchanged.
+        assert_eq!(m.encode().unwrap()[0], 4);
+        let hello = ClientControl::Hello {
+            version: 7,
+            name: "bo".into(),
+        };
+        assert_eq!(hello.as_hello(), Some((7, "bo", None)));
+        assert_eq!(ClientControl::Leave.as_hello(), None);
+        for room in ["", "a\nb"] {
+            let bad = ClientControl::HelloRoom {
+                version: PROTOCOL_VERSION,
+                name: "ana".into(),
+                room: room.into(),
+            };
+            assert!(bad.encode().is_err(), "{room:?}");
+        }
+        let long = ClientControl::HelloRoom {
+            version: PROTOCOL_VERSION,
+            name: "ana".into(),
+            room: "r".repeat(MAX_ID_LEN + 1),
+        };
+        assert!(long.encode().is_err());
     }
 }

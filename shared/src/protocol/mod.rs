@@ -22,6 +22,7 @@ mod codec;
 mod control;
 mod datagram;
 mod error;
+mod fingerprint;
 mod frame;
 pub mod snapshot;
 mod varint;
@@ -34,14 +35,19 @@ pub use control::{
 };
 pub use datagram::{fits, input_timing, InputPacket, Outgoing, Snapshot};
 pub use error::ProtocolError;
+pub use fingerprint::{Fingerprint, ParseFingerprintError};
 pub use frame::{write_frame, FrameDecoder, FRAME_HEADER};
 pub use snapshot::{
-    decode_delta, encode_delta, is_replicated, EntityState, SnapshotHistory, StateSnapshot,
+    decode_delta, encode_delta, extrapolate, is_replicated, EntityState, SnapshotHistory,
+    StateSnapshot,
 };
 
 /// Version of this protocol, sent in [`ClientControl::Hello`]; the server
 /// rejects any other. Bump it on every change of any encoding.
-pub const PROTOCOL_VERSION: u32 = 2;
+///
+/// 3: `ClientControl::HelloRoom`; deltas against baseline entities
+/// extrapolated by their velocity ([`snapshot::extrapolate`]).
+pub const PROTOCOL_VERSION: u32 = 3;
 
 /// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
 /// an unrelated QUIC peer. It names the application, not the version:

@@ -1,0 +1,80 @@
+//! The level a server plays: a file, or the embedded default level; its id
+//! and content hash for the [`ledge_shared::protocol::Welcome`].
+
+use std::path::Path;
+
+use ledge_shared::level::{self, Level};
+use ledge_shared::protocol::{check_text, MAX_ID_LEN};
+
+/// Why the level could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum LevelLoadError {
+    /// The file could not be read or is not a valid level.
+    #[error("cannot load level {path}: {message}")]
+    Load {
+        /// The file.
+        path: String,
+        /// What the loader said.
+        message: String,
+    },
+}
+
+/// Loads `path` (OGMO `.json` or Tiled `.tmx`, see
+/// [`ledge_shared::level::load_file`]), or the embedded default level.
+pub fn load(path: Option<&Path>) -> Result<Level, LevelLoadError> {
+    match path {
+        Some(path) => level::load_file(path).map_err(|e| LevelLoadError::Load {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        }),
+        None => Ok(default_level()),
+    }
+}
+
+/// The embedded default level.
+pub fn default_level() -> Level {
+    level::default_level()
+}
+
+/// The level's id as sent in `Welcome`: its name, or `"level"` when the name
+/// is not a valid protocol id (empty, too long, control characters).
+pub fn level_id(level: &Level) -> String {
+    if check_text("level id", &level.name, 1, MAX_ID_LEN).is_ok() {
+        level.name.clone()
+    } else {
+        "level".to_owned()
+    }
+}
+
+/// A stable 64-bit hash of the level's content (FNV-1a over its bincode
+/// encoding), so a client can check it plays the same level.
+pub fn level_hash(level: &Level) -> u64 {
+    let bytes = bincode::serde::encode_to_vec(level, bincode::config::standard())
+        .expect("a level always encodes");
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_level_loads_and_has_a_stable_identity() {
+        let a = load(None).unwrap();
+        let b = load(None).unwrap();
+        assert_eq!(level_hash(&a), level_hash(&b));
+        assert!(check_text("level id", &level_id(&a), 1, MAX_ID_LEN).is_ok());
+        let mut renamed = a.clone();
+        renamed.name = "x\n".repeat(40);
+        assert_eq!(level_id(&renamed), "level");
+        assert_ne!(level_hash(&renamed), level_hash(&a));
+    }
+
+    #[test]
+    fn a_missing_file_is_an_error() {
+        let err = load(Some(Path::new("/nonexistent/level.json"))).unwrap_err();
+        assert!(err.to_string().contains("/nonexistent/level.json"), "{err}");
+    }
+}

@@ -1,0 +1,418 @@
+//! Prometheus metrics (`prometheus-client`) and a minimal HTTP endpoint
+//! serving them as text at `/metrics`.
+//!
+//! Label sets are bounded: rooms are fixed at start, reasons are enums, and
+//! the per-client byte counters are labelled by player id and removed when
+//! the player leaves, so at most `max_connections` client series exist.
+
+use std::net::SocketAddr;
+use std::sync::Arc;
+use std::time::Duration;
+
+use prometheus_client::encoding::{EncodeLabelSet, EncodeLabelValue};
+use prometheus_client::metrics::counter::Counter;
+use prometheus_client::metrics::family::Family;
+use prometheus_client::metrics::gauge::Gauge;
+use prometheus_client::metrics::histogram::{exponential_buckets, Histogram};
+pub use prometheus_client::registry::Registry;
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio::net::TcpListener;
+use tokio::sync::watch;
+use tracing::{debug, warn};
+
+/// Label: a room.
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct RoomLabel {
+    /// The room's name.
+    pub room: String,
+}
+
+/// Label: a connected player.
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct ClientLabel {
+    /// The player id, as a number.
+    pub client: u32,
+}
+
+/// Which channel a message came in or went out on.
+#[derive(Debug, Clone, Copy, Hash, PartialEq, Eq, EncodeLabelValue)]
+pub enum Channel {
+    /// Unreliable datagrams (inputs, snapshots).
+    Datagram,
+    /// The reliable control stream.
+    Stream,
+}
+
+/// Label: a channel.
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct ChannelLabel {
+    /// The channel.
+    pub channel: Channel,
+}
+
+/// Why a message was dropped.
+#[derive(Debug, Clone, Copy, Hash, PartialEq, Eq, EncodeLabelValue)]
+pub enum DropReason {
+    /// An input datagram over the client's rate limit.
+    DatagramRateLimited,
+    /// A control message over the client's rate limit.
+    ControlRateLimited,
+    /// An input for a tick already simulated (arrived too late).
+    InputLate,
+    /// An input for a tick too far in the future.
+    InputTooEarly,
+    /// A message for a client whose control queue was full.
+    ControlQueueFull,
+    /// A snapshot not sent because a stream snapshot is still unacknowledged.
+    SnapshotDeferred,
+    /// A snapshot datagram quinn refused to send.
+    SnapshotSendFailed,
+}
+
+/// Label: a drop reason.
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct DropLabel {
+    /// The reason.
+    pub reason: DropReason,
+}
+
+/// Full or delta snapshot.
+#[derive(Debug, Clone, Copy, Hash, PartialEq, Eq, EncodeLabelValue)]
+pub enum SnapshotKind {
+    /// Encoded without a baseline.
+    Full,
+    /// Encoded against an acknowledged snapshot.
+    Delta,
+}
+
+/// Label: snapshot kind and the channel it went on.
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct SnapshotLabel {
+    /// Full or delta.
+    pub kind: SnapshotKind,
+    /// Datagram or control stream.
+    pub channel: Channel,
+}
+
+/// Why a client was disconnected by the server.
+#[derive(Debug, Clone, Copy, Hash, PartialEq, Eq, EncodeLabelValue)]
+pub enum KickReason {
+    /// Too many malformed messages, or a broken control stream.
+    Malformed,
+    /// Kept exceeding its rate limits.
+    Flooding,
+}
+
+/// Label: a kick reason.
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct KickLabel {
+    /// The reason.
+    pub reason: KickReason,
+}
+
+/// A client's byte counters (shared with the family: removing the label
+/// from the family does not invalidate these handles).
+#[derive(Debug, Clone, Default)]
+pub struct ClientBytes {
+    /// Bytes received from the client (datagrams and stream).
+    pub bytes_in: Counter,
+    /// Bytes sent to the client (datagrams and stream).
+    pub bytes_out: Counter,
+}
+
+/// Every metric of the server.
+#[derive(Debug)]
+pub struct Metrics {
+    /// Time to run one tick (inputs, step, snapshots), per room.
+    pub tick_duration: Family<RoomLabel, Histogram, fn() -> Histogram>,
+    /// Ticks skipped because the loop fell too far behind, per room.
+    pub missed_ticks: Family<RoomLabel, Counter>,
+    /// Players in each room.
+    pub players: Family<RoomLabel, Gauge>,
+    /// Open connections (including handshakes).
+    pub connections: Gauge,
+    /// Connections refused because of `max_connections`.
+    pub connections_refused: Counter,
+    /// Bytes received per client.
+    pub client_bytes_in: Family<ClientLabel, Counter>,
+    /// Bytes sent per client.
+    pub client_bytes_out: Family<ClientLabel, Counter>,
+    /// Bytes received, all clients, per channel.
+    pub bytes_in: Family<ChannelLabel, Counter>,
+    /// Bytes sent, all clients, per channel.
+    pub bytes_out: Family<ChannelLabel, Counter>,
+    /// Encoded snapshot sizes in bytes.
+    pub snapshot_bytes: Family<SnapshotLabel, Histogram, fn() -> Histogram>,
+    /// Ticks a player's input was missing and the previous one repeated.
+    pub input_starvation: Family<RoomLabel, Counter>,
+    /// Messages dropped, by reason.
+    pub dropped: Family<DropLabel, Counter>,
+    /// Messages that failed to decode, per channel.
+    pub malformed: Family<ChannelLabel, Counter>,
+    /// Clients disconnected by the server, by reason.
+    pub kicks: Family<KickLabel, Counter>,
+}
+
+fn tick_histogram() -> Histogram {
+    // 50 µs .. ~100 ms.
+    Histogram::new(exponential_buckets(0.000_05, 2.0, 12))
+}
+
+fn size_histogram() -> Histogram {
+    // 16 B .. 64 KiB.
+    Histogram::new(exponential_buckets(16.0, 2.0, 13))
+}
+
+impl Metrics {
+    /// New metrics, registered in a new registry.
+    pub fn new() -> (Arc<Metrics>, Registry) {
+        let m = Metrics {
+            tick_duration: Family::new_with_constructor(tick_histogram as fn() -> Histogram),
+            missed_ticks: Family::default(),
+            players: Family::default(),
+            connections: Gauge::default(),
+            connections_refused: Counter::default(),
+            client_bytes_in: Family::default(),
+            client_bytes_out: Family::default(),
+            bytes_in: Family::default(),
+            bytes_out: Family::default(),
+            snapshot_bytes: Family::new_with_constructor(size_histogram as fn() -> Histogram),
+            input_starvation: Family::default(),
+            dropped: Family::default(),
+            malformed: Family::default(),
+            kicks: Family::default(),
+        };
+        let mut r = Registry::with_prefix("ledge");
+        r.register(
+            "tick_duration_seconds",
+            "Time to run one tick (inputs, simulation step, snapshots)",
+            m.tick_duration.clone(),
+        );
+        r.register(
+            "missed_ticks",
+            "Ticks skipped because the tick loop fell too far behind",
+            m.missed_ticks.clone(),
+        );
+        r.register("players", "Players in the room", m.players.clone());
+        r.register(
+            "connections",
+            "Open QUIC connections",
+            m.connections.clone(),
+        );
+        r.register(
+            "connections_refused",
+            "Connections refused at the connection cap",
+            m.connections_refused.clone(),
+        );
+        r.register(
+            "client_bytes_in",
+            "Bytes received from a connected player",
+            m.client_bytes_in.clone(),
+        );
+        r.register(
+            "client_bytes_out",
+            "Bytes sent to a connected player",
+            m.client_bytes_out.clone(),
+        );
+        r.register(
+            "bytes_in",
+            "Bytes received from all clients",
+            m.bytes_in.clone(),
+        );
+        r.register(
+            "bytes_out",
+            "Bytes sent to all clients",
+            m.bytes_out.clone(),
+        );
+        r.register(
+            "snapshot_bytes",
+            "Encoded snapshot sizes",
+            m.snapshot_bytes.clone(),
+        );
+        r.register(
+            "input_starvation",
+            "Ticks a player's input had not arrived (the previous one was repeated)",
+            m.input_starvation.clone(),
+        );
+        r.register("dropped_messages", "Messages dropped", m.dropped.clone());
+        r.register(
+            "malformed_messages",
+            "Messages that failed to decode",
+            m.malformed.clone(),
+        );
+        r.register(
+            "kicks",
+            "Clients disconnected for misbehaving",
+            m.kicks.clone(),
+        );
+        (Arc::new(m), r)
+    }
+
+    /// Counts one dropped message.
+    pub fn count_drop(&self, reason: DropReason) {
+        self.dropped.get_or_create(&DropLabel { reason }).inc();
+    }
+
+    /// Counts `n` dropped messages.
+    pub fn count_drops(&self, reason: DropReason, n: u64) {
+        if n > 0 {
+            self.dropped.get_or_create(&DropLabel { reason }).inc_by(n);
+        }
+    }
+
+    /// Counts one malformed message.
+    pub fn malformed(&self, channel: Channel) {
+        self.malformed
+            .get_or_create(&ChannelLabel { channel })
+            .inc();
+    }
+
+    /// The byte counters of a client (created now, series removed by
+    /// [`Metrics::forget_client`]).
+    pub fn client(&self, client: u32) -> ClientBytes {
+        let label = ClientLabel { client };
+        ClientBytes {
+            bytes_in: self.client_bytes_in.get_or_create_owned(&label),
+            bytes_out: self.client_bytes_out.get_or_create_owned(&label),
+        }
+    }
+
+    /// Removes a departed client's series.
+    pub fn forget_client(&self, client: u32) {
+        let label = ClientLabel { client };
+        self.client_bytes_in.remove(&label);
+        self.client_bytes_out.remove(&label);
+    }
+
+    /// Counts bytes received on `channel` from a client.
+    pub fn received(&self, client: &ClientBytes, channel: Channel, bytes: usize) {
+        client.bytes_in.inc_by(bytes as u64);
+        self.bytes_in
+            .get_or_create(&ChannelLabel { channel })
+            .inc_by(bytes as u64);
+    }
+
+    /// Counts bytes sent on `channel` to a client.
+    pub fn sent(&self, client: &ClientBytes, channel: Channel, bytes: usize) {
+        client.bytes_out.inc_by(bytes as u64);
+        self.bytes_out
+            .get_or_create(&ChannelLabel { channel })
+            .inc_by(bytes as u64);
+    }
+}
+
+/// The registry in the text exposition format.
+pub fn encode(registry: &Registry) -> String {
+    let mut text = String::new();
+    prometheus_client::encoding::text::encode(&mut text, registry)
+        .expect("writing to a String cannot fail");
+    text
+}
+
+/// How long a metrics client has to send its request.
+const REQUEST_TIMEOUT: Duration = Duration::from_secs(2);
+/// Largest request head read.
+const MAX_REQUEST: usize = 4096;
+
+/// Serves `GET /metrics` on `listener` until `stop` turns true. One request
+/// per connection, handled one at a time (a scraper, not a web server).
+pub async fn serve(
+    listener: TcpListener,
+    registry: Arc<Registry>,
+    mut stop: watch::Receiver<bool>,
+) {
+    loop {
+        tokio::select! {
+            () = crate::server::stopped(&mut stop) => break,
+            accepted = listener.accept() => match accepted {
+                Ok((stream, peer)) => {
+                    let answer = tokio::time::timeout(REQUEST_TIMEOUT, respond(stream, &registry));
+                    if let Ok(Err(e)) | Err(e) = answer.await.map_err(std::io::Error::other) {
+                        debug!(%peer, "metrics request failed: {e}");
+                    }
+                }
+                Err(e) => {
+                    warn!("metrics listener: {e}");
+                    tokio::time::sleep(Duration::from_millis(100)).await;
+                }
+            }
+        }
+    }
+}
+
+async fn respond(mut stream: tokio::net::TcpStream, registry: &Registry) -> std::io::Result<()> {
+    let mut head = Vec::with_capacity(512);
+    let mut buf = [0u8; 1024];
+    while !head.windows(4).any(|w| w == b"\r\n\r\n") && !head.windows(2).any(|w| w == b"\n\n") {
+        let n = stream.read(&mut buf).await?;
+        if n == 0 {
+            break;
+        }
+        head.extend_from_slice(&buf[..n]);
+        if head.len() > MAX_REQUEST {
+            break;
+        }
+    }
+    let line = head.split(|&b| b == b'\n').next().unwrap_or_default();
+    let line = String::from_utf8_lossy(line);
+    let mut parts = line.split_whitespace();
+    let (method, path) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
+    let (status, content_type, body) = if method == "GET" && (path == "/metrics" || path == "/") {
+        (
+            "200 OK",
+            "application/openmetrics-text; version=1.0.0; charset=utf-8",
+            encode(registry),
+        )
+    } else {
+        (
+            "404 Not Found",
+            "text/plain; charset=utf-8",
+            "not found: try GET /metrics\n".to_owned(),
+        )
+    };
+    let response = format!(
+        "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
+        body.len()
+    );
+    stream.write_all(response.as_bytes()).await?;
+    stream.shutdown().await
+}
+
+/// Binds the metrics listener now (so a bad address fails the start-up and
+/// the real port is known).
+pub fn bind(addr: SocketAddr) -> std::io::Result<TcpListener> {
+    let listener = std::net::TcpListener::bind(addr)?;
+    listener.set_nonblocking(true)?;
+    TcpListener::from_std(listener)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn metrics_encode_with_their_labels() {
+        let (m, registry) = Metrics::new();
+        m.count_drop(DropReason::InputLate);
+        m.malformed(Channel::Datagram);
+        let client = m.client(7);
+        m.sent(&client, Channel::Datagram, 100);
+        m.players
+            .get_or_create(&RoomLabel {
+                room: "room-1".into(),
+            })
+            .set(3);
+        let text = encode(&registry);
+        for needle in [
+            "ledge_dropped_messages_total{reason=\"InputLate\"} 1",
+            "ledge_malformed_messages_total{channel=\"Datagram\"} 1",
+            "ledge_client_bytes_out_total{client=\"7\"} 100",
+            "ledge_bytes_out_total{channel=\"Datagram\"} 100",
+            "ledge_players{room=\"room-1\"} 3",
+        ] {
+            assert!(text.contains(needle), "{needle} missing from\n{text}");
+        }
+        m.forget_client(7);
+        assert!(!encode(&registry).contains("client=\"7\""));
+    }
+}
