@@ -224,9 +224,7 @@ pub fn dir_order(a: I64Vec2, b: I64Vec2) -> Ordering {
             1
         }
     }
-    half(a)
-        .cmp(&half(b))
-        .then_with(|| 0.cmp(&cross128(a, b)))
+    half(a).cmp(&half(b)).then_with(|| 0.cmp(&cross128(a, b)))
 }
 
 #[cfg(test)]

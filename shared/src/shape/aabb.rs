@@ -32,7 +32,10 @@ impl Aabb {
     pub fn from_size(size: IVec2) -> Result<Self, ShapeError> {
         for (what, v) in [("box width", size.x), ("box height", size.y)] {
             if v % 2 != 0 {
-                return Err(ShapeError::OddSize { what, value: v as i64 });
+                return Err(ShapeError::OddSize {
+                    what,
+                    value: v as i64,
+                });
             }
         }
         Self::new(size / 2)
@@ -134,7 +137,10 @@ mod tests {
         assert!(Aabb::from_size(IVec2::new(-4, 10)).is_err());
         assert_eq!(
             Aabb::from_size(IVec2::new(3, 10)),
-            Err(ShapeError::OddSize { what: "box width", value: 3 })
+            Err(ShapeError::OddSize {
+                what: "box width",
+                value: 3
+            })
         );
         assert!(Aabb::from_size(IVec2::new(4, 5)).is_err());
     }

@@ -56,8 +56,14 @@ impl Obb {
             return Err(ShapeError::BadAxes);
         }
         for (what, c) in [
-            ("oriented box extent x", (u.x as i64).abs() + (v.x as i64).abs()),
-            ("oriented box extent y", (u.y as i64).abs() + (v.y as i64).abs()),
+            (
+                "oriented box extent x",
+                (u.x as i64).abs() + (v.x as i64).abs(),
+            ),
+            (
+                "oriented box extent y",
+                (u.y as i64).abs() + (v.y as i64).abs(),
+            ),
         ] {
             check_extent(what, c)?;
         }
