@@ -22,7 +22,8 @@ use std::time::{Duration, Instant};
 use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
-    write_frame, InputPacket, NetTiming, Outgoing, PlayerId, RejectReason, ServerControl, Welcome,
+    encode_sim_config, write_frame, InputPacket, NetTiming, Outgoing, PlayerId, RejectReason,
+    ServerControl, Welcome,
 };
 use prometheus_client::metrics::counter::Counter;
 use prometheus_client::metrics::histogram::Histogram;
@@ -450,7 +451,15 @@ impl Room {
                     snapshot_interval: self.config.snapshot_interval,
                     input_redundancy: self.config.input_redundancy,
                 },
-                sim_config: Vec::new(),
+                // The game's constants, so the client predicts with exactly
+                // the server's rules (a GameConfig is a few dozen bytes).
+                sim_config: match encode_sim_config(self.game.config()) {
+                    Ok(bytes) => bytes,
+                    Err(e) => {
+                        warn!("cannot send the game config: {e}");
+                        Vec::new()
+                    }
+                },
             },
             inbox,
         })

@@ -1072,3 +1072,20 @@ fn documented_example_bytes() {
         [0xFB, 0x2C, 0x01, 0x02, 0x10, 0x00, 0x01, 0xFB, 0x29, 0x01]
     );
 }
+
+#[test]
+fn the_game_config_round_trips_through_the_welcome_blob() {
+    use ledge_shared::game::GameConfig;
+    use ledge_shared::protocol::{decode_sim_config, encode_sim_config, MAX_SIM_CONFIG_LEN};
+    let mut config = GameConfig::default();
+    config.player.gravity += 3;
+    let bytes = encode_sim_config(&config).unwrap();
+    assert!(bytes.len() <= MAX_SIM_CONFIG_LEN);
+    assert_eq!(decode_sim_config::<GameConfig>(&bytes).unwrap(), config);
+    // Trailing, truncated and oversized blobs are errors, not panics.
+    let mut long = bytes.clone();
+    long.push(0);
+    assert!(decode_sim_config::<GameConfig>(&long).is_err());
+    assert!(decode_sim_config::<GameConfig>(&bytes[..bytes.len() - 1]).is_err());
+    assert!(decode_sim_config::<GameConfig>(&vec![0xff; MAX_SIM_CONFIG_LEN + 1]).is_err());
+}

@@ -66,6 +66,49 @@ pub fn check_version(theirs: u32) -> Result<(), ProtocolError> {
     }
 }
 
+/// Encodes a simulation configuration for [`Welcome::sim_config`], so the
+/// client predicts with exactly the server's constants. At most
+/// [`MAX_SIM_CONFIG_LEN`] bytes.
+pub fn encode_sim_config<T: serde::Serialize>(config: &T) -> Result<Vec<u8>, ProtocolError> {
+    let bytes = bincode::serde::encode_to_vec(
+        config,
+        bincode::config::standard().with_limit::<MAX_SIM_CONFIG_LEN>(),
+    )
+    .map_err(|e| ProtocolError::malformed("sim config", format!("cannot encode: {e}")))?;
+    if bytes.len() > MAX_SIM_CONFIG_LEN {
+        return Err(ProtocolError::too_large(
+            "sim config",
+            bytes.len(),
+            MAX_SIM_CONFIG_LEN,
+        ));
+    }
+    Ok(bytes)
+}
+
+/// Decodes a [`Welcome::sim_config`] written by [`encode_sim_config`]; no
+/// trailing bytes, never panics.
+pub fn decode_sim_config<T: serde::de::DeserializeOwned>(bytes: &[u8]) -> Result<T, ProtocolError> {
+    if bytes.len() > MAX_SIM_CONFIG_LEN {
+        return Err(ProtocolError::too_large(
+            "sim config",
+            bytes.len(),
+            MAX_SIM_CONFIG_LEN,
+        ));
+    }
+    let (config, used) = bincode::serde::decode_from_slice(
+        bytes,
+        bincode::config::standard().with_limit::<MAX_SIM_CONFIG_LEN>(),
+    )
+    .map_err(|e| ProtocolError::malformed("sim config", e.to_string()))?;
+    if used != bytes.len() {
+        return Err(ProtocolError::TrailingBytes {
+            what: "sim config",
+            extra: bytes.len() - used,
+        });
+    }
+    Ok(config)
+}
+
 /// A player's id, unique within one server run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub struct PlayerId(pub u32);

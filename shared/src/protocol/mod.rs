@@ -29,9 +29,9 @@ mod varint;
 
 pub use codec::Message;
 pub use control::{
-    check_name, check_text, check_version, ClientControl, CloseCode, NetTiming, NoticeKind,
-    PlayerId, RejectReason, ServerControl, Welcome, MAX_CHAT_LEN, MAX_ID_LEN, MAX_NAME_LEN,
-    MAX_REASON_LEN, MAX_SIM_CONFIG_LEN,
+    check_name, check_text, check_version, decode_sim_config, encode_sim_config, ClientControl,
+    CloseCode, NetTiming, NoticeKind, PlayerId, RejectReason, ServerControl, Welcome, MAX_CHAT_LEN,
+    MAX_ID_LEN, MAX_NAME_LEN, MAX_REASON_LEN, MAX_SIM_CONFIG_LEN,
 };
 pub use datagram::{fits, input_timing, InputPacket, Outgoing, Snapshot};
 pub use error::ProtocolError;
