@@ -13,7 +13,7 @@
 
 use std::fmt;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{mpsc, Arc};
+use std::sync::{mpsc, Arc, Mutex};
 use std::thread;
 use std::time::Duration;
 
@@ -21,11 +21,14 @@ use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{Fingerprint, NoticeKind, PlayerId, Welcome};
 use tokio::sync::oneshot;
 
-use crate::session::{connect_with, JoinOptions, SessionEvent, SnapshotUpdate};
-use crate::transport::resolve;
+use crate::netstats::TransportSample;
+use crate::session::{JoinOptions, SessionEvent, SnapshotUpdate};
+use crate::trust::{connect_trusted, Trust};
 
 /// How often the background thread pings the server.
 const PING_INTERVAL: Duration = Duration::from_secs(1);
+/// How often the background thread reads QUIC's counters.
+const TRANSPORT_INTERVAL: Duration = Duration::from_millis(250);
 /// Events waiting for the front end; more are dropped.
 pub const EVENT_QUEUE: usize = 512;
 /// Commands waiting for the network thread; more are dropped.
@@ -47,6 +50,11 @@ pub struct ConnectRequest {
 pub struct NetOptions {
     /// The room to join; `None`: the server picks the least full one.
     pub room: Option<String>,
+    /// How to trust the server's certificate; `None`: pinned to
+    /// [`ConnectRequest::cert_fingerprint`]. With
+    /// [`Trust::KnownHosts`] (trust on first use) the request's
+    /// fingerprint is ignored.
+    pub trust: Option<Trust>,
 }
 
 /// What the front end asks the network thread to do.
@@ -94,6 +102,7 @@ pub struct NetThread {
     events: mpsc::Receiver<NetEvent>,
     commands: tokio::sync::mpsc::Sender<NetCommand>,
     dropped: Arc<AtomicU64>,
+    transport: Arc<Mutex<Option<TransportSample>>>,
     quit: Option<oneshot::Sender<()>>,
     thread: Option<thread::JoinHandle<()>>,
 }
@@ -113,9 +122,11 @@ impl NetThread {
         let (commands, commands_rx) = tokio::sync::mpsc::channel(COMMAND_QUEUE);
         let (quit, quit_rx) = oneshot::channel();
         let dropped = Arc::new(AtomicU64::new(0));
+        let transport = Arc::new(Mutex::new(None));
         let events_tx = Events {
             tx: events_tx,
             dropped: dropped.clone(),
+            transport: transport.clone(),
         };
         let thread = thread::Builder::new()
             .name("ledge-net".into())
@@ -126,6 +137,7 @@ impl NetThread {
             events,
             commands,
             dropped,
+            transport,
             quit: Some(quit),
             thread: Some(thread),
         })
@@ -156,6 +168,12 @@ impl NetThread {
         self.send(NetCommand::Chat(text.to_owned()))
     }
 
+    /// QUIC's byte counters and RTT, read by the network thread every
+    /// quarter second (`None` before connecting).
+    pub fn transport(&self) -> Option<TransportSample> {
+        self.transport.lock().ok().and_then(|t| *t)
+    }
+
     /// Events and commands dropped so far because a queue was full.
     pub fn dropped(&self) -> u64 {
         self.dropped.load(Ordering::Relaxed)
@@ -182,6 +200,7 @@ impl Drop for NetThread {
 struct Events {
     tx: mpsc::SyncSender<NetEvent>,
     dropped: Arc<AtomicU64>,
+    transport: Arc<Mutex<Option<TransportSample>>>,
 }
 
 impl Events {
@@ -206,28 +225,42 @@ async fn run(
     mut quit: oneshot::Receiver<()>,
 ) {
     let connecting = async {
-        let (addr, server_name) = resolve(&request.server).await?;
         let join = JoinOptions {
             player_name: request.player_name.clone(),
             room: options.room.clone(),
         };
-        connect_with(addr, &server_name, request.cert_fingerprint, &join).await
+        let trust = options
+            .trust
+            .clone()
+            .unwrap_or(Trust::Pinned(request.cert_fingerprint));
+        connect_trusted(&request.server, &trust, &join).await
     };
     let mut session = tokio::select! {
         _ = &mut quit => return,
         result = connecting => match result {
-            Ok(session) => session,
+            Ok((session, _)) => session,
             Err(e) => {
                 events.send(NetEvent::Failed(e.to_string()));
                 return;
             }
         },
     };
+    let sample = |s: &crate::session::Session| {
+        if let Ok(mut slot) = events.transport.lock() {
+            *slot = Some(TransportSample::of(s.connection()));
+        }
+    };
+    sample(&session);
     events.send(NetEvent::Connected(session.welcome().clone()));
     let mut ticker = tokio::time::interval(PING_INTERVAL);
+    let mut transport_ticker = tokio::time::interval(TRANSPORT_INTERVAL);
     loop {
         let result = tokio::select! {
             _ = &mut quit => break,
+            _ = transport_ticker.tick() => {
+                sample(&session);
+                Ok(true)
+            }
             command = commands.recv() => match command {
                 Some(NetCommand::Input { tick, buttons }) => {
                     // A full datagram queue is not fatal: the next input

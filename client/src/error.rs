@@ -58,6 +58,31 @@ pub enum ClientError {
     /// The server did not answer in time.
     #[error("server did not answer in time")]
     Timeout,
+    /// The server plays a level we do not have (or a different version).
+    #[error(
+        "the server plays level {level_id:?} (hash {server:016x}), but {tried} has hash \
+         {ours:016x}: pass the server's level file (--level)"
+    )]
+    LevelMismatch {
+        /// The level id the server sent.
+        level_id: String,
+        /// What we tried.
+        tried: String,
+        /// The server's level hash.
+        server: u64,
+        /// Ours.
+        ours: u64,
+    },
+    /// A level file could not be loaded.
+    #[error("level: {0}")]
+    Level(String),
+    /// The game refused something (a snapshot, a player).
+    #[error("game: {0}")]
+    Game(#[from] ledge_shared::game::GameError),
+    /// The server's certificate is not the one this client trusted for
+    /// this address before (trust on first use).
+    #[error("{0}")]
+    Trust(#[from] crate::trust::TrustError),
 }
 
 impl ClientError {

@@ -5,28 +5,56 @@
 //! `gui`) is a thin layer on top. The wire protocol is
 //! [`ledge_shared::protocol`].
 //!
-//! * [`verifier`]: trust the server certificate by pinned fingerprint only;
+//! * [`view`]: what a front end draws ([`view::FrameView`]) and shows
+//!   ([`view::NetStats`]): the stable API of the front end;
+//! * [`online`]: a networked game for a GUI ([`online::OnlineGame`]);
+//! * [`game`]: the client's game, sans IO ([`game::ClientGame`]): clock,
+//!   prediction, interpolation, statistics, views;
+//! * [`predict`]: prediction and reconciliation ([`predict::Predictor`]);
+//! * [`interp`]: remote players drawn in the past ([`interp::Interpolator`]);
+//! * [`clock`]: the synchronised local clock ([`clock::SyncClock`]) and the
+//!   simple [`InputClock`];
+//! * [`netstats`]: RTT, jitter, loss, rates;
+//! * [`bot`]: headless bots (idle, random walker, route runner,
+//!   misbehaving);
+//! * [`trust`]: pinned fingerprints and trust on first use (known hosts);
+//! * [`verifier`]: the certificate verifier behind both;
 //! * [`transport`]: resolve and dial a server over QUIC;
 //! * [`session`]: the handshake, inputs out, snapshots and control messages
 //!   in ([`Session`], [`SessionEvent`]);
-//! * [`clock`]: which tick to send inputs for ([`InputClock`]);
+//! * [`levels`]: the server's level, checked by hash;
 //! * [`background`]: the network on its own thread, for GUI front ends;
 //! * [`timestep`]: fixed-step accumulator for render loops;
 //! * [`error`]: what can fail ([`ClientError`]).
+//!
+//! `docs/CLIENT.md` describes the design and the figures.
 #![deny(missing_docs)]
 
 pub mod background;
+pub mod bot;
 pub mod clock;
 pub mod error;
+pub mod game;
+pub mod interp;
+pub mod levels;
+pub mod netstats;
+pub mod online;
+pub mod predict;
 pub mod session;
 pub mod timestep;
 pub mod transport;
+pub mod trust;
 pub mod verifier;
+pub mod view;
 
-pub use clock::InputClock;
+pub use clock::{InputClock, SyncClock};
 pub use error::ClientError;
+pub use game::ClientGame;
 pub use ledge_shared::protocol::Fingerprint;
+pub use online::{OnlineGame, OnlineRequest};
 pub use session::{
     connect, connect_with, handshake, JoinOptions, Session, SessionEvent, SessionStats,
     SnapshotUpdate,
 };
+pub use trust::{connect_trusted, Trust};
+pub use view::{EntityDraw, Facing, FrameView, NetStats, PlayerDraw};

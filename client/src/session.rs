@@ -193,6 +193,8 @@ pub struct SnapshotUpdate {
     pub via_stream: bool,
     /// Encoded size in bytes.
     pub wire_bytes: usize,
+    /// When it was received and decoded (for jitter and interpolation).
+    pub received: Instant,
 }
 
 /// Something the server sent.
@@ -511,6 +513,7 @@ impl Session {
                 input_timing: snapshot.input_timing,
                 via_stream,
                 wire_bytes,
+                received: Instant::now(),
             }));
     }
 

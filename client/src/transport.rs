@@ -27,14 +27,22 @@ pub struct Dialed {
     pub connection: quinn::Connection,
 }
 
-/// Where the verifier records the fingerprint of a refused certificate.
-type RefusedSlot = Arc<Mutex<Option<Fingerprint>>>;
+/// Where the verifier records the fingerprint of a certificate.
+type Slot = Arc<Mutex<Option<Fingerprint>>>;
 
-/// The quinn client configuration trusting only `pin` (TLS 1.3, ring, ALPN).
-fn client_config(pin: Fingerprint) -> Result<(quinn::ClientConfig, RefusedSlot), ClientError> {
+/// The quinn client configuration trusting only `pin`, or any certificate
+/// when `None` (TLS 1.3, ring, ALPN); with the verifier's refused and
+/// presented slots.
+fn client_config(
+    pin: Option<Fingerprint>,
+) -> Result<(quinn::ClientConfig, Slot, Slot), ClientError> {
     let provider = Arc::new(rustls::crypto::ring::default_provider());
-    let verifier = Arc::new(PinnedCertVerifier::new(pin, &provider));
+    let verifier = Arc::new(match pin {
+        Some(pin) => PinnedCertVerifier::new(pin, &provider),
+        None => PinnedCertVerifier::any(&provider),
+    });
     let refused = verifier.refused();
+    let presented = verifier.presented();
     let mut tls = rustls::ClientConfig::builder_with_provider(provider)
         .with_protocol_versions(&[&rustls::version::TLS13])
         .map_err(|e| ClientError::Config(e.to_string()))?
@@ -54,7 +62,7 @@ fn client_config(pin: Fingerprint) -> Result<(quinn::ClientConfig, RefusedSlot),
             quinn::IdleTimeout::try_from(IDLE_TIMEOUT).expect("constant fits a QUIC varint"),
         ));
     config.transport_config(Arc::new(transport));
-    Ok((config, refused))
+    Ok((config, refused, presented))
 }
 
 /// Connects to `addr`, trusting only the certificate whose SHA-256 is `pin`.
@@ -67,7 +75,20 @@ pub async fn dial(
     server_name: &str,
     pin: Fingerprint,
 ) -> Result<Dialed, ClientError> {
-    let (config, refused) = client_config(pin)?;
+    dial_any_or(addr, server_name, Some(pin))
+        .await
+        .map(|(d, _)| d)
+}
+
+/// Connects to `addr` trusting only `pin`, or any certificate when `None`
+/// (trust on first use); returns the connection and the fingerprint of the
+/// certificate the server presented.
+pub async fn dial_any_or(
+    addr: SocketAddr,
+    server_name: &str,
+    pin: Option<Fingerprint>,
+) -> Result<(Dialed, Fingerprint), ClientError> {
+    let (config, refused, presented) = client_config(pin)?;
     let local: SocketAddr = if addr.is_ipv6() {
         (Ipv6Addr::UNSPECIFIED, 0).into()
     } else {
@@ -77,18 +98,28 @@ pub async fn dial(
     endpoint.set_default_client_config(config);
     let connecting = endpoint.connect(addr, server_name)?;
     match connecting.await {
-        Ok(connection) => Ok(Dialed {
-            endpoint,
-            connection,
-        }),
+        Ok(connection) => {
+            let fingerprint = presented
+                .lock()
+                .ok()
+                .and_then(|slot| *slot)
+                .ok_or_else(|| ClientError::Config("no certificate was presented".into()))?;
+            Ok((
+                Dialed {
+                    endpoint,
+                    connection,
+                },
+                fingerprint,
+            ))
+        }
         Err(e) => {
-            let presented = refused.lock().ok().and_then(|slot| *slot);
-            Err(match presented {
-                Some(presented) => ClientError::FingerprintMismatch {
-                    expected: pin,
+            let refused = refused.lock().ok().and_then(|slot| *slot);
+            Err(match (refused, pin) {
+                (Some(presented), Some(expected)) => ClientError::FingerprintMismatch {
+                    expected,
                     presented,
                 },
-                None => ClientError::from_connection_error(e),
+                _ => ClientError::from_connection_error(e),
             })
         }
     }

@@ -1,4 +1,5 @@
-//! Trust the server certificate by its pinned SHA-256 fingerprint only.
+//! Trust the server certificate by its pinned SHA-256 fingerprint only (or,
+//! for trust on first use, any certificate once, recording which).
 //!
 //! ledge servers use self-signed certificates, so there is no CA chain to
 //! check: the certificate is trusted if and only if its fingerprint equals
@@ -30,11 +31,14 @@ pub fn fingerprint_of(der: &[u8]) -> Fingerprint {
 /// A rustls verifier accepting exactly one certificate, by fingerprint.
 #[derive(Debug)]
 pub struct PinnedCertVerifier {
-    pin: Fingerprint,
+    /// `None`: accept any certificate (first use), recording it.
+    pin: Option<Fingerprint>,
     algorithms: WebPkiSupportedAlgorithms,
     /// The fingerprint of the last refused certificate, so the caller can
     /// report what the server actually presented.
     refused: Arc<Mutex<Option<Fingerprint>>>,
+    /// The fingerprint of the last certificate presented.
+    presented: Arc<Mutex<Option<Fingerprint>>>,
 }
 
 impl PinnedCertVerifier {
@@ -42,10 +46,28 @@ impl PinnedCertVerifier {
     /// checked with `provider`'s algorithms.
     pub fn new(pin: Fingerprint, provider: &CryptoProvider) -> PinnedCertVerifier {
         PinnedCertVerifier {
-            pin,
+            pin: Some(pin),
             algorithms: provider.signature_verification_algorithms,
             refused: Arc::default(),
+            presented: Arc::default(),
         }
+    }
+
+    /// Trusts any certificate (trust on first use: the caller stores what
+    /// [`PinnedCertVerifier::presented`] recorded). Signatures are still
+    /// checked, so the server holds the key of the certificate recorded.
+    pub fn any(provider: &CryptoProvider) -> PinnedCertVerifier {
+        PinnedCertVerifier {
+            pin: None,
+            algorithms: provider.signature_verification_algorithms,
+            refused: Arc::default(),
+            presented: Arc::default(),
+        }
+    }
+
+    /// Where the fingerprint of the presented certificate is recorded.
+    pub fn presented(&self) -> Arc<Mutex<Option<Fingerprint>>> {
+        self.presented.clone()
     }
 
     /// Where the fingerprint of a refused certificate is recorded.
@@ -64,7 +86,10 @@ impl ServerCertVerifier for PinnedCertVerifier {
         _now: UnixTime,
     ) -> Result<ServerCertVerified, rustls::Error> {
         let presented = fingerprint_of(end_entity);
-        if presented == self.pin {
+        if let Ok(mut slot) = self.presented.lock() {
+            *slot = Some(presented);
+        }
+        if self.pin.is_none_or(|pin| pin == presented) {
             return Ok(ServerCertVerified::assertion());
         }
         if let Ok(mut refused) = self.refused.lock() {
@@ -120,6 +145,17 @@ mod tests {
             .verify_server_cert(&other, &[], &name, &[], UnixTime::now())
             .is_err());
         assert_eq!(*v.refused().lock().unwrap(), Some(fingerprint_of(&other)));
+    }
+
+    #[test]
+    fn trust_on_first_use_accepts_any_and_records_it() {
+        let cert = CertificateDer::from(b"pretend DER".to_vec());
+        let name = ServerName::try_from("localhost").unwrap();
+        let v = PinnedCertVerifier::any(&rustls::crypto::ring::default_provider());
+        assert!(v
+            .verify_server_cert(&cert, &[], &name, &[], UnixTime::now())
+            .is_ok());
+        assert_eq!(*v.presented().lock().unwrap(), Some(fingerprint_of(&cert)));
     }
 
     #[test]

@@ -5,6 +5,8 @@
 //! headless client library exactly as players and bots do. [`UdpRelay`]
 //! sits between a client and the server and can drop everything, to make a
 //! client go silent without closing; [`scrape`] reads the metrics endpoint.
+//! [`PredictedClient`] drives a predicting client ([`ClientGame`]) in real
+//! time with a scripted input, the way a player or bot would.
 
 use std::collections::BTreeSet;
 use std::net::SocketAddr;
@@ -12,9 +14,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use ledge_client::{connect, Session, SessionEvent, SnapshotUpdate};
+use ledge_client::netstats::TransportSample;
+use ledge_client::predict::Reconciled;
+use ledge_client::{connect, ClientGame, Session, SessionEvent, SnapshotUpdate};
 use ledge_server::metrics::Registry;
 use ledge_server::{Fingerprint, Server, ServerConfig, ServerError, ShutdownHandle};
+use ledge_shared::input::Buttons;
 use ledge_shared::protocol::StateSnapshot;
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::net::UdpSocket;
@@ -191,50 +196,100 @@ pub fn ids(state: &StateSnapshot) -> BTreeSet<u32> {
     state.entities.iter().map(|e| e.id).collect()
 }
 
+/// How a [`UdpRelay`] impairs the traffic: loss, delay and jitter, each
+/// way (`up`: client to server, `down`: server to client).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Impairment {
+    /// Fraction of client-to-server datagrams dropped.
+    pub loss_up: f64,
+    /// Fraction of server-to-client datagrams dropped.
+    pub loss_down: f64,
+    /// Fixed one-way delay, each way.
+    pub delay: Duration,
+    /// Extra one-way delay, uniform in `[0, jitter)` per datagram (so
+    /// datagrams may be reordered).
+    pub jitter: Duration,
+}
+
 /// A UDP relay on loopback between one client and a server. While
 /// [`UdpRelay::blackhole`] is on, it drops every datagram both ways, as a
-/// dead network or a frozen client would.
+/// dead network or a frozen client would; [`UdpRelay::impair`] adds loss,
+/// delay and jitter.
 #[derive(Debug)]
 pub struct UdpRelay {
     /// Where clients connect instead of the server.
     pub addr: SocketAddr,
     drop_all: Arc<AtomicBool>,
+    impairment: Arc<std::sync::Mutex<Impairment>>,
     task: JoinHandle<()>,
+}
+
+/// A tiny deterministic generator for the relay's loss and jitter.
+fn next_random(state: &mut u64) -> f64 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    (*state >> 11) as f64 / (1u64 << 53) as f64
 }
 
 impl UdpRelay {
     /// Starts relaying to `server`.
     pub async fn start(server: SocketAddr) -> UdpRelay {
-        let front = UdpSocket::bind("127.0.0.1:0").await.unwrap();
-        let back = UdpSocket::bind("127.0.0.1:0").await.unwrap();
+        let front = Arc::new(UdpSocket::bind("127.0.0.1:0").await.unwrap());
+        let back = Arc::new(UdpSocket::bind("127.0.0.1:0").await.unwrap());
         back.connect(server).await.unwrap();
         let addr = front.local_addr().unwrap();
         let drop_all = Arc::new(AtomicBool::new(false));
+        let impairment = Arc::new(std::sync::Mutex::new(Impairment::default()));
         let dropping = drop_all.clone();
+        let impaired = impairment.clone();
         let task = tokio::spawn(async move {
             let mut client: Option<SocketAddr> = None;
             let (mut up, mut down) = (vec![0u8; 65536], vec![0u8; 65536]);
+            let mut rng = 0x2545_f491_4f6c_dd1du64;
             loop {
-                tokio::select! {
+                let (bytes, upward) = tokio::select! {
                     r = front.recv_from(&mut up) => {
                         let Ok((n, from)) = r else { return };
                         client = Some(from);
-                        if !dropping.load(Ordering::Relaxed) {
-                            let _ = back.send(&up[..n]).await;
-                        }
+                        (up[..n].to_vec(), true)
                     }
                     r = back.recv(&mut down) => {
                         let Ok(n) = r else { return };
-                        if let (Some(to), false) = (client, dropping.load(Ordering::Relaxed)) {
-                            let _ = front.send_to(&down[..n], to).await;
-                        }
+                        (down[..n].to_vec(), false)
                     }
+                };
+                if dropping.load(Ordering::Relaxed) {
+                    continue;
+                }
+                let imp = *impaired.lock().unwrap();
+                let loss = if upward { imp.loss_up } else { imp.loss_down };
+                if loss > 0.0 && next_random(&mut rng) < loss {
+                    continue;
+                }
+                let delay = imp.delay + imp.jitter.mul_f64(next_random(&mut rng));
+                let (front, back) = (front.clone(), back.clone());
+                let send = async move {
+                    if upward {
+                        let _ = back.send(&bytes).await;
+                    } else if let Some(to) = client {
+                        let _ = front.send_to(&bytes, to).await;
+                    }
+                };
+                if delay.is_zero() {
+                    send.await;
+                } else {
+                    tokio::spawn(async move {
+                        tokio::time::sleep(delay).await;
+                        send.await;
+                    });
                 }
             }
         });
         UdpRelay {
             addr,
             drop_all,
+            impairment,
             task,
         }
     }
@@ -243,10 +298,132 @@ impl UdpRelay {
     pub fn blackhole(&self) {
         self.drop_all.store(true, Ordering::Relaxed);
     }
+
+    /// Impairs the traffic from now on.
+    pub fn impair(&self, impairment: Impairment) {
+        *self.impairment.lock().unwrap() = impairment;
+    }
 }
 
 impl Drop for UdpRelay {
     fn drop(&mut self) {
         self.task.abort();
+    }
+}
+
+/// Ticks the server's room `room` starved for inputs (a player's input for a
+/// tick missing when it ran), from the metrics.
+pub fn starvation(server: &TestServer, room: &str) -> f64 {
+    metric(
+        &server.metrics(),
+        &format!("ledge_input_starvation_total{{room=\"{room}\"}}"),
+    )
+}
+
+/// A predicting client on a real session, driven by a script.
+#[derive(Debug)]
+pub struct PredictedClient {
+    /// The session.
+    pub session: Session,
+    /// Its predicted game, clock, interpolation.
+    pub game: ClientGame,
+    /// Every reconciliation so far.
+    pub log: Vec<Reconciled>,
+    /// Every snapshot received so far (its tick and our authoritative state).
+    pub snapshots: u64,
+    /// Local ticks run.
+    pub ticks: u64,
+    /// Inputs deliberately not sent.
+    pub skipped: u64,
+}
+
+impl PredictedClient {
+    /// Joins `server` as `name` and sets up prediction on the default level,
+    /// with an input margin of `margin` ticks.
+    pub async fn join(server: &TestServer, name: &str, margin: f64) -> PredictedClient {
+        Self::join_via(server, server.addr, name, margin).await
+    }
+
+    /// [`PredictedClient::join`] through `addr` (a [`UdpRelay`]).
+    pub async fn join_via(
+        server: &TestServer,
+        addr: SocketAddr,
+        name: &str,
+        margin: f64,
+    ) -> PredictedClient {
+        let session = connect(addr, "localhost", server.fingerprint, name)
+            .await
+            .unwrap_or_else(|e| panic!("{name} is welcomed: {e}"));
+        let level = ledge_shared::level::default_level();
+        let mut game = ClientGame::new(
+            session.welcome(),
+            level,
+            session.connection().rtt(),
+            Instant::now(),
+        )
+        .expect("the server plays the default level");
+        game.set_base_margin(margin);
+        PredictedClient {
+            session,
+            game,
+            log: Vec::new(),
+            snapshots: 0,
+            ticks: 0,
+            skipped: 0,
+        }
+    }
+
+    /// Plays until `until`. Each due tick, `script(game, tick)` gives the
+    /// buttons and whether to send them (not sending simulates a lost burst
+    /// the redundancy cannot recover: the next packet fills the gap with
+    /// the previous buttons). Each snapshot is reconciled, then handed to
+    /// `seen` with the reconciliation.
+    pub async fn run(
+        &mut self,
+        until: Instant,
+        mut script: impl FnMut(&ClientGame, u64) -> (Buttons, bool),
+        mut seen: impl FnMut(&ClientGame, &SnapshotUpdate, &Reconciled),
+    ) {
+        let mut next_sample = Instant::now();
+        loop {
+            let now = Instant::now();
+            if now >= until {
+                return;
+            }
+            if now >= next_sample {
+                let sample = TransportSample::of(self.session.connection());
+                self.game.on_transport(sample, now);
+                next_sample = now + Duration::from_millis(250);
+            }
+            let due = self.game.advance(now);
+            for _ in 0..due {
+                let (buttons, send) = script(&self.game, self.game.next_tick());
+                let tick = self.game.step(buttons);
+                self.ticks += 1;
+                if send {
+                    self.session
+                        .send_input(tick, buttons)
+                        .expect("input datagram queued");
+                } else {
+                    self.skipped += 1;
+                }
+            }
+            let wait = self
+                .game
+                .clock()
+                .until_next_tick(Instant::now())
+                .min(until.saturating_duration_since(Instant::now()));
+            let event = tokio::select! {
+                event = self.session.recv() => event.expect("session stays up"),
+                () = tokio::time::sleep(wait) => continue,
+            };
+            if let SessionEvent::Snapshot(update) = event {
+                self.snapshots += 1;
+                if let Some(r) = self.game.on_snapshot(&update) {
+                    self.log.push(r);
+                    seen(&self.game, &update, &r);
+                }
+            }
+        }
     }
 }

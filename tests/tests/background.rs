@@ -17,6 +17,7 @@ async fn the_network_thread_joins_sends_inputs_and_reports_snapshots() {
     };
     let options = NetOptions {
         room: Some("room-2".into()),
+        ..NetOptions::default()
     };
     let events = tokio::task::spawn_blocking(move || {
         let net = NetThread::spawn_with(request, options).unwrap();

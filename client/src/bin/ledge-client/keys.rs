@@ -1,24 +1,355 @@
-//! Keyboard to buttons: arrow keys or WASD to move, space to jump.
+//! Keyboard (and, with the `gamepad` feature, gamepad) to buttons, with
+//! bindings rebindable in a TOML file (`--keys FILE`).
+//!
+//! The file lists, for each action, the keys that trigger it, by macroquad
+//! key name (case-insensitive: `Left`, `A`, `Space`, `F1`, `Key1` or `1`,
+//! `LeftShift`, `Kp0`, ...). Actions missing from the file keep their
+//! defaults; unknown actions and key names are errors. The defaults are
+//! [`DEFAULT_KEYS`] (also printed by `ledge-client --print-keys`).
 
 use ledge_shared::input::Buttons;
-use macroquad::input::{is_key_down, KeyCode};
+use macroquad::input::{is_key_down, is_key_pressed, KeyCode};
+use serde::Deserialize;
 
-/// Each button with the keys that hold it.
-const BINDINGS: [(u8, &[KeyCode]); 5] = [
-    (Buttons::LEFT, &[KeyCode::Left, KeyCode::A]),
-    (Buttons::RIGHT, &[KeyCode::Right, KeyCode::D]),
-    (Buttons::UP, &[KeyCode::Up, KeyCode::W]),
-    (Buttons::DOWN, &[KeyCode::Down, KeyCode::S]),
-    (Buttons::JUMP, &[KeyCode::Space]),
-];
+/// The default bindings, as a key file.
+pub const DEFAULT_KEYS: &str = r#"# ledge key bindings: action = [keys] (macroquad key names, any case).
+left = ["Left", "A"]
+right = ["Right", "D"]
+up = ["Up", "W"]
+# Down + jump drops through one-way ledges.
+down = ["Down", "S"]
+jump = ["Space", "Z", "K"]
+# Debug overlay: colliders, contacts and their MTVs, touched sides.
+debug = ["F1"]
+# Net graph and HUD on/off.
+hud = ["F2"]
+quit = ["Escape"]
+"#;
 
-/// The buttons held right now.
-pub fn held_buttons() -> Buttons {
-    let mut bits = 0;
-    for (bit, keys) in BINDINGS {
-        if keys.iter().any(|&key| is_key_down(key)) {
-            bits |= bit;
-        }
+/// The key file's shape.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KeyFile {
+    left: Option<Vec<String>>,
+    right: Option<Vec<String>>,
+    up: Option<Vec<String>>,
+    down: Option<Vec<String>>,
+    jump: Option<Vec<String>>,
+    debug: Option<Vec<String>>,
+    hud: Option<Vec<String>>,
+    quit: Option<Vec<String>>,
+}
+
+/// Keys for every action.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Bindings {
+    /// Keys holding each button, in [`Buttons`] bit order.
+    buttons: [(u8, Vec<KeyCode>); 5],
+    /// Toggles the debug overlay.
+    pub debug: Vec<KeyCode>,
+    /// Toggles the HUD.
+    pub hud: Vec<KeyCode>,
+    /// Quits.
+    pub quit: Vec<KeyCode>,
+}
+
+impl Default for Bindings {
+    fn default() -> Bindings {
+        let empty = Bindings {
+            buttons: [
+                (Buttons::LEFT, Vec::new()),
+                (Buttons::RIGHT, Vec::new()),
+                (Buttons::UP, Vec::new()),
+                (Buttons::DOWN, Vec::new()),
+                (Buttons::JUMP, Vec::new()),
+            ],
+            debug: Vec::new(),
+            hud: Vec::new(),
+            quit: Vec::new(),
+        };
+        empty
+            .with(DEFAULT_KEYS)
+            .expect("the default key file is valid")
     }
-    Buttons(bits)
+}
+
+impl Bindings {
+    /// The defaults overridden by the key file at `path`.
+    pub fn load(path: &std::path::Path) -> Result<Bindings, String> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("reading key file {}: {e}", path.display()))?;
+        Bindings::default()
+            .with(&text)
+            .map_err(|e| format!("key file {}: {e}", path.display()))
+    }
+
+    /// These bindings overridden by the actions in key file `text`.
+    pub fn with(mut self, text: &str) -> Result<Bindings, String> {
+        let file: KeyFile = toml::from_str(text).map_err(|e| e.to_string())?;
+        let keys = |names: Option<Vec<String>>, into: &mut Vec<KeyCode>| -> Result<(), String> {
+            if let Some(names) = names {
+                *into = names
+                    .iter()
+                    .map(|n| key_by_name(n).ok_or_else(|| format!("unknown key name {n:?}")))
+                    .collect::<Result<_, _>>()?;
+            }
+            Ok(())
+        };
+        let [l, r, u, d, j] = &mut self.buttons;
+        keys(file.left, &mut l.1)?;
+        keys(file.right, &mut r.1)?;
+        keys(file.up, &mut u.1)?;
+        keys(file.down, &mut d.1)?;
+        keys(file.jump, &mut j.1)?;
+        keys(file.debug, &mut self.debug)?;
+        keys(file.hud, &mut self.hud)?;
+        keys(file.quit, &mut self.quit)?;
+        Ok(self)
+    }
+
+    /// The buttons held on the keyboard right now.
+    pub fn held(&self) -> Buttons {
+        let mut bits = 0;
+        for (bit, keys) in &self.buttons {
+            if keys.iter().any(|&key| is_key_down(key)) {
+                bits |= bit;
+            }
+        }
+        Buttons(bits)
+    }
+
+    /// Whether one of `keys` was pressed this frame.
+    pub fn pressed(keys: &[KeyCode]) -> bool {
+        keys.iter().any(|&k| is_key_pressed(k))
+    }
+}
+
+/// Every key a binding can name.
+const ALL_KEYS: &[KeyCode] = {
+    use KeyCode::*;
+    &[
+        Space,
+        Apostrophe,
+        Comma,
+        Minus,
+        Period,
+        Slash,
+        Key0,
+        Key1,
+        Key2,
+        Key3,
+        Key4,
+        Key5,
+        Key6,
+        Key7,
+        Key8,
+        Key9,
+        Semicolon,
+        Equal,
+        A,
+        B,
+        C,
+        D,
+        E,
+        F,
+        G,
+        H,
+        I,
+        J,
+        K,
+        L,
+        M,
+        N,
+        O,
+        P,
+        Q,
+        R,
+        S,
+        T,
+        U,
+        V,
+        W,
+        X,
+        Y,
+        Z,
+        LeftBracket,
+        Backslash,
+        RightBracket,
+        GraveAccent,
+        Escape,
+        Enter,
+        Tab,
+        Backspace,
+        Insert,
+        Delete,
+        Right,
+        Left,
+        Down,
+        Up,
+        PageUp,
+        PageDown,
+        Home,
+        End,
+        CapsLock,
+        ScrollLock,
+        NumLock,
+        PrintScreen,
+        Pause,
+        F1,
+        F2,
+        F3,
+        F4,
+        F5,
+        F6,
+        F7,
+        F8,
+        F9,
+        F10,
+        F11,
+        F12,
+        Kp0,
+        Kp1,
+        Kp2,
+        Kp3,
+        Kp4,
+        Kp5,
+        Kp6,
+        Kp7,
+        Kp8,
+        Kp9,
+        KpDecimal,
+        KpDivide,
+        KpMultiply,
+        KpSubtract,
+        KpAdd,
+        KpEnter,
+        KpEqual,
+        LeftShift,
+        LeftControl,
+        LeftAlt,
+        LeftSuper,
+        RightShift,
+        RightControl,
+        RightAlt,
+        RightSuper,
+        Menu,
+    ]
+};
+
+/// The key called `name` (its macroquad name, any case; digits also bare).
+pub fn key_by_name(name: &str) -> Option<KeyCode> {
+    let name = name.trim();
+    let wanted = if name.len() == 1 && name.as_bytes()[0].is_ascii_digit() {
+        format!("key{name}")
+    } else {
+        name.to_ascii_lowercase()
+    };
+    ALL_KEYS
+        .iter()
+        .copied()
+        .find(|k| format!("{k:?}").to_ascii_lowercase() == wanted)
+}
+
+/// Gamepads through gilrs: d-pad or left stick to move, south (A/cross)
+/// or east to jump, down + jump to drop through.
+#[cfg(feature = "gamepad")]
+pub struct Gamepads {
+    gilrs: Option<gilrs::Gilrs>,
+}
+
+#[cfg(feature = "gamepad")]
+impl Gamepads {
+    /// Opens the gamepad subsystem (none if it cannot start: keyboard only).
+    pub fn new() -> Gamepads {
+        let gilrs = match gilrs::Gilrs::new() {
+            Ok(g) => Some(g),
+            Err(e) => {
+                tracing::warn!("no gamepads: {e}");
+                None
+            }
+        };
+        Gamepads { gilrs }
+    }
+
+    /// The buttons held on any connected gamepad.
+    pub fn held(&mut self) -> Buttons {
+        use gilrs::{Axis, Button};
+        let Some(gilrs) = &mut self.gilrs else {
+            return Buttons::NONE;
+        };
+        while gilrs.next_event().is_some() {}
+        let mut bits = 0;
+        for (_, pad) in gilrs.gamepads() {
+            let x = pad.value(Axis::LeftStickX);
+            let y = pad.value(Axis::LeftStickY);
+            if pad.is_pressed(Button::DPadLeft) || x < -0.5 {
+                bits |= Buttons::LEFT;
+            }
+            if pad.is_pressed(Button::DPadRight) || x > 0.5 {
+                bits |= Buttons::RIGHT;
+            }
+            if pad.is_pressed(Button::DPadUp) || y > 0.5 {
+                bits |= Buttons::UP;
+            }
+            if pad.is_pressed(Button::DPadDown) || y < -0.5 {
+                bits |= Buttons::DOWN;
+            }
+            if pad.is_pressed(Button::South) || pad.is_pressed(Button::East) {
+                bits |= Buttons::JUMP;
+            }
+        }
+        Buttons(bits)
+    }
+}
+
+/// Without the `gamepad` feature: no gamepads.
+#[cfg(not(feature = "gamepad"))]
+pub struct Gamepads;
+
+#[cfg(not(feature = "gamepad"))]
+impl Gamepads {
+    /// No gamepad support in this build.
+    pub fn new() -> Gamepads {
+        Gamepads
+    }
+
+    /// Nothing held.
+    pub fn held(&mut self) -> Buttons {
+        Buttons::NONE
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_arrows_wasd_space_z() {
+        let b = Bindings::default();
+        assert_eq!(b.buttons[0].1, [KeyCode::Left, KeyCode::A]);
+        assert_eq!(b.buttons[4].1, [KeyCode::Space, KeyCode::Z, KeyCode::K]);
+        assert_eq!(b.debug, [KeyCode::F1]);
+        assert_eq!(b.quit, [KeyCode::Escape]);
+    }
+
+    #[test]
+    fn a_file_overrides_some_actions() {
+        let b = Bindings::default()
+            .with("jump = [\"x\", \"LEFTSHIFT\"]\nleft = [\"j\", \"kp4\"]")
+            .unwrap();
+        assert_eq!(b.buttons[4].1, [KeyCode::X, KeyCode::LeftShift]);
+        assert_eq!(b.buttons[0].1, [KeyCode::J, KeyCode::Kp4]);
+        assert_eq!(b.buttons[1].1, [KeyCode::Right, KeyCode::D], "kept");
+    }
+
+    #[test]
+    fn bad_files_are_refused() {
+        let e = Bindings::default()
+            .with("jump = [\"Spacebar\"]")
+            .unwrap_err();
+        assert!(e.contains("Spacebar"), "{e}");
+        assert!(Bindings::default().with("fly = [\"F\"]").is_err());
+        assert_eq!(key_by_name("1"), Some(KeyCode::Key1));
+        assert_eq!(key_by_name("f12"), Some(KeyCode::F12));
+    }
 }

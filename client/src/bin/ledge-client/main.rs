@@ -1,95 +1,388 @@
 //! `ledge-client`: the macroquad front end.
 //!
-//! Runs the warm-up room locally at a fixed 60 Hz (arrow keys or WASD,
-//! space to jump) and shows the tick and state hash. With `--connect` it
-//! also joins a server on a background network thread (macroquad owns the
-//! main thread) and shows the welcome. Drawing the world comes later.
+//! * offline (no `--connect`/`--local`): the default level in a local game;
+//! * `--connect HOST:PORT --cert-hash HEX`: joins a server on a background
+//!   network thread (macroquad owns the main thread) and predicts our
+//!   player with the shared simulation;
+//! * `--local`: starts the real server in-process on `127.0.0.1:0` and
+//!   joins it: one command, a playable game.
+//!
+//! The simulation runs at a fixed 60 Hz (accumulator); frames are drawn
+//! interpolated between the last two ticks. `--script`, `--screenshot` and
+//! `--exit-after-ticks` drive it without a human, for tests.
 
+mod camera;
+mod debug;
 mod hud;
 mod keys;
+mod local;
+mod play;
+mod render;
+mod script;
+mod shot;
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicI32, Ordering};
+use std::time::{Duration, Instant};
 
 use clap::Parser;
-use ledge_client::background::{ConnectRequest, NetStatus, NetThread};
-use ledge_client::timestep::FixedStep;
+use ledge_client::background::ConnectRequest;
+use ledge_client::view::px2;
 use ledge_client::Fingerprint;
+use ledge_shared::fixed::UNITS_PER_PX;
+use ledge_shared::input::Buttons;
 use macroquad::prelude::*;
-use std::time::Duration;
 
-/// Local simulation rate in Hz (the server's default).
-const TICK_RATE: u32 = 60;
-/// Most ticks simulated per rendered frame before the backlog is dropped.
-const MAX_STEPS_PER_FRAME: u32 = 8;
+use camera::Camera;
+use keys::{Bindings, Gamepads};
+use render::{EntitySprite, PlayerSprite};
+use script::Script;
+
+/// Frames are not drawn faster than this (no vsync under Xvfb).
+const MAX_FPS: f64 = 240.0;
+
+/// The process exit code, set by the game loop (macroquad's loop owns the
+/// main thread until it ends).
+static EXIT_CODE: AtomicI32 = AtomicI32::new(0);
 
 /// ledge: a networked 2D platformer.
+///
+/// Keys (rebind with --keys FILE; --print-keys shows the defaults): arrows
+/// or WASD move, space, Z or K jump, down + jump drops through one-way
+/// ledges, F1 debug overlay, F2 HUD, Esc quits. Gamepads need the
+/// `gamepad` build feature.
 #[derive(Debug, Parser)]
 #[command(version)]
 struct Cli {
-    /// Server to join, as HOST:PORT (without it, play locally).
+    /// Server to join, as HOST:PORT (without it or --local: play offline).
     #[arg(long, value_name = "HOST:PORT", requires = "cert_hash")]
     connect: Option<String>,
     /// SHA-256 fingerprint of the server certificate (the server prints it).
     #[arg(long, value_name = "HEX", requires = "connect")]
     cert_hash: Option<Fingerprint>,
-    /// Player name shown to others.
+    /// Start a server in this process (127.0.0.1, any free port, the
+    /// default level) and join it.
+    #[arg(long, conflicts_with = "connect")]
+    local: bool,
+    /// Level file (OGMO `.json` or Tiled `.tmx`) to play offline, or the
+    /// one the server plays (`ledge-server --level`); default: the
+    /// embedded level. `--local` always plays the embedded level.
+    #[arg(long, value_name = "FILE")]
+    level: Option<PathBuf>,
+    /// Player name.
     #[arg(long, default_value = "player")]
     name: String,
+    /// Key bindings file (TOML; actions left out keep their defaults).
+    #[arg(long, value_name = "FILE")]
+    keys: Option<PathBuf>,
+    /// Print the default key bindings file and exit.
+    #[arg(long)]
+    print_keys: bool,
+    /// Scripted input instead of the keyboard: a file, or the script
+    /// itself, e.g. "0-59 -> right; 60 -> right+jump" (ticks from the
+    /// start of play -> buttons).
+    #[arg(long, value_name = "FILE|SCRIPT")]
+    script: Option<String>,
+    /// Quit after this many ticks of play (from joining, or from the start
+    /// offline).
+    #[arg(long, value_name = "N")]
+    exit_after_ticks: Option<u64>,
+    /// Save a PNG of the frame at --exit-after-ticks, and PATH.json beside
+    /// it (camera transform, our player's server position on screen).
+    #[arg(long, value_name = "PATH", requires = "exit_after_ticks")]
+    screenshot: Option<PathBuf>,
+    /// Give up (exit code 2) when not joined within this many seconds (only
+    /// with --exit-after-ticks; interactive sessions keep waiting).
+    #[arg(long, value_name = "SECONDS", default_value_t = 20)]
+    join_timeout: u64,
+    /// Point the camera at world pixel X,Y instead of our player (for
+    /// screenshots of any part of the level).
+    #[arg(long, value_name = "X,Y", value_parser = parse_point)]
+    look_at: Option<(f32, f32)>,
+    /// Start with the debug overlay (F1) on.
+    #[arg(long)]
+    debug: bool,
+    /// Window size, WIDTHxHEIGHT.
+    #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = parse_size)]
+    window: (i32, i32),
+}
+
+fn parse_size(s: &str) -> Result<(i32, i32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT"))?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<i32>()
+            .ok()
+            .filter(|&v| (64..=16384).contains(&v))
+            .ok_or_else(|| format!("{v:?}: expected a size in pixels (64..=16384)"))
+    };
+    Ok((n(w)?, n(h)?))
+}
+
+fn parse_point(s: &str) -> Result<(f32, f32), String> {
+    let (x, y) = s
+        .split_once(',')
+        .ok_or_else(|| format!("{s:?}: expected X,Y"))?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{v:?}: expected a number of pixels"))
+    };
+    Ok((n(x)?, n(y)?))
+}
+
+/// Everything the game loop needs, prepared before the window opens.
+struct Setup {
+    play: play::Play,
+    bindings: Bindings,
+    script: Option<Script>,
+    exit_after: Option<u64>,
+    screenshot: Option<PathBuf>,
+    join_timeout: Duration,
+    name: String,
+    debug: bool,
+    look_at: Option<Vec2>,
+    /// Kept alive for the whole game; dropped after the network thread.
+    server: Option<local::LocalServer>,
 }
 
 fn main() -> anyhow::Result<()> {
     // Parse before opening the window, so `--help` and errors need no display.
     let cli = Cli::parse();
+    if cli.print_keys {
+        print!("{}", keys::DEFAULT_KEYS);
+        return Ok(());
+    }
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
         )
+        .with_writer(std::io::stderr)
         .init();
 
-    let (net, status) = match (cli.connect, cli.cert_hash) {
-        (Some(server), Some(cert_fingerprint)) => {
-            let request = ConnectRequest {
-                server: server.clone(),
+    let bindings = match &cli.keys {
+        Some(path) => Bindings::load(path).map_err(anyhow::Error::msg)?,
+        None => Bindings::default(),
+    };
+    let script = cli
+        .script
+        .as_deref()
+        .map(Script::load)
+        .transpose()
+        .map_err(anyhow::Error::msg)?;
+    let level = match &cli.level {
+        Some(path) if !cli.local => ledge_shared::level::load_file(path)
+            .map_err(|e| anyhow::anyhow!("loading the level: {e}"))?,
+        _ => ledge_shared::level::default_level(),
+    };
+    let level_file = cli.level.clone().filter(|_| !cli.local);
+    let mut server = None;
+    let request = if cli.local {
+        let s = local::LocalServer::start()?;
+        let request = ConnectRequest {
+            server: s.addr.to_string(),
+            cert_fingerprint: s.fingerprint,
+            player_name: cli.name.clone(),
+        };
+        server = Some(s);
+        Some(request)
+    } else {
+        match (cli.connect, cli.cert_hash) {
+            (Some(server), Some(cert_fingerprint)) => Some(ConnectRequest {
+                server,
                 cert_fingerprint,
-                player_name: cli.name,
-            };
-            let net = NetThread::spawn(request)
-                .map_err(|e| anyhow::anyhow!("starting the network thread: {e}"))?;
-            (Some(net), NetStatus::Connecting(server))
+                player_name: cli.name.clone(),
+            }),
+            _ => None,
         }
-        _ => (None, NetStatus::Offline),
+    };
+    let play = match request {
+        Some(request) => play::Play::online(request, level, level_file)?,
+        None => play::Play::offline(level, &cli.name)?,
+    };
+    let setup = Setup {
+        play,
+        bindings,
+        script,
+        exit_after: cli.exit_after_ticks,
+        screenshot: cli.screenshot,
+        join_timeout: Duration::from_secs(cli.join_timeout),
+        name: cli.name,
+        debug: cli.debug,
+        look_at: cli.look_at.map(|(x, y)| vec2(x, y)),
+        server,
     };
 
     let conf = macroquad::window::Conf {
         window_title: "ledge".to_owned(),
-        window_width: 960,
-        window_height: 540,
+        window_width: cli.window.0,
+        window_height: cli.window.1,
+        window_resizable: true,
         ..Default::default()
     };
     // What `#[macroquad::main]` expands to, called directly so the command
     // line is parsed before a window exists.
-    macroquad::Window::from_config(conf, game(net, status));
-    Ok(())
+    macroquad::Window::from_config(conf, game(setup));
+    match EXIT_CODE.load(Ordering::Relaxed) {
+        0 => Ok(()),
+        code => std::process::exit(code),
+    }
 }
 
-async fn game(net: Option<NetThread>, mut status: NetStatus) {
-    let mut world = ledge_shared::scene::warmup_room();
-    let mut clock = FixedStep::new(TICK_RATE, MAX_STEPS_PER_FRAME);
+/// Fails the run: message on stderr, exit code `code`.
+fn fail(code: i32, message: &str) {
+    eprintln!("ledge-client: {message}");
+    EXIT_CODE.store(code, Ordering::Relaxed);
+}
+
+async fn game(mut setup: Setup) {
+    let started = Instant::now();
+    let mut camera = Camera::new();
+    let mut pads = Gamepads::new();
+    let mut graph = hud::NetGraph::default();
+    let mut show_debug = setup.debug;
+    let mut show_hud = true;
+    // Ticks of play so far: the script's clock and --exit-after-ticks'.
+    let mut played: u64 = 0;
+    let mut last_frame = Instant::now();
+    // Closing the window ends the loop below, so we leave the server.
+    prevent_quit();
     loop {
-        if is_key_pressed(KeyCode::Escape) {
+        if Bindings::pressed(&setup.bindings.quit) || is_quit_requested() {
             break;
         }
-        let buttons = keys::held_buttons();
-        let frame = Duration::from_secs_f32(get_frame_time().max(0.0));
-        for _ in 0..clock.advance(frame) {
-            world.step(&[buttons]);
+        if Bindings::pressed(&setup.bindings.debug) {
+            show_debug = !show_debug;
         }
-        if let Some(net) = &net {
-            while let Some(event) = net.try_recv() {
-                status.apply(event);
+        if Bindings::pressed(&setup.bindings.hud) {
+            show_hud = !show_hud;
+        }
+        let now = started.elapsed().as_secs_f64();
+        let frame = last_frame.elapsed();
+        last_frame = Instant::now();
+
+        // Simulate: the ticks due, with the script's or the player's buttons.
+        let remaining = setup
+            .exit_after
+            .map_or(u64::MAX, |n| n.saturating_sub(played));
+        let script = &setup.script;
+        let bindings = &setup.bindings;
+        let base = played;
+        played += setup.play.update(remaining, |i| match script {
+            Some(script) => script.at(base + i),
+            None => Buttons(bindings.held().0 | pads.held().0),
+        });
+        for _ in 0..setup.play.take_arrivals() {
+            graph.arrival(now);
+        }
+        let stats = setup.play.net_stats();
+        if let Some(stats) = &stats {
+            graph.rtt(now, stats.rtt_ms);
+        }
+        if setup.exit_after.is_some() {
+            if let Some(reason) = setup.play.failure() {
+                fail(2, &reason);
+                break;
+            }
+            if !setup.play.joined() && started.elapsed() > setup.join_timeout {
+                fail(2, &format!("not joined after {:?}", setup.join_timeout));
+                break;
             }
         }
-        hud::draw(&world, buttons, &status);
+
+        // What to draw, and from where.
+        let level = setup.play.level();
+        let level_px = {
+            let map = &level.tilemap;
+            let o = px2(map.origin());
+            let t = map.tile_size() as f32 / UNITS_PER_PX as f32;
+            Rect::new(o.x, o.y, map.width() as f32 * t, map.height() as f32 * t)
+        };
+        let frame_view = setup.play.view().unwrap_or_default();
+        let local: Option<PlayerSprite> = frame_view.local.as_ref().map(PlayerSprite::from);
+        let remotes: Vec<PlayerSprite> =
+            frame_view.remotes.iter().map(PlayerSprite::from).collect();
+        let entities: Vec<EntitySprite> =
+            frame_view.entities.iter().map(EntitySprite::from).collect();
+        let me = setup.play.me();
+        let focus = setup.look_at.unwrap_or_else(|| {
+            local
+                .as_ref()
+                .or(remotes.first())
+                .map_or(level_px.center(), |p| p.pos)
+        });
+        let screen = vec2(screen_width(), screen_height());
+        let view = camera.update(focus, level_px, screen, frame.as_secs_f32());
+
+        // Draw: sky, tiles, entities, players, overlays.
+        let time = now as f32;
+        render::draw_background(&view, time);
+        render::draw_tilemap(&level.tilemap, &view);
+        render::draw_entities(
+            &entities,
+            &view,
+            me.as_ref().and_then(|m| m.checkpoint),
+            time,
+        );
+        for p in &remotes {
+            let label = p.name.clone().unwrap_or_else(|| format!("player {}", p.id));
+            render::draw_player(p, &view, render::player_color(p.id, false), &label);
+        }
+        if let Some(p) = &local {
+            let label = p.name.as_deref().unwrap_or(&setup.name);
+            render::draw_player(p, &view, render::player_color(p.id, true), label);
+        }
+        if show_debug {
+            if let Some(game) = setup.play.game() {
+                debug::draw(game.game().world(), &view);
+            }
+        }
+        if show_hud {
+            let status = setup.play.status_line();
+            let info = hud::HudInfo {
+                status: &status,
+                net: stats.as_ref(),
+                fps: get_fps(),
+                tick: frame_view.tick,
+                coins: me.as_ref().map_or(0, |m| m.coins),
+                won: me.as_ref().is_some_and(|m| m.won),
+            };
+            hud::draw(&info, &graph, now);
+        }
+        if let Some(text) = setup.play.banner() {
+            hud::banner(&text);
+        }
+
+        // Done?
+        if setup.exit_after.is_some_and(|n| played >= n) {
+            if let Some(path) = &setup.screenshot {
+                let shot = shot::Shot {
+                    tick: played,
+                    view: &view,
+                    level_px,
+                    tile_px: level.tilemap.tile_size() / UNITS_PER_PX,
+                    server: setup.play.server_me(),
+                    drawn: local.as_ref().map(|p| p.pos),
+                };
+                if let Err(e) = shot::save(path, &shot) {
+                    fail(1, &format!("saving the screenshot: {e}"));
+                }
+            }
+            break;
+        }
+        // No vsync (Xvfb, some drivers): do not spin.
+        let spent = last_frame.elapsed().as_secs_f64();
+        if spent < 1.0 / MAX_FPS {
+            std::thread::sleep(Duration::from_secs_f64(1.0 / MAX_FPS - spent));
+        }
         next_frame().await;
     }
-    // Leaves the server (if connected) before the window closes.
-    drop(net);
+    // Leave the server (if connected) before the window closes, then stop
+    // the in-process server, if any.
+    drop(setup.play);
+    drop(setup.server.take());
 }

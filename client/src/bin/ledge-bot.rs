@@ -1,0 +1,218 @@
+//! `ledge-bot`: headless bots for load and robustness testing.
+//!
+//! ```sh
+//! ledge-bot --connect 127.0.0.1:4433 --cert-hash HEX --count 8 --brain runner --seconds 30
+//! ledge-bot --connect 127.0.0.1:4433 --count 4 --brain misbehave --mode flood,stale
+//! ```
+//!
+//! Runs N bots in one process on one tokio runtime, each with its own QUIC
+//! connection, clock, prediction and brain, and prints one line per bot at
+//! the end: ticks, corrections, RTT, whether the server saw it reach the
+//! goal. Without `--cert-hash` the certificate is trusted on first use
+//! (`--known-hosts`, default in the user's configuration folder).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use clap::{Parser, ValueEnum};
+use ledge_client::bot::{
+    connect_and_run, misbehave, BotOptions, Brain, Idle, Misbehavior, RandomWalker, Runner,
+};
+use ledge_client::transport::resolve;
+use ledge_client::trust::{KnownHosts, Trust};
+use ledge_client::Fingerprint;
+use ledge_shared::level::default_route;
+
+/// Which brain the bots run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum BrainKind {
+    /// Follows the default level's route to the goal.
+    Runner,
+    /// Holds nothing.
+    Idle,
+    /// Random buttons (seeded).
+    Walker,
+    /// Abuses the protocol (see --mode).
+    Misbehave,
+}
+
+/// Headless ledge bots.
+#[derive(Debug, Parser)]
+#[command(version)]
+struct Cli {
+    /// Server address, HOST:PORT.
+    #[arg(long, value_name = "HOST:PORT")]
+    connect: String,
+    /// SHA-256 fingerprint of the server certificate (else trust on first
+    /// use with --known-hosts).
+    #[arg(long, value_name = "HEX")]
+    cert_hash: Option<Fingerprint>,
+    /// Known-hosts file for trust on first use.
+    #[arg(long, value_name = "PATH")]
+    known_hosts: Option<PathBuf>,
+    /// Number of bots.
+    #[arg(long, default_value_t = 1)]
+    count: usize,
+    /// What they do.
+    #[arg(long, value_enum, default_value_t = BrainKind::Runner)]
+    brain: BrainKind,
+    /// How long they play, seconds.
+    #[arg(long, default_value_t = 30.0)]
+    seconds: f64,
+    /// Misbehaviors, comma separated, cycled over the bots (garbage,
+    /// oversized, flood, garbage-datagrams, stale, future, version; default
+    /// all).
+    #[arg(long, value_delimiter = ',')]
+    mode: Vec<String>,
+    /// Seed of the random walkers and misbehavers.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Room to join (default: the server picks).
+    #[arg(long)]
+    room: Option<String>,
+    /// The server's level file, when it is not the default level.
+    #[arg(long, value_name = "PATH")]
+    level: Option<PathBuf>,
+    /// Name prefix (bots are PREFIX-1, PREFIX-2, ...).
+    #[arg(long, default_value = "bot")]
+    name: String,
+    /// Runners leave when they reach the goal.
+    #[arg(long)]
+    stop_at_goal: bool,
+    /// Input margin kept with no jitter, ticks (more tolerates a loaded
+    /// machine: many bots planning at once).
+    #[arg(long, value_name = "TICKS")]
+    margin: Option<f64>,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let runtime = match tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+    {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("ledge-bot: cannot start the runtime: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    runtime.block_on(run(cli))
+}
+
+async fn run(cli: Cli) -> ExitCode {
+    let trust = Trust::from_args(cli.cert_hash, cli.known_hosts.clone());
+    let duration = Duration::from_secs_f64(cli.seconds.max(0.0));
+    if cli.brain == BrainKind::Misbehave {
+        return run_misbehavers(&cli, &trust, duration).await;
+    }
+    let mut tasks = Vec::new();
+    for i in 0..cli.count {
+        let mut brain: Box<dyn Brain> = match cli.brain {
+            BrainKind::Runner => Box::new(Runner::new(default_route())),
+            BrainKind::Idle => Box::new(Idle),
+            BrainKind::Walker => Box::new(RandomWalker::new(cli.seed.wrapping_add(i as u64))),
+            BrainKind::Misbehave => unreachable!("handled above"),
+        };
+        let options = BotOptions {
+            room: cli.room.clone(),
+            stop_when_done: cli.stop_at_goal,
+            level: cli.level.clone(),
+            min_margin: cli.margin,
+            ..BotOptions::new(&format!("{}-{}", cli.name, i + 1), duration)
+        };
+        let server = cli.connect.clone();
+        let trust = trust.clone();
+        tasks.push(tokio::spawn(async move {
+            connect_and_run(&server, &trust, brain.as_mut(), &options).await
+        }));
+        // Stagger the joins a little (the first one may store the host key).
+        tokio::time::sleep(Duration::from_millis(if i == 0 { 300 } else { 20 })).await;
+    }
+    let mut failed = 0;
+    let mut goals = 0;
+    println!("{} bots, brain {:?}:", cli.count, cli.brain);
+    for task in tasks {
+        match task.await {
+            Ok(report) => {
+                failed += usize::from(report.ended.is_some() && report.ticks == 0);
+                goals += usize::from(report.won);
+                println!("{report}");
+            }
+            Err(e) => {
+                failed += 1;
+                println!("a bot task failed: {e}");
+            }
+        }
+    }
+    if cli.brain == BrainKind::Runner {
+        println!(
+            "{goals}/{} reached the goal (as the server saw it)",
+            cli.count
+        );
+    }
+    if failed > 0 {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+async fn run_misbehavers(cli: &Cli, trust: &Trust, duration: Duration) -> ExitCode {
+    let modes: Vec<Misbehavior> = if cli.mode.is_empty() {
+        Misbehavior::ALL.to_vec()
+    } else {
+        match cli.mode.iter().map(|m| m.parse()).collect() {
+            Ok(m) => m,
+            Err(e) => {
+                eprintln!("ledge-bot: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    };
+    let (addr, _) = match resolve(&cli.connect).await {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("ledge-bot: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let fingerprint = match trust {
+        Trust::Pinned(pin) => *pin,
+        Trust::KnownHosts(path) => match KnownHosts::load(path) {
+            Ok(known) => match known.get(&cli.connect) {
+                Some(k) => k.fingerprint,
+                None => {
+                    eprintln!(
+                        "ledge-bot: misbehaving bots need --cert-hash (or {} in {})",
+                        cli.connect,
+                        path.display()
+                    );
+                    return ExitCode::FAILURE;
+                }
+            },
+            Err(e) => {
+                eprintln!("ledge-bot: {e}");
+                return ExitCode::FAILURE;
+            }
+        },
+    };
+    let mut tasks = Vec::new();
+    for i in 0..cli.count {
+        let mode = modes[i % modes.len()];
+        let name = format!("{}-{}", cli.name, i + 1);
+        let seed = cli.seed.wrapping_add(i as u64);
+        tasks.push(tokio::spawn(async move {
+            misbehave(addr, fingerprint, &name, mode, duration, seed).await
+        }));
+    }
+    println!("{} misbehaving bots:", cli.count);
+    for task in tasks {
+        match task.await {
+            Ok(report) => println!("{report}"),
+            Err(e) => println!("a bot task failed: {e}"),
+        }
+    }
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,695 @@
+//! Drawing the world: the tilemap, the level's entities and the players,
+//! through a [`View`] (world pixels to screen pixels). Plain shapes, no
+//! textures: every colour is in [`palette`].
+
+use ledge_client::view::{EntityType, Facing};
+use ledge_shared::fixed::UNITS_PER_PX;
+use ledge_shared::tilemap::{Slope, Tile, Tilemap};
+use macroquad::prelude::*;
+
+use crate::camera::View;
+
+/// The colours of the game.
+pub mod palette {
+    use macroquad::color::Color;
+
+    const fn rgb(r: u8, g: u8, b: u8) -> Color {
+        Color::new(r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0, 1.0)
+    }
+
+    /// The sky behind everything.
+    pub const SKY: Color = rgb(104, 164, 226);
+    /// Distant clouds.
+    pub const CLOUD: Color = rgb(236, 242, 250);
+    /// Solid ground (tiles and the body of slopes).
+    pub const SOLID: Color = rgb(124, 84, 60);
+    /// Pebbles in the ground.
+    pub const SOLID_SPECK: Color = rgb(104, 70, 50);
+    /// Edges of the ground facing empty space.
+    pub const SOLID_EDGE: Color = rgb(70, 46, 34);
+    /// Grass on exposed ground tops and slope surfaces.
+    pub const GRASS: Color = rgb(92, 184, 72);
+    /// The darker line under the grass.
+    pub const GRASS_DARK: Color = rgb(56, 128, 48);
+    /// One-way ledges (tiles).
+    pub const PLANK: Color = rgb(196, 142, 78);
+    /// Their shaded underside.
+    pub const PLANK_DARK: Color = rgb(128, 86, 44);
+    /// Spikes.
+    pub const SPIKE: Color = rgb(222, 226, 236);
+    /// Spike outlines and bases.
+    pub const SPIKE_DARK: Color = rgb(120, 30, 40);
+    /// Crates (blocks).
+    pub const CRATE: Color = rgb(186, 124, 58);
+    /// Crate boards.
+    pub const CRATE_DARK: Color = rgb(120, 74, 30);
+    /// Solid moving platforms.
+    pub const STEEL: Color = rgb(108, 120, 146);
+    /// Their outline.
+    pub const STEEL_DARK: Color = rgb(58, 64, 84);
+    /// Their lit top edge.
+    pub const STEEL_LIGHT: Color = rgb(170, 184, 210);
+    /// One-way moving platforms.
+    pub const ONE_WAY: Color = rgb(240, 196, 72);
+    /// Their see-through underside.
+    pub const ONE_WAY_GHOST: Color = Color::new(0.94, 0.77, 0.28, 0.35);
+    /// Walkers.
+    pub const WALKER: Color = rgb(170, 60, 160);
+    /// Defeated walkers.
+    pub const WALKER_DEAD: Color = Color::new(0.45, 0.45, 0.5, 0.7);
+    /// Coins.
+    pub const COIN: Color = rgb(252, 206, 40);
+    /// Coin shine.
+    pub const COIN_LIGHT: Color = rgb(255, 240, 160);
+    /// Coin rim.
+    pub const COIN_DARK: Color = rgb(186, 132, 18);
+    /// Springboard pads.
+    pub const SPRING: Color = rgb(226, 62, 62);
+    /// Springboard coils and bases.
+    pub const METAL: Color = rgb(150, 156, 168);
+    /// Poles of checkpoints and the goal.
+    pub const POLE: Color = rgb(236, 236, 240);
+    /// A checkpoint that is the local player's respawn point.
+    pub const FLAG_ACTIVE: Color = rgb(64, 224, 120);
+    /// Other checkpoints.
+    pub const FLAG_IDLE: Color = rgb(140, 140, 152);
+    /// The goal.
+    pub const GOAL: Color = rgb(255, 208, 32);
+    /// Outlines of dark things and eye pupils.
+    pub const INK: Color = rgb(24, 20, 30);
+    /// Eyes.
+    pub const EYE: Color = rgb(255, 255, 255);
+    /// The local player.
+    pub const LOCAL_PLAYER: Color = rgb(255, 132, 24);
+    /// Other players, by id.
+    pub const REMOTE_PLAYERS: [Color; 4] = [
+        rgb(64, 210, 255),
+        rgb(190, 120, 255),
+        rgb(130, 236, 110),
+        rgb(255, 110, 186),
+    ];
+
+    /// A colour as `[r, g, b]` bytes (for the screenshot JSON).
+    pub fn bytes(c: Color) -> [u8; 3] {
+        let b = |v: f32| (v * 255.0).round() as u8;
+        [b(c.r), b(c.g), b(c.b)]
+    }
+}
+
+/// A player to draw (world pixels: centre and full size).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlayerSprite {
+    /// Its id.
+    pub id: u32,
+    /// Its name, when known.
+    pub name: Option<String>,
+    /// Centre of its box.
+    pub pos: Vec2,
+    /// Full size of its box.
+    pub size: Vec2,
+    /// Which way it looks.
+    pub facing: Facing,
+    /// Reached the goal (wears a crown).
+    pub won: bool,
+}
+
+/// A level entity to draw (world pixels: centre and full size).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EntitySprite {
+    /// Its id.
+    pub id: u32,
+    /// What it is.
+    pub kind: EntityType,
+    /// Centre of its box.
+    pub pos: Vec2,
+    /// Full size of its box.
+    pub size: Vec2,
+    /// A walker not defeated, a coin not picked up.
+    pub active: bool,
+    /// A one-way platform.
+    pub one_way: bool,
+    /// A walker's direction.
+    pub facing: Facing,
+}
+
+impl EntitySprite {
+    fn top_left(&self) -> Vec2 {
+        self.pos - self.size * 0.5
+    }
+}
+
+impl PlayerSprite {
+    fn top_left(&self) -> Vec2 {
+        self.pos - self.size * 0.5
+    }
+}
+
+/// Pixels per unit.
+const PX: f32 = 1.0 / UNITS_PER_PX as f32;
+
+/// Draws a world-space rectangle (top-left `x, y`, size `w, h`, world px).
+fn rect(view: &View, x: f32, y: f32, w: f32, h: f32, color: Color) {
+    let p = view.to_screen(vec2(x, y));
+    draw_rectangle(p.x, p.y, w * view.zoom, h * view.zoom, color);
+}
+
+/// Draws a world-space triangle.
+fn tri(view: &View, a: Vec2, b: Vec2, c: Vec2, color: Color) {
+    draw_triangle(
+        view.to_screen(a),
+        view.to_screen(b),
+        view.to_screen(c),
+        color,
+    );
+}
+
+/// Draws a world-space line `thickness` world px thick.
+fn line(view: &View, a: Vec2, b: Vec2, thickness: f32, color: Color) {
+    let (a, b) = (view.to_screen(a), view.to_screen(b));
+    draw_line(a.x, a.y, b.x, b.y, thickness * view.zoom, color);
+}
+
+/// Draws a world-space convex quad (corners in order).
+fn quad(view: &View, p: [Vec2; 4], color: Color) {
+    tri(view, p[0], p[1], p[2], color);
+    tri(view, p[0], p[2], p[3], color);
+}
+
+/// Clouds: `(x, y, width)` in pixels of a far layer that scrolls at half
+/// the camera's speed (so they seem far away).
+const CLOUDS: [(f32, f32, f32); 7] = [
+    (60.0, 40.0, 56.0),
+    (260.0, 70.0, 40.0),
+    (430.0, 30.0, 72.0),
+    (640.0, 84.0, 48.0),
+    (820.0, 44.0, 64.0),
+    (1040.0, 76.0, 44.0),
+    (1240.0, 36.0, 60.0),
+];
+/// Clouds move this fraction of the camera's motion.
+const CLOUD_PARALLAX: f32 = 0.5;
+
+/// Clears to the sky and draws distant clouds (high up, behind
+/// everything).
+pub fn draw_background(view: &View, time: f32) {
+    clear_background(palette::SKY);
+    // Horizontally at parallax; vertically almost fixed, in the upper part
+    // of the screen.
+    let far = View {
+        offset: vec2(
+            view.offset.x * CLOUD_PARALLAX,
+            view.offset.y * 0.1 + 40.0 * view.zoom,
+        ),
+        ..*view
+    };
+    // The cloud band repeats every this many world pixels.
+    let period = 1400.0;
+    let drift = time * 2.0;
+    let left = far.to_world(Vec2::ZERO).x;
+    let right = far.to_world(view.screen).x;
+    for &(x, y, w) in &CLOUDS {
+        let mut cx = (x + drift - left).rem_euclid(period) + left - w;
+        while cx < right + w {
+            cloud(&far, cx, y, w);
+            cx += period;
+        }
+    }
+}
+
+fn cloud(view: &View, x: f32, y: f32, w: f32) {
+    let c = palette::CLOUD;
+    for (dx, dy, r) in [(0.2, 0.1, 0.16), (0.45, -0.05, 0.22), (0.72, 0.08, 0.17)] {
+        let p = view.to_screen(vec2(x + dx * w, y + dy * w));
+        draw_circle(p.x, p.y, r * w * view.zoom, c);
+    }
+    rect(view, x + 0.12 * w, y + 0.1 * w, 0.72 * w, 0.14 * w, c);
+}
+
+/// Surface heights of a slope at its left and right tile edges, in units
+/// above the tile's bottom: the ends of the straight line
+/// [`Slope::height`] follows (`height(0)` and its value extended to
+/// `x = T`).
+pub fn slope_ends(slope: Slope, t: i32) -> (i32, i32) {
+    match slope {
+        Slope::Right45 => (0, t),
+        Slope::Left45 => (t, 0),
+        Slope::RightLow22 => (0, t / 2),
+        Slope::RightHigh22 => (t / 2, t),
+        Slope::LeftHigh22 => (t, t / 2),
+        Slope::LeftLow22 => (t / 2, 0),
+    }
+}
+
+/// Whether `tile` covers the top of the tile below it (no grass there).
+fn covers_below(tile: Tile) -> bool {
+    matches!(tile, Tile::Solid | Tile::Slope(_))
+}
+
+/// Draws the tiles of `map` that `view` shows.
+pub fn draw_tilemap(map: &Tilemap, view: &View) {
+    let t = map.tile_size() as f32 * PX;
+    let origin = vec2(map.origin().x as f32, map.origin().y as f32) * PX;
+    let seen = view.visible();
+    let col0 = (((seen.x - origin.x) / t).floor() as i64).max(0);
+    let row0 = (((seen.y - origin.y) / t).floor() as i64).max(0);
+    let col1 = (((seen.right() - origin.x) / t).ceil() as i64).min(map.width() as i64);
+    let row1 = (((seen.bottom() - origin.y) / t).ceil() as i64).min(map.height() as i64);
+    let at = |c: i64, r: i64| map.tile(IVec2::new(c as i32, r as i32));
+    // Edge lines: one world pixel.
+    let hair = 1.0;
+    let mut grass = Vec::new();
+    for r in row0..row1 {
+        for c in col0..col1 {
+            let (x, y) = (origin.x + c as f32 * t, origin.y + r as f32 * t);
+            match at(c, r) {
+                Tile::Empty => {}
+                Tile::Solid => {
+                    rect(view, x, y, t, t, palette::SOLID);
+                    // Pebbles, away from the tile's centre.
+                    let h = (c * 7 + r * 13).rem_euclid(5);
+                    if h == 0 {
+                        rect(view, x + 2.0, y + 10.0, 3.0, 2.0, palette::SOLID_SPECK);
+                    } else if h == 3 {
+                        rect(view, x + 11.0, y + 3.0, 2.0, 2.0, palette::SOLID_SPECK);
+                    }
+                    // Slopes lean on their neighbours: no edge line there.
+                    let exposed = |dc: i64, dr: i64| {
+                        !matches!(at(c + dc, r + dr), Tile::Solid | Tile::Slope(_))
+                    };
+                    if exposed(-1, 0) {
+                        rect(view, x, y, hair, t, palette::SOLID_EDGE);
+                    }
+                    if exposed(1, 0) {
+                        rect(view, x + t - hair, y, hair, t, palette::SOLID_EDGE);
+                    }
+                    if exposed(0, 1) {
+                        rect(view, x, y + t - hair, t, hair, palette::SOLID_EDGE);
+                    }
+                    if !covers_below(at(c, r - 1)) {
+                        rect(view, x, y, t, 3.0, palette::GRASS);
+                        rect(view, x, y + 3.0, t, 1.0, palette::GRASS_DARK);
+                    }
+                }
+                Tile::Slope(s) => {
+                    let (hl, hr) = slope_ends(s, map.tile_size());
+                    let b = y + t;
+                    let (l, rr) = (b - hl as f32 * PX, b - hr as f32 * PX);
+                    quad(
+                        view,
+                        [vec2(x, b), vec2(x, l), vec2(x + t, rr), vec2(x + t, b)],
+                        palette::SOLID,
+                    );
+                    // Grass below the exact surface line, drawn after the
+                    // tiles below (it reaches into them at the low end).
+                    grass.push([
+                        vec2(x, l),
+                        vec2(x + t, rr),
+                        vec2(x + t, rr + 3.0),
+                        vec2(x, l + 3.0),
+                    ]);
+                }
+                Tile::OneWay => {
+                    rect(view, x, y, t, 4.0, palette::PLANK);
+                    rect(view, x, y + 3.0, t, 1.0, palette::PLANK_DARK);
+                    // Little brackets under the ends of a run of ledges.
+                    if !matches!(at(c - 1, r), Tile::OneWay) {
+                        tri(
+                            view,
+                            vec2(x + 1.0, y + 4.0),
+                            vec2(x + 5.0, y + 4.0),
+                            vec2(x + 1.0, y + 8.0),
+                            palette::PLANK_DARK,
+                        );
+                    }
+                    if !matches!(at(c + 1, r), Tile::OneWay) {
+                        tri(
+                            view,
+                            vec2(x + t - 5.0, y + 4.0),
+                            vec2(x + t - 1.0, y + 4.0),
+                            vec2(x + t - 1.0, y + 8.0),
+                            palette::PLANK_DARK,
+                        );
+                    }
+                }
+                Tile::Hazard => spikes(view, Rect::new(x, y, t, t)),
+            }
+        }
+    }
+    for band in grass {
+        quad(view, band, palette::GRASS);
+    }
+}
+
+/// A row of spikes standing on the bottom of `area` (world px).
+fn spikes(view: &View, area: Rect) {
+    let n = (area.w / 4.0).round().max(1.0);
+    let w = area.w / n;
+    let h = (area.h * 0.7).min(11.0);
+    let b = area.bottom();
+    rect(view, area.x, b - 2.0, area.w, 2.0, palette::SPIKE_DARK);
+    for i in 0..n as usize {
+        let x = area.x + i as f32 * w;
+        tri(
+            view,
+            vec2(x, b - 1.0),
+            vec2(x + w / 2.0, b - h),
+            vec2(x + w, b - 1.0),
+            palette::SPIKE,
+        );
+        line(
+            view,
+            vec2(x + w / 2.0, b - h),
+            vec2(x + w, b - 1.0),
+            0.75,
+            palette::SPIKE_DARK,
+        );
+    }
+}
+
+/// Draws the level's entities. `checkpoint`: the local player's respawn
+/// checkpoint (drawn raised); `time`: seconds, for small animations.
+pub fn draw_entities(entities: &[EntitySprite], view: &View, checkpoint: Option<u32>, time: f32) {
+    let seen = view.visible();
+    for e in entities {
+        let tl = e.top_left();
+        let area = Rect::new(tl.x, tl.y, e.size.x, e.size.y);
+        // Poles and flags reach above their box.
+        let margin = Rect::new(area.x - 16.0, area.y - 48.0, area.w + 32.0, area.h + 64.0);
+        if !margin.overlaps(&seen) {
+            continue;
+        }
+        match e.kind {
+            EntityType::Spawn => {}
+            EntityType::Block => crate_box(view, area),
+            EntityType::Platform if e.one_way => {
+                rect(view, area.x, area.y, area.w, area.h, palette::ONE_WAY_GHOST);
+                rect(view, area.x, area.y, area.w, 4.0, palette::ONE_WAY);
+                rect(view, area.x, area.y + 4.0, area.w, 1.0, palette::PLANK_DARK);
+                // Chevrons: passable from below.
+                let n = (area.w / 12.0).floor().max(1.0) as usize;
+                for i in 0..n {
+                    let cx = area.x + (i as f32 + 0.5) * area.w / n as f32;
+                    let cy = area.y + area.h * 0.65;
+                    line(
+                        view,
+                        vec2(cx - 3.0, cy + 2.0),
+                        vec2(cx, cy - 1.0),
+                        1.0,
+                        palette::ONE_WAY,
+                    );
+                    line(
+                        view,
+                        vec2(cx, cy - 1.0),
+                        vec2(cx + 3.0, cy + 2.0),
+                        1.0,
+                        palette::ONE_WAY,
+                    );
+                }
+            }
+            EntityType::Platform => {
+                rect(view, area.x, area.y, area.w, area.h, palette::STEEL_DARK);
+                rect(
+                    view,
+                    area.x + 1.0,
+                    area.y + 1.0,
+                    area.w - 2.0,
+                    area.h - 2.0,
+                    palette::STEEL,
+                );
+                rect(
+                    view,
+                    area.x + 1.0,
+                    area.y + 1.0,
+                    area.w - 2.0,
+                    2.0,
+                    palette::STEEL_LIGHT,
+                );
+                for x in [area.x + 4.0, area.right() - 4.0] {
+                    let p = view.to_screen(vec2(x, area.y + area.h * 0.6));
+                    draw_circle(p.x, p.y, view.zoom, palette::STEEL_DARK);
+                }
+            }
+            EntityType::Walker => walker(view, area, e.active, e.facing, time),
+            EntityType::Springboard => springboard(view, area),
+            EntityType::Coin if e.active => coin(view, area, e.id, time),
+            EntityType::Coin => {}
+            EntityType::Checkpoint => {
+                let raised = checkpoint == Some(e.id);
+                flag(
+                    view,
+                    area,
+                    if raised {
+                        palette::FLAG_ACTIVE
+                    } else {
+                        palette::FLAG_IDLE
+                    },
+                    raised,
+                );
+            }
+            EntityType::Goal => {
+                // A golden pedestal, the flag, and a pulsing star above.
+                rect(
+                    view,
+                    area.x,
+                    area.bottom() - 4.0,
+                    area.w,
+                    4.0,
+                    palette::COIN_DARK,
+                );
+                rect(
+                    view,
+                    area.x + 1.0,
+                    area.bottom() - 4.0,
+                    area.w - 2.0,
+                    2.5,
+                    palette::GOAL,
+                );
+                flag(view, area, palette::GOAL, true);
+                let top = area.bottom() - area.h.max(24.0);
+                let c = vec2(area.center().x, top - 7.0);
+                let r = 4.5 + 0.8 * (time * 4.0).sin();
+                let star = |k: f32| {
+                    let a = std::f32::consts::FRAC_PI_2 + k * std::f32::consts::TAU / 3.0;
+                    c - vec2(a.cos(), a.sin()) * r
+                };
+                let down = |k: f32| {
+                    let a = -std::f32::consts::FRAC_PI_2 + k * std::f32::consts::TAU / 3.0;
+                    c - vec2(a.cos(), a.sin()) * r
+                };
+                tri(view, star(0.0), star(1.0), star(2.0), palette::GOAL);
+                tri(view, down(0.0), down(1.0), down(2.0), palette::GOAL);
+            }
+            EntityType::Hazard => spikes(view, area),
+        }
+    }
+}
+
+fn crate_box(view: &View, a: Rect) {
+    rect(view, a.x, a.y, a.w, a.h, palette::CRATE_DARK);
+    rect(
+        view,
+        a.x + 1.5,
+        a.y + 1.5,
+        a.w - 3.0,
+        a.h - 3.0,
+        palette::CRATE,
+    );
+    line(
+        view,
+        vec2(a.x + 2.0, a.y + 2.0),
+        vec2(a.right() - 2.0, a.bottom() - 2.0),
+        1.5,
+        palette::CRATE_DARK,
+    );
+    line(
+        view,
+        vec2(a.right() - 2.0, a.y + 2.0),
+        vec2(a.x + 2.0, a.bottom() - 2.0),
+        1.5,
+        palette::CRATE_DARK,
+    );
+}
+
+fn walker(view: &View, a: Rect, alive: bool, facing: Facing, time: f32) {
+    if !alive {
+        let h = (a.h * 0.3).max(2.0);
+        rect(view, a.x, a.bottom() - h, a.w, h, palette::WALKER_DEAD);
+        return;
+    }
+    let bob = ((time * 10.0).sin() * 0.75).round();
+    // Feet, body, eyes.
+    for fx in [a.x + 1.0, a.right() - 4.0] {
+        rect(view, fx, a.bottom() - 2.0, 3.0, 2.0, palette::INK);
+    }
+    let body = Rect::new(a.x, a.y + bob, a.w, a.h - 2.0 - bob);
+    rect(view, body.x, body.y, body.w, body.h, palette::INK);
+    rect(
+        view,
+        body.x + 1.0,
+        body.y + 1.0,
+        body.w - 2.0,
+        body.h - 2.0,
+        palette::WALKER,
+    );
+    eyes(view, body, facing);
+}
+
+/// Two eyes in the upper part of `body`, looking towards `facing`.
+fn eyes(view: &View, body: Rect, facing: Facing) {
+    let cx = body.center().x + facing.sign() * body.w * 0.15;
+    let y = body.y + body.h * 0.22;
+    for dx in [-0.2, 0.2] {
+        let x = cx + dx * body.w - 1.25;
+        rect(view, x, y, 2.5, 3.5, palette::EYE);
+        let px = x + if facing == Facing::Left { 0.0 } else { 1.25 };
+        rect(view, px, y + 1.0, 1.25, 2.0, palette::INK);
+    }
+}
+
+fn springboard(view: &View, a: Rect) {
+    let b = a.bottom();
+    let plate = (a.h * 0.25).clamp(1.5, 3.0);
+    rect(view, a.x + 1.0, b - plate, a.w - 2.0, plate, palette::METAL);
+    // A zigzag coil from the base to the pad.
+    let (low, high) = (b - plate, a.y + plate);
+    let n = ((low - high) / 2.0).floor().max(2.0) as usize;
+    let step = (low - high) / n as f32;
+    for i in 0..n {
+        let y0 = low - i as f32 * step;
+        let (x0, x1) = if i % 2 == 0 {
+            (a.x + 3.0, a.right() - 3.0)
+        } else {
+            (a.right() - 3.0, a.x + 3.0)
+        };
+        line(view, vec2(x0, y0), vec2(x1, y0 - step), 1.0, palette::METAL);
+    }
+    rect(view, a.x - 1.0, a.y, a.w + 2.0, plate, palette::SPRING);
+    rect(
+        view,
+        a.x - 1.0,
+        a.y + plate - 0.75,
+        a.w + 2.0,
+        0.75,
+        palette::INK,
+    );
+}
+
+fn coin(view: &View, a: Rect, id: u32, time: f32) {
+    let c = a.center();
+    let r = a.w.min(a.h) * 0.4;
+    // Spin: the coin's width follows a cosine, each coin in its own phase.
+    let phase = (id % 7) as f32 * 0.9;
+    let squash = (time * 3.0 + phase).cos().abs().max(0.25);
+    let p = view.to_screen(c);
+    let (w, h) = (r * squash * view.zoom, r * view.zoom);
+    draw_ellipse(p.x, p.y, w, h, 0.0, palette::COIN_DARK);
+    draw_ellipse(p.x, p.y, w * 0.78, h * 0.85, 0.0, palette::COIN);
+    draw_ellipse(
+        p.x - w * 0.25,
+        p.y - h * 0.3,
+        w * 0.2,
+        h * 0.25,
+        0.0,
+        palette::COIN_LIGHT,
+    );
+}
+
+/// A flag on a pole standing on the bottom of `a`; `raised`: at the top.
+fn flag(view: &View, a: Rect, color: Color, raised: bool) {
+    let x = a.center().x - 0.5;
+    let top = a.bottom() - a.h.max(24.0);
+    rect(view, x, top, 1.5, a.bottom() - top, palette::POLE);
+    rect(view, x - 2.0, a.bottom() - 2.0, 5.5, 2.0, palette::POLE);
+    let fy = if raised {
+        top
+    } else {
+        top + (a.bottom() - top) * 0.5
+    };
+    tri(
+        view,
+        vec2(x + 1.5, fy),
+        vec2(x + 12.0, fy + 4.0),
+        vec2(x + 1.5, fy + 8.0),
+        color,
+    );
+}
+
+/// The colour of player `id` (ours: [`palette::LOCAL_PLAYER`]).
+pub fn player_color(id: u32, local: bool) -> Color {
+    if local {
+        palette::LOCAL_PLAYER
+    } else {
+        palette::REMOTE_PLAYERS[id as usize % palette::REMOTE_PLAYERS.len()]
+    }
+}
+
+/// Draws a player, with `label` above its head.
+pub fn draw_player(p: &PlayerSprite, view: &View, color: Color, label: &str) {
+    let tl = p.top_left();
+    let a = Rect::new(tl.x, tl.y, p.size.x, p.size.y);
+    rect(view, a.x, a.y, a.w, a.h, palette::INK);
+    rect(view, a.x + 1.0, a.y + 1.0, a.w - 2.0, a.h - 2.0, color);
+    // A belt, then the eyes.
+    let belt = Color::new(color.r * 0.6, color.g * 0.6, color.b * 0.6, 1.0);
+    rect(view, a.x + 1.0, a.y + a.h * 0.72, a.w - 2.0, 1.5, belt);
+    eyes(view, Rect::new(a.x, a.y, a.w, a.h * 0.8), p.facing);
+    if p.won {
+        let c = a.center().x;
+        for dx in [-4.0, 0.0, 4.0] {
+            tri(
+                view,
+                vec2(c + dx - 2.0, a.y - 1.0),
+                vec2(c + dx, a.y - 5.0),
+                vec2(c + dx + 2.0, a.y - 1.0),
+                palette::GOAL,
+            );
+        }
+    }
+    if !label.is_empty() {
+        let size = 16.0;
+        let dims = measure_text(label, None, size as u16, 1.0);
+        let head = view.to_screen(vec2(a.center().x, a.y));
+        let x = (head.x - dims.width / 2.0).round();
+        let y = (head.y - 8.0 - if p.won { 4.0 * view.zoom } else { 0.0 }).round();
+        draw_rectangle(
+            x - 3.0,
+            y - dims.offset_y - 2.0,
+            dims.width + 6.0,
+            dims.height + 4.0,
+            Color::new(0.0, 0.0, 0.0, 0.45),
+        );
+        draw_text(label, x, y, size, WHITE);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slope_ends_follow_the_surface() {
+        let t = 4096;
+        for s in Slope::ALL {
+            let (l, r) = slope_ends(s, t);
+            assert_eq!(l, s.height(0, t), "{s:?} left end");
+            // The last unit column is within one unit of the line's end.
+            let last = s.height(t - 1, t);
+            assert!((r - last).abs() <= 1, "{s:?}: {r} vs {last}");
+        }
+    }
+
+    #[test]
+    fn colours_are_distinct_where_tests_look() {
+        let all = [
+            palette::SKY,
+            palette::SOLID,
+            palette::GRASS,
+            palette::LOCAL_PLAYER,
+        ];
+        for (i, a) in all.iter().enumerate() {
+            for b in &all[i + 1..] {
+                assert_ne!(palette::bytes(*a), palette::bytes(*b));
+            }
+        }
+    }
+}

@@ -1,0 +1,167 @@
+//! Scripted input (`--script FILE|INLINE`): which buttons are held at which
+//! tick, for tests, demos and screenshots.
+//!
+//! A script is a list of entries separated by newlines or `;`, each
+//! `TICKS -> BUTTONS` (or `TICKS: BUTTONS`):
+//!
+//! * `TICKS` counts simulated ticks from the start of play (the first tick
+//!   after joining, or the first offline tick), starting at 0: `N` (one
+//!   tick), `N-M` (inclusive) or `N..M` (`M` excluded);
+//! * `BUTTONS` is a list of `left`, `right`, `up`, `down`, `jump` (or
+//!   `l r u d j`) joined by `+`, `,` or spaces; `none` or `-` for nothing.
+//!
+//! Ticks no entry covers hold nothing; where entries overlap, their buttons
+//! combine. `#` starts a comment.
+//!
+//! ```text
+//! 0-59 -> right          # run right for a second
+//! 30..34 -> jump         # jumping on the way
+//! 120 -> down+jump       # drop through a one-way ledge
+//! ```
+
+use ledge_shared::input::Buttons;
+
+/// One entry: ticks `start..end` hold `buttons`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Entry {
+    start: u64,
+    end: u64,
+    buttons: u8,
+}
+
+/// A parsed script.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Script {
+    entries: Vec<Entry>,
+}
+
+impl Script {
+    /// Reads `arg`: the file at that path if there is one, else the text
+    /// itself.
+    pub fn load(arg: &str) -> Result<Script, String> {
+        let path = std::path::Path::new(arg);
+        if path.is_file() {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| format!("reading script {}: {e}", path.display()))?;
+            Script::parse(&text).map_err(|e| format!("{}: {e}", path.display()))
+        } else {
+            Script::parse(arg).map_err(|e| format!("inline script: {e}"))
+        }
+    }
+
+    /// Parses script text (see the module documentation).
+    pub fn parse(text: &str) -> Result<Script, String> {
+        let mut entries = Vec::new();
+        for (n, line) in text.lines().enumerate() {
+            let line = line.split('#').next().unwrap_or("");
+            for part in line.split(';') {
+                let part = part.trim();
+                if part.is_empty() {
+                    continue;
+                }
+                let entry = parse_entry(part).map_err(|e| format!("line {}: {e}", n + 1))?;
+                entries.push(entry);
+            }
+        }
+        Ok(Script { entries })
+    }
+
+    /// The buttons held at `tick`.
+    pub fn at(&self, tick: u64) -> Buttons {
+        let bits = self
+            .entries
+            .iter()
+            .filter(|e| (e.start..e.end).contains(&tick))
+            .fold(0, |acc, e| acc | e.buttons);
+        Buttons(bits)
+    }
+}
+
+fn parse_entry(part: &str) -> Result<Entry, String> {
+    let (ticks, buttons) = part
+        .split_once("->")
+        .or_else(|| part.split_once(':'))
+        .ok_or_else(|| format!("{part:?}: expected `TICKS -> BUTTONS`"))?;
+    let (start, end) = parse_ticks(ticks.trim())?;
+    let buttons = parse_buttons(buttons.trim())?;
+    Ok(Entry {
+        start,
+        end,
+        buttons,
+    })
+}
+
+fn parse_ticks(s: &str) -> Result<(u64, u64), String> {
+    let num = |t: &str| {
+        t.trim()
+            .parse::<u64>()
+            .map_err(|_| format!("{t:?} is not a tick number"))
+    };
+    let (start, end) = if let Some((a, b)) = s.split_once("..") {
+        (num(a)?, num(b)?)
+    } else if let Some((a, b)) = s.split_once('-') {
+        (num(a)?, num(b)?.saturating_add(1))
+    } else {
+        let t = num(s)?;
+        (t, t.saturating_add(1))
+    };
+    if end <= start {
+        return Err(format!("empty tick range {s:?}"));
+    }
+    Ok((start, end))
+}
+
+fn parse_buttons(s: &str) -> Result<u8, String> {
+    let mut bits = 0;
+    for word in s.split(['+', ',', ' ', '\t']).filter(|w| !w.is_empty()) {
+        bits |= match word.to_ascii_lowercase().as_str() {
+            "left" | "l" => Buttons::LEFT,
+            "right" | "r" => Buttons::RIGHT,
+            "up" | "u" => Buttons::UP,
+            "down" | "d" => Buttons::DOWN,
+            "jump" | "j" => Buttons::JUMP,
+            "none" | "-" => 0,
+            other => {
+                return Err(format!(
+                    "unknown button {other:?} (left, right, up, down, jump, none)"
+                ))
+            }
+        };
+    }
+    Ok(bits)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_ranges_buttons_and_comments() {
+        let s = Script::parse(
+            "0-59 -> right   # run\n30..34: jump; 120 -> down+jump\n\n200..210 -> L,J\n300 -> none",
+        )
+        .unwrap();
+        assert_eq!(s.at(0), Buttons(Buttons::RIGHT));
+        assert_eq!(s.at(59), Buttons(Buttons::RIGHT));
+        assert_eq!(s.at(60), Buttons::NONE);
+        assert_eq!(s.at(31), Buttons(Buttons::RIGHT | Buttons::JUMP));
+        assert_eq!(s.at(34), Buttons(Buttons::RIGHT));
+        assert_eq!(s.at(120), Buttons(Buttons::DOWN | Buttons::JUMP));
+        assert_eq!(s.at(205), Buttons(Buttons::LEFT | Buttons::JUMP));
+        assert_eq!(s.at(300), Buttons::NONE);
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let e = Script::parse("0-5 -> right\n7 -> fly").unwrap_err();
+        assert!(e.contains("line 2") && e.contains("fly"), "{e}");
+        assert!(Script::parse("9-3 -> right").is_err());
+        assert!(Script::parse("right").is_err());
+    }
+
+    #[test]
+    fn inline_when_no_such_file() {
+        let s = Script::load("0..2 -> jump").unwrap();
+        assert_eq!(s.at(1), Buttons(Buttons::JUMP));
+    }
+}

@@ -1,0 +1,175 @@
+//! `--screenshot PATH`: the frame as a PNG, and `PATH.json` beside it
+//! describing where things are on it, so a test can check pixels:
+//!
+//! ```json
+//! {
+//!   "png": "shot.png",
+//!   "tick": 150,                       // ticks of play when taken
+//!   "screen": [960, 540],              // PNG size, pixels
+//!   "camera": {"zoom": 2.0, "offset": [-12.0, -420.0]},
+//!                                      // screen = world_px * zoom + offset
+//!   "level_px": [0, 0, 1600, 480],     // x, y, w, h in world pixels
+//!   "tile_px": 16,
+//!   "player": {                        // null before the first snapshot
+//!     "id": 1,
+//!     "server_tick": 148,              // tick of the authoritative state
+//!     "server_pos_units": [21504, 106496],
+//!     "server_pos_px": [84.0, 416.0],  // centre of the box
+//!     "server_screen": [156.0, 412.0], // that centre on the screen
+//!     "size_px": [12.0, 16.0],
+//!     "drawn_screen": [156.0, 412.0]   // where it was drawn (predicted)
+//!   },
+//!   "colors": {"sky": [r, g, b], "solid": [...], "grass": [...],
+//!              "local_player": [...], "one_way": [...]}
+//! }
+//! ```
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use glam::IVec2;
+use macroquad::math::{Rect, Vec2};
+use macroquad::texture::get_screen_data;
+
+use crate::camera::View;
+use crate::render::palette;
+
+/// What a screenshot records.
+pub struct Shot<'a> {
+    /// Ticks of play.
+    pub tick: u64,
+    /// The frame's camera.
+    pub view: &'a View,
+    /// The level's bounds, world pixels.
+    pub level_px: Rect,
+    /// Tile size, pixels.
+    pub tile_px: i32,
+    /// Our player as the server last said: `(tick, id, centre, half
+    /// extents)` in units.
+    pub server: Option<(u64, u32, IVec2, IVec2)>,
+    /// Where our player was drawn (world px, centre).
+    pub drawn: Option<Vec2>,
+}
+
+/// The JSON path for screenshot `png`: `png` with `.json` appended.
+pub fn json_path(png: &Path) -> PathBuf {
+    let mut s = png.as_os_str().to_owned();
+    s.push(".json");
+    PathBuf::from(s)
+}
+
+/// Saves the current frame to `path` and the description beside it.
+pub fn save(path: &Path, shot: &Shot) -> std::io::Result<()> {
+    let image = get_screen_data();
+    let text = path
+        .to_str()
+        .ok_or_else(|| std::io::Error::other("the screenshot path is not UTF-8"))?;
+    image.export_png(text);
+    let json = describe(shot, path, image.width, image.height);
+    std::fs::write(json_path(path), json)
+}
+
+fn pair(v: Vec2) -> String {
+    format!("[{:.3}, {:.3}]", v.x, v.y)
+}
+
+fn rgb(c: macroquad::color::Color) -> String {
+    let [r, g, b] = palette::bytes(c);
+    format!("[{r}, {g}, {b}]")
+}
+
+/// The JSON text (see the module documentation).
+pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
+    let v = shot.view;
+    let px = |u: IVec2| Vec2::new(u.x as f32, u.y as f32) / 256.0;
+    let mut s = String::from("{\n");
+    let name = png
+        .file_name()
+        .map(|n| n.to_string_lossy().replace(['"', '\\'], "_"))
+        .unwrap_or_default();
+    let _ = writeln!(s, "  \"png\": \"{name}\",");
+    let _ = writeln!(s, "  \"tick\": {},", shot.tick);
+    let _ = writeln!(s, "  \"screen\": [{width}, {height}],");
+    let _ = writeln!(
+        s,
+        "  \"camera\": {{\"zoom\": {:.4}, \"offset\": {}}},",
+        v.zoom,
+        pair(v.offset)
+    );
+    let l = shot.level_px;
+    let _ = writeln!(s, "  \"level_px\": [{}, {}, {}, {}],", l.x, l.y, l.w, l.h);
+    let _ = writeln!(s, "  \"tile_px\": {},", shot.tile_px);
+    match shot.server {
+        Some((tick, id, pos, half)) => {
+            let p = px(pos);
+            let _ = writeln!(s, "  \"player\": {{");
+            let _ = writeln!(s, "    \"id\": {id},");
+            let _ = writeln!(s, "    \"server_tick\": {tick},");
+            let _ = writeln!(s, "    \"server_pos_units\": [{}, {}],", pos.x, pos.y);
+            let _ = writeln!(s, "    \"server_pos_px\": {},", pair(p));
+            let _ = writeln!(s, "    \"server_screen\": {},", pair(v.to_screen(p)));
+            let _ = writeln!(s, "    \"size_px\": {},", pair(px(half * 2)));
+            match shot.drawn {
+                Some(d) => {
+                    let _ = writeln!(s, "    \"drawn_screen\": {}", pair(v.to_screen(d)));
+                }
+                None => {
+                    let _ = writeln!(s, "    \"drawn_screen\": null");
+                }
+            }
+            let _ = writeln!(s, "  }},");
+        }
+        None => {
+            let _ = writeln!(s, "  \"player\": null,");
+        }
+    }
+    let _ = writeln!(
+        s,
+        "  \"colors\": {{\"sky\": {}, \"solid\": {}, \"grass\": {}, \"local_player\": {}, \"one_way\": {}}}",
+        rgb(palette::SKY),
+        rgb(palette::SOLID),
+        rgb(palette::GRASS),
+        rgb(palette::LOCAL_PLAYER),
+        rgb(palette::PLANK),
+    );
+    s.push_str("}\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_names_the_player_on_screen() {
+        let view = View {
+            zoom: 2.0,
+            offset: Vec2::new(-10.0, -20.0),
+            screen: Vec2::new(960.0, 540.0),
+        };
+        let shot = Shot {
+            tick: 7,
+            view: &view,
+            level_px: Rect::new(0.0, 0.0, 1600.0, 480.0),
+            tile_px: 16,
+            server: Some((
+                5,
+                3,
+                IVec2::new(256 * 100, 256 * 50),
+                IVec2::new(1536, 2048),
+            )),
+            drawn: Some(Vec2::new(100.0, 50.0)),
+        };
+        let json = describe(&shot, Path::new("/tmp/a.png"), 960, 540);
+        assert!(
+            json.contains("\"server_screen\": [190.000, 80.000]"),
+            "{json}"
+        );
+        assert!(json.contains("\"size_px\": [12.000, 16.000]"), "{json}");
+        assert!(json.contains("\"png\": \"a.png\""), "{json}");
+        assert_eq!(
+            json_path(Path::new("x/s.png")),
+            PathBuf::from("x/s.png.json")
+        );
+    }
+}

@@ -1,0 +1,122 @@
+//! Bot brains: what a bot presses each tick, given the predicted game.
+//!
+//! A [`Brain`] is asked once per local tick, before that tick is
+//! predicted, with the predicted [`Game`] as it stands (exactly the
+//! server's state when the prediction is right) and our player id.
+
+use ledge_shared::game::Game;
+use ledge_shared::input::Buttons;
+use ledge_shared::protocol::PlayerId;
+
+pub use super::runner::Runner;
+
+/// Decides a bot's buttons, tick by tick.
+pub trait Brain: Send {
+    /// A short name for reports (`idle`, `walker`, `runner`).
+    fn name(&self) -> &'static str;
+
+    /// The buttons to hold during the next tick (`game.tick()`), given the
+    /// predicted game. Called once per tick, in order.
+    fn buttons(&mut self, game: &Game, me: PlayerId) -> Buttons;
+
+    /// Whether the brain has nothing more to do (a runner at the goal).
+    fn done(&self) -> bool {
+        false
+    }
+
+    /// A snapshot corrected the prediction: plans made on the old one are
+    /// stale.
+    fn on_correction(&mut self) {}
+
+    /// A one-line progress note for reports (a runner's waypoint).
+    fn progress(&self) -> String {
+        String::new()
+    }
+}
+
+/// Holds no button, ever.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Idle;
+
+impl Brain for Idle {
+    fn name(&self) -> &'static str {
+        "idle"
+    }
+
+    fn buttons(&mut self, _game: &Game, _me: PlayerId) -> Buttons {
+        Buttons::NONE
+    }
+}
+
+/// Random buttons, changed at random intervals, from a seed (the same seed
+/// presses the same buttons on the same ticks).
+#[derive(Debug, Clone)]
+pub struct RandomWalker {
+    rng: SplitMix64,
+    current: Buttons,
+    hold: u32,
+}
+
+impl RandomWalker {
+    /// A walker seeded with `seed`.
+    pub fn new(seed: u64) -> RandomWalker {
+        RandomWalker {
+            rng: SplitMix64(seed),
+            current: Buttons::NONE,
+            hold: 0,
+        }
+    }
+}
+
+impl Brain for RandomWalker {
+    fn name(&self) -> &'static str {
+        "walker"
+    }
+
+    fn buttons(&mut self, _game: &Game, _me: PlayerId) -> Buttons {
+        if self.hold == 0 {
+            let r = self.rng.next_u64();
+            let dir = match r % 3 {
+                0 => Buttons::LEFT,
+                1 => Buttons::RIGHT,
+                _ => 0,
+            };
+            let jump = if (r >> 8) % 4 == 0 { Buttons::JUMP } else { 0 };
+            let down = if (r >> 16) % 16 == 0 {
+                Buttons::DOWN
+            } else {
+                0
+            };
+            self.current = Buttons(dir | jump | down);
+            self.hold = 5 + ((r >> 24) % 40) as u32;
+        }
+        self.hold -= 1;
+        self.current
+    }
+}
+
+/// A small, fast, seedable generator (SplitMix64): good enough for bots and
+/// test noise, no dependency.
+#[derive(Debug, Clone)]
+pub struct SplitMix64(pub u64);
+
+impl SplitMix64 {
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// A float in [0, 1).
+    pub fn next_f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// An integer in `0..n` (`n > 0`).
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next_u64() % n.max(1)
+    }
+}

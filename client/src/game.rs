@@ -1,0 +1,366 @@
+//! [`ClientGame`]: the client's side of a game, sans IO. It ties together
+//! the synchronised clock ([`SyncClock`]), prediction and reconciliation
+//! ([`Predictor`]), the interpolation of remote players
+//! ([`Interpolator`]), the network figures ([`StatsTracker`]), and builds
+//! the [`FrameView`] and [`NetStats`] a front end draws.
+//!
+//! The caller owns the transport (a [`crate::Session`] for bots and tests,
+//! a [`crate::background::NetThread`] for the GUI, see
+//! [`crate::online::OnlineGame`]) and feeds it:
+//!
+//! ```text
+//! every frame:   game.update(now, buttons, |tick, b| send the input)
+//!                (or: for _ in 0..game.advance(now) { let t = game.step(b); send(t, b) })
+//! each snapshot: game.on_snapshot(&update)
+//! each ping:     game.on_rtt(rtt);  now and then: game.on_transport(sample, now)
+//! to draw:       game.view(), game.net_stats(now)
+//! ```
+
+use std::time::{Duration, Instant};
+
+use glam::IVec2;
+use ledge_shared::game::state::{kind, player_flags};
+use ledge_shared::game::{Game, GameConfig};
+use ledge_shared::input::Buttons;
+use ledge_shared::level::Level;
+use ledge_shared::protocol::{EntityState, PlayerId, Welcome};
+
+use crate::clock::SyncClock;
+use crate::error::ClientError;
+use crate::interp::Interpolator;
+use crate::levels::check_level;
+use crate::netstats::{StatsTracker, TransportSample};
+use crate::predict::{Predictor, Reconciled};
+use crate::session::SnapshotUpdate;
+use crate::view::{px2, EntityDraw, EntityType, Facing, FrameView, NetStats, PlayerDraw};
+
+/// At most this many inputs are handed to `send` per [`ClientGame::update`]
+/// (after a long frame): each packet repeats the previous ticks anyway, and
+/// a burst of datagrams would look like a flood to the server.
+pub const MAX_SENDS_PER_UPDATE: u32 = 4;
+/// At most this many ticks are due per [`ClientGame::advance`]; the rest
+/// are due at the next calls (a window frozen for minutes must not stall
+/// one frame for seconds).
+pub const MAX_TICKS_PER_ADVANCE: u32 = 240;
+
+/// The client's predicted game, clock, interpolation and statistics.
+#[derive(Debug, Clone)]
+pub struct ClientGame {
+    level: Level,
+    me: PlayerId,
+    name: Option<String>,
+    welcome: Option<Welcome>,
+    predictor: Predictor,
+    clock: SyncClock,
+    interp: Interpolator,
+    stats: StatsTracker,
+    player_half: IVec2,
+    /// Entity centres one tick before the newest (for blending).
+    prev_entities: Vec<IVec2>,
+    offline: bool,
+}
+
+impl ClientGame {
+    /// The game of a session the server welcomed at `now` with `welcome`,
+    /// on `level` (which must be the server's: its hash is checked), with
+    /// the handshake's round-trip time `rtt` to start the clock.
+    pub fn new(
+        welcome: &Welcome,
+        level: Level,
+        rtt: Duration,
+        now: Instant,
+    ) -> Result<ClientGame, ClientError> {
+        check_level(welcome, &level, "our level")?;
+        let clock = SyncClock::for_welcome(welcome, rtt, now);
+        let predictor = Predictor::new(&level, welcome.player_id, clock.tick())?;
+        let t = &welcome.timing;
+        let mut stats = StatsTracker::new(t.tick_rate, t.snapshot_interval);
+        stats.rtt(rtt);
+        Ok(ClientGame {
+            player_half: GameConfig::default().player.half,
+            me: welcome.player_id,
+            name: None,
+            welcome: Some(welcome.clone()),
+            predictor,
+            clock,
+            interp: Interpolator::new(t.tick_rate, t.snapshot_interval),
+            stats,
+            prev_entities: Vec::new(),
+            level,
+            offline: false,
+        })
+    }
+
+    /// A local game with no server (offline play): player 1 at the level's
+    /// spawn, 60 Hz; [`ClientGame::update`] runs it and nothing needs
+    /// sending.
+    pub fn offline(level: Level, now: Instant) -> Result<ClientGame, ClientError> {
+        let me = PlayerId(1);
+        let game = Game::from_level(&level)?;
+        let predictor = Predictor::offline(game, me)?;
+        Ok(ClientGame {
+            player_half: GameConfig::default().player.half,
+            me,
+            name: None,
+            welcome: None,
+            predictor,
+            clock: SyncClock::new(0.0, 60, now),
+            interp: Interpolator::new(60, 2),
+            stats: StatsTracker::new(60, 2),
+            prev_entities: Vec::new(),
+            level,
+            offline: true,
+        })
+    }
+
+    /// Sets the input margin the clock keeps with no jitter, ticks (default
+    /// [`crate::clock::BASE_MARGIN`]).
+    pub fn set_base_margin(&mut self, ticks: f64) {
+        self.clock.set_base_margin(ticks);
+    }
+
+    /// Sets our player's name (shown in [`PlayerDraw::name`]).
+    pub fn set_name(&mut self, name: &str) {
+        self.name = Some(name.to_owned());
+    }
+
+    /// Our player id.
+    pub fn me(&self) -> PlayerId {
+        self.me
+    }
+
+    /// The level (draw its tilemap once).
+    pub fn level(&self) -> &Level {
+        &self.level
+    }
+
+    /// The server's welcome (`None` offline).
+    pub fn welcome(&self) -> Option<&Welcome> {
+        self.welcome.as_ref()
+    }
+
+    /// Whether this is a local game without a server.
+    pub fn is_offline(&self) -> bool {
+        self.offline
+    }
+
+    /// The predicted game.
+    pub fn game(&self) -> &Game {
+        self.predictor.game()
+    }
+
+    /// The predictor (counters, predicted states).
+    pub fn predictor(&self) -> &Predictor {
+        &self.predictor
+    }
+
+    /// The local clock.
+    pub fn clock(&self) -> &SyncClock {
+        &self.clock
+    }
+
+    /// The remote players' playout buffer.
+    pub fn interpolator(&self) -> &Interpolator {
+        &self.interp
+    }
+
+    /// The raw network figures.
+    pub fn tracker(&self) -> &StatsTracker {
+        &self.stats
+    }
+
+    /// Whether prediction has started (the first snapshot arrived).
+    pub fn synced(&self) -> bool {
+        self.predictor.synced()
+    }
+
+    /// The next tick [`ClientGame::step`] runs.
+    pub fn next_tick(&self) -> u64 {
+        self.predictor.next_tick()
+    }
+
+    /// Advances the clock (and the remote players' render tick) to `now`;
+    /// returns how many local ticks are due: call [`ClientGame::step`] that
+    /// many times.
+    pub fn advance(&mut self, now: Instant) -> u32 {
+        self.clock.advance(now);
+        self.interp.advance(now);
+        let due = self.clock.tick().saturating_sub(self.predictor.next_tick());
+        u32::try_from(due)
+            .unwrap_or(u32::MAX)
+            .min(MAX_TICKS_PER_ADVANCE)
+    }
+
+    /// Runs one local tick with our `buttons`; returns the tick they are
+    /// for (send them to the server with it).
+    pub fn step(&mut self, buttons: Buttons) -> u64 {
+        self.prev_entities.clear();
+        let positions = self.predictor.game().entities().map(|e| e.pos);
+        self.prev_entities.extend(positions);
+        self.predictor.step(buttons)
+    }
+
+    /// [`ClientGame::advance`], then the due ticks with `buttons`, handing
+    /// each input to `send` (at most [`MAX_SENDS_PER_UPDATE`], the newest).
+    /// Returns the ticks run.
+    pub fn update(
+        &mut self,
+        now: Instant,
+        buttons: Buttons,
+        mut send: impl FnMut(u64, Buttons),
+    ) -> u32 {
+        let due = self.advance(now);
+        for i in 0..due {
+            let tick = self.step(buttons);
+            if due - i <= MAX_SENDS_PER_UPDATE && !self.offline {
+                send(tick, buttons);
+            }
+        }
+        due
+    }
+
+    /// Takes an authoritative snapshot (received at `update.received`):
+    /// network figures, clock feedback, remote players, reconciliation.
+    pub fn on_snapshot(&mut self, update: &SnapshotUpdate) -> Option<Reconciled> {
+        let now = update.received;
+        let tick = update.state.tick;
+        self.stats.snapshot(tick, now);
+        let jitter = self.stats.jitter_ticks();
+        let loss = self.stats.loss();
+        self.interp.set_jitter(jitter);
+        self.interp.set_loss(loss);
+        self.clock.set_jitter(jitter);
+        self.clock.set_loss(loss);
+        let remotes: Vec<EntityState> = update
+            .state
+            .entities
+            .iter()
+            .filter(|e| e.kind == kind::PLAYER && e.id != self.me.0)
+            .copied()
+            .collect();
+        self.interp.push(tick, remotes, now);
+        if update.last_input_tick.is_some() {
+            self.clock.observe(update.input_timing);
+        }
+        let r = self.predictor.reconcile(&update.state)?;
+        if r.correction_px > 0.0 {
+            self.stats.correction(r.correction_px, now);
+        }
+        if r.ahead {
+            self.clock
+                .catch_up_to(self.predictor.next_tick() as f64 + self.clock.target_margin());
+        }
+        Some(r)
+    }
+
+    /// A measured round-trip time (a ping, or QUIC's estimate).
+    pub fn on_rtt(&mut self, rtt: Duration) {
+        self.stats.rtt(rtt);
+    }
+
+    /// The transport's byte counters (and QUIC's RTT) at `now`.
+    pub fn on_transport(&mut self, sample: TransportSample, now: Instant) {
+        self.stats.transport(sample, now);
+    }
+
+    /// What to draw now (as of the last [`ClientGame::advance`]).
+    pub fn view(&self) -> FrameView {
+        let alpha = self.clock.alpha();
+        let rate = self.clock.rate() as f32;
+        let game = self.predictor.game();
+        let size = px2(self.player_half * 2);
+        let local = game.player(self.me).map(|p| {
+            let cur = px2(p.pos);
+            let prev = self.predictor.prev_pos().map_or(cur, px2);
+            let prev = if (cur - prev).abs().max_element() > 64.0 {
+                cur
+            } else {
+                prev
+            };
+            PlayerDraw {
+                id: self.me,
+                name: self.name.clone(),
+                pos: prev.lerp(cur, alpha) + self.predictor.offset(),
+                size: px2(p.half * 2),
+                vel: px2(p.vel) * rate,
+                facing: Facing::from_left(p.facing_left),
+                grounded: p.grounded,
+                won: p.won,
+            }
+        });
+        let remotes = self
+            .interp
+            .sample()
+            .into_iter()
+            .filter(|s| s.id != self.me.0 && game.player(PlayerId(s.id)).is_some())
+            .map(|s| PlayerDraw {
+                id: PlayerId(s.id),
+                name: None,
+                pos: s.pos,
+                size,
+                vel: s.vel * rate,
+                facing: Facing::from_left(s.state.flags & player_flags::FACING_LEFT != 0),
+                grounded: s.state.flags & player_flags::GROUNDED != 0,
+                won: s.state.flags & player_flags::WON != 0,
+            })
+            .collect();
+        let entities = game
+            .entities()
+            .enumerate()
+            .map(|(i, e)| {
+                let cur = px2(e.pos);
+                let prev = self.prev_entities.get(i).map_or(cur, |&p| px2(p));
+                let pos = if (cur - prev).abs().max_element() > 64.0 {
+                    cur
+                } else {
+                    prev.lerp(cur, alpha)
+                };
+                EntityDraw {
+                    id: e.id,
+                    kind: e.ty,
+                    pos,
+                    size: px2(e.half * 2),
+                    active: e.active,
+                    one_way: e.one_way,
+                    facing: if e.ty == EntityType::Walker {
+                        Facing::from_left(e.facing_left)
+                    } else {
+                        Facing::Right
+                    },
+                }
+            })
+            .collect();
+        FrameView {
+            local,
+            remotes,
+            entities,
+            tick: game.tick(),
+            alpha,
+            remote_tick: self.interp.render_tick().unwrap_or(0.0),
+        }
+    }
+
+    /// The network panel as of `now`.
+    pub fn net_stats(&self, now: Instant) -> NetStats {
+        let s = &self.stats;
+        let (bytes_in, bytes_out) = s.bytes_per_s();
+        let tick_ms = s.tick_ms();
+        let p = self.predictor.stats();
+        NetStats {
+            rtt_ms: s.latest_rtt().map_or(0.0, |r| r.as_secs_f32() * 1000.0),
+            jitter_ms: (s.jitter_ticks() * tick_ms) as f32,
+            loss: s.loss() as f32,
+            snapshot_hz: s.snapshot_hz(now) as f32,
+            bytes_in_per_s: bytes_in as f32,
+            bytes_out_per_s: bytes_out as f32,
+            corrections_per_s: s.corrections_per_s(now) as f32,
+            last_correction_px: s.last_correction_px(),
+            input_margin_ticks: self.clock.margin().unwrap_or(0.0) as f32,
+            target_margin_ticks: self.clock.target_margin() as f32,
+            clock_adjust: self.clock.adjust() as f32,
+            interp_delay_ms: (self.interp.delay() * tick_ms) as f32,
+            corrections: p.corrections,
+            mispredictions: p.mispredictions,
+        }
+    }
+}

@@ -1,0 +1,424 @@
+//! Interpolation of remote players: drawn between two snapshots a little in
+//! the past, through a playout buffer that adapts to jitter.
+//!
+//! The [`Interpolator`] keeps the last snapshots' remote players and a
+//! *render tick*, a fractional server tick that advances with local time at
+//! the tick rate, scaled by a small adjustment (at most
+//! [`MAX_RENDER_ADJUST`]) that keeps it `delay` ticks behind the newest
+//! snapshot as it would be by now (the newest tick plus the time since it
+//! arrived). `delay` is one snapshot interval plus half a tick plus
+//! [`JITTER_DELAY`] times the measured arrival jitter: with regular arrivals
+//! the next snapshot is always there before it is needed; with jitter the
+//! buffer deepens. The render tick never goes backwards: when the buffer
+//! runs dry it holds the newest state (an *underrun*, counted), and when it
+//! falls far behind (a stall) it jumps forward.
+//!
+//! Why interpolation rather than predicting remote players with their last
+//! input: the server does not send other players' inputs (only states), so
+//! "their last input" would have to be guessed from velocities; a guess
+//! turns every change of direction and every jump into a visible snap back,
+//! and remote players do not interact with ours (no player collisions), so
+//! showing them 50 ms late costs nothing in play. See `docs/CLIENT.md`.
+
+use std::collections::VecDeque;
+use std::time::Instant;
+
+use glam::Vec2;
+use ledge_shared::fixed::UNITS_PER_PX;
+use ledge_shared::protocol::EntityState;
+
+use crate::view::px2;
+
+/// Extra delay per tick of jitter.
+pub const JITTER_DELAY: f64 = 2.5;
+/// Most delay, ticks.
+pub const MAX_DELAY: f64 = 30.0;
+/// Render speed adjustment per tick of delay error.
+const RENDER_GAIN: f64 = 0.05;
+/// Largest render speed adjustment (10%).
+pub const MAX_RENDER_ADJUST: f64 = 0.1;
+/// Behind by this many ticks more than the delay: jump forward.
+const RESYNC: f64 = 30.0;
+/// Snapshots kept.
+const KEPT: usize = 64;
+/// A remote player moving more than this between two snapshots (pixels)
+/// teleported (a respawn): not blended.
+pub const TELEPORT_PX: i32 = 64;
+
+/// One snapshot's remote entities.
+#[derive(Debug, Clone)]
+struct Frame {
+    tick: u64,
+    entities: Vec<EntityState>,
+}
+
+/// A remote entity at the render tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// The entity's id.
+    pub id: u32,
+    /// Its centre, pixels (blended).
+    pub pos: Vec2,
+    /// Its velocity, pixels per tick (blended).
+    pub vel: Vec2,
+    /// The state of the nearer of the two snapshots (flags, kind, aux).
+    pub state: EntityState,
+}
+
+/// Counters of the interpolator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct InterpStats {
+    /// Snapshots buffered.
+    pub snapshots: u64,
+    /// Frames where the render tick reached the newest snapshot and held.
+    pub underruns: u64,
+    /// Forward jumps after falling too far behind.
+    pub resyncs: u64,
+}
+
+/// The playout buffer of remote players.
+#[derive(Debug, Clone)]
+pub struct Interpolator {
+    rate: f64,
+    interval: f64,
+    frames: VecDeque<Frame>,
+    newest_arrival: Option<Instant>,
+    render: Option<f64>,
+    at: Option<Instant>,
+    jitter: f64,
+    /// Snapshot intervals of extra delay for loss.
+    loss_intervals: f64,
+    adjust: f64,
+    stats: InterpStats,
+}
+
+impl Interpolator {
+    /// A buffer for snapshots every `interval` ticks at `tick_rate` Hz.
+    pub fn new(tick_rate: u32, interval: u32) -> Interpolator {
+        Interpolator {
+            rate: f64::from(tick_rate.max(1)),
+            interval: f64::from(interval.max(1)),
+            frames: VecDeque::new(),
+            newest_arrival: None,
+            render: None,
+            at: None,
+            jitter: 0.0,
+            loss_intervals: 0.0,
+            adjust: 0.0,
+            stats: InterpStats::default(),
+        }
+    }
+
+    /// Sets the measured arrival jitter, ticks.
+    pub fn set_jitter(&mut self, jitter_ticks: f64) {
+        self.jitter = jitter_ticks.max(0.0);
+    }
+
+    /// Sets the measured snapshot loss (fraction): the buffer deepens by
+    /// the snapshot intervals `k` such that `k + 1` snapshots in a row are
+    /// lost with probability under 1% (10% loss: one interval, 30%:
+    /// three), at most three.
+    pub fn set_loss(&mut self, loss: f64) {
+        self.loss_intervals = if loss <= 0.01 {
+            0.0
+        } else if loss >= 0.5 {
+            3.0
+        } else {
+            ((0.01f64.ln() / loss.ln()).ceil() - 1.0).clamp(0.0, 3.0)
+        };
+    }
+
+    /// The delay aimed for, ticks behind the newest snapshot.
+    pub fn target_delay(&self) -> f64 {
+        let base = self.interval * (1.0 + self.loss_intervals) + 0.5;
+        (base + JITTER_DELAY * self.jitter).min(MAX_DELAY)
+    }
+
+    /// How far behind the newest snapshot (extrapolated to the last
+    /// [`Interpolator::advance`]) the render tick is, ticks.
+    pub fn delay(&self) -> f64 {
+        match (self.render, self.at) {
+            (Some(r), Some(at)) => self.expected_newest(at) - r,
+            _ => self.target_delay(),
+        }
+    }
+
+    /// The render tick (fractional server tick), once a snapshot arrived.
+    pub fn render_tick(&self) -> Option<f64> {
+        self.render
+    }
+
+    /// The render speed adjustment in force.
+    pub fn adjust(&self) -> f64 {
+        self.adjust
+    }
+
+    /// Counters.
+    pub fn stats(&self) -> InterpStats {
+        self.stats
+    }
+
+    /// Newest snapshot tick buffered.
+    pub fn newest_tick(&self) -> Option<u64> {
+        self.frames.back().map(|f| f.tick)
+    }
+
+    /// Buffers the remote `entities` of the snapshot of `tick`, which
+    /// arrived at `now`. Older than the newest: ignored.
+    pub fn push(&mut self, tick: u64, entities: Vec<EntityState>, now: Instant) {
+        if self.frames.back().is_some_and(|f| f.tick >= tick) {
+            return;
+        }
+        self.frames.push_back(Frame { tick, entities });
+        self.newest_arrival = Some(now);
+        self.stats.snapshots += 1;
+        while self.frames.len() > KEPT {
+            self.frames.pop_front();
+        }
+        if self.render.is_none() {
+            self.render = Some((tick as f64 - self.target_delay()).max(0.0));
+            self.at = Some(now);
+        }
+    }
+
+    /// The newest tick as it would be at `now`, if snapshots kept coming.
+    fn expected_newest(&self, now: Instant) -> f64 {
+        match (self.frames.back(), self.newest_arrival) {
+            (Some(f), Some(at)) => {
+                f.tick as f64 + now.saturating_duration_since(at).as_secs_f64() * self.rate
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Advances the render tick to `now` and returns it (never backwards).
+    pub fn advance(&mut self, now: Instant) -> Option<f64> {
+        let (Some(render), Some(at)) = (self.render, self.at) else {
+            return None;
+        };
+        let newest = self.frames.back().map_or(0, |f| f.tick) as f64;
+        let dt = now.saturating_duration_since(at).as_secs_f64();
+        let behind = self.expected_newest(now) - render;
+        let error = behind - self.target_delay();
+        let mut r = render;
+        // Far behind what is actually buffered (not merely expected: a
+        // stall of the server is held, not skipped).
+        if newest - render - self.target_delay() > RESYNC {
+            r = r.max(self.expected_newest(now) - self.target_delay());
+            self.stats.resyncs += 1;
+            self.adjust = 0.0;
+        } else {
+            self.adjust = (error * RENDER_GAIN).clamp(-MAX_RENDER_ADJUST, MAX_RENDER_ADJUST);
+            r += dt * self.rate * (1.0 + self.adjust);
+        }
+        if r > newest {
+            if render < newest || dt > 0.0 {
+                self.stats.underruns += 1;
+            }
+            r = newest.max(render);
+        }
+        self.render = Some(r);
+        self.at = Some(now.max(at));
+        // Keep one frame at or before the render tick.
+        while self.frames.len() > 2 && self.frames[1].tick as f64 <= r {
+            self.frames.pop_front();
+        }
+        Some(r)
+    }
+
+    /// The remote entities at the render tick: blended between the two
+    /// snapshots around it (an entity in only the older one is held there;
+    /// one only in the newer appears when the render tick reaches it).
+    pub fn sample(&self) -> Vec<Sample> {
+        let Some(r) = self.render else {
+            return Vec::new();
+        };
+        let Some(i) = self.frames.iter().rposition(|f| f.tick as f64 <= r) else {
+            // Before the first snapshot: show the first.
+            return self.frames.front().map_or_else(Vec::new, hold);
+        };
+        let a = &self.frames[i];
+        let Some(b) = self.frames.get(i + 1) else {
+            return hold(a);
+        };
+        let f = ((r - a.tick as f64) / (b.tick - a.tick) as f64).clamp(0.0, 1.0) as f32;
+        let mut out = Vec::with_capacity(a.entities.len());
+        for ea in &a.entities {
+            let s = match b.entities.binary_search_by_key(&ea.id, |e| e.id) {
+                Ok(j) => {
+                    let eb = &b.entities[j];
+                    let jump = (eb.pos - ea.pos).abs().max_element();
+                    if jump > TELEPORT_PX * UNITS_PER_PX {
+                        let e = if f < 0.5 { ea } else { eb };
+                        Sample {
+                            id: e.id,
+                            pos: px2(e.pos),
+                            vel: px2(e.vel),
+                            state: *e,
+                        }
+                    } else {
+                        Sample {
+                            id: ea.id,
+                            pos: px2(ea.pos).lerp(px2(eb.pos), f),
+                            vel: px2(ea.vel).lerp(px2(eb.vel), f),
+                            state: if f < 0.5 { *ea } else { *eb },
+                        }
+                    }
+                }
+                Err(_) => Sample {
+                    id: ea.id,
+                    pos: px2(ea.pos),
+                    vel: px2(ea.vel),
+                    state: *ea,
+                },
+            };
+            out.push(s);
+        }
+        out
+    }
+}
+
+fn hold(f: &Frame) -> Vec<Sample> {
+    f.entities
+        .iter()
+        .map(|e| Sample {
+            id: e.id,
+            pos: px2(e.pos),
+            vel: px2(e.vel),
+            state: *e,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::IVec2;
+    use std::time::Duration;
+
+    fn player(id: u32, x_px: i32) -> EntityState {
+        EntityState {
+            id,
+            kind: 1,
+            pos: IVec2::new(x_px * UNITS_PER_PX, 0),
+            vel: IVec2::ZERO,
+            flags: 0,
+            aux: 0,
+        }
+    }
+
+    fn ms(t0: Instant, ms: f64) -> Instant {
+        t0 + Duration::from_secs_f64(ms / 1000.0)
+    }
+
+    /// Feeds snapshots every 2 ticks at 60 Hz (x = tick px) with the given
+    /// extra arrival delays (ms), sampling every millisecond; returns the
+    /// render ticks and the sampled x of player 7.
+    fn play(delays: &[f64], jitter: f64) -> (Interpolator, Vec<f64>, Vec<f32>) {
+        let t0 = Instant::now();
+        let mut it = Interpolator::new(60, 2);
+        it.set_jitter(jitter);
+        let mut arrivals: Vec<(f64, u64)> = delays
+            .iter()
+            .enumerate()
+            .map(|(i, d)| (i as f64 * 2000.0 / 60.0 + d, 100 + 2 * i as u64))
+            .collect();
+        arrivals.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let end = arrivals.last().unwrap().0 as usize;
+        let (mut renders, mut xs) = (Vec::new(), Vec::new());
+        let mut next = 0;
+        for t in 0..end {
+            while next < arrivals.len() && arrivals[next].0 <= t as f64 {
+                let tick = arrivals[next].1;
+                it.push(tick, vec![player(7, tick as i32)], ms(t0, t as f64));
+                next += 1;
+            }
+            if let Some(r) = it.advance(ms(t0, t as f64)) {
+                renders.push(r);
+                xs.push(it.sample()[0].pos.x);
+            }
+        }
+        (it, renders, xs)
+    }
+
+    #[test]
+    fn positions_are_blended_between_the_two_snapshots_around_the_render_tick() {
+        let t0 = Instant::now();
+        let mut it = Interpolator::new(60, 2);
+        it.push(100, vec![player(1, 100), player(2, 0)], t0);
+        it.push(102, vec![player(1, 110), player(3, 50)], t0);
+        it.render = Some(101.5);
+        let s = it.sample();
+        assert_eq!(s.len(), 2, "player 3 appears only when reached: {s:?}");
+        assert_eq!(s[0].id, 1);
+        assert!((s[0].pos.x - 107.5).abs() < 1e-4, "{}", s[0].pos.x);
+        assert_eq!(
+            (s[1].id, s[1].pos.x),
+            (2, 0.0),
+            "player 2 held where it was"
+        );
+        // A teleport is not blended.
+        it.push(104, vec![player(1, 500)], t0);
+        it.render = Some(102.5);
+        assert_eq!(it.sample()[0].pos.x, 110.0);
+        it.render = Some(103.5);
+        assert_eq!(it.sample()[0].pos.x, 500.0);
+    }
+
+    #[test]
+    fn regular_snapshots_play_smoothly_without_underruns() {
+        let (it, renders, xs) = play(&vec![10.0; 300], 0.0);
+        assert!(renders.windows(2).all(|w| w[1] >= w[0]), "never backwards");
+        assert!(xs.windows(2).all(|w| w[1] >= w[0]));
+        // After settling: no hold, and the delay is the target.
+        let settled = &renders[2000..];
+        let steps: Vec<f64> = settled.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(steps.iter().all(|&d| d > 0.0), "never held once settled");
+        assert!(
+            (it.delay() - it.target_delay()).abs() < 1.0,
+            "{}",
+            it.delay()
+        );
+        assert!(it.stats().underruns < 5, "{:?}", it.stats());
+    }
+
+    #[test]
+    fn the_buffer_deepens_with_jitter_and_rarely_runs_dry() {
+        let mut rng = 99u64;
+        let delays: Vec<f64> = (0..600)
+            .map(|_| {
+                rng ^= rng << 13;
+                rng ^= rng >> 7;
+                rng ^= rng << 17;
+                (rng % 40) as f64 // 0..40 ms: about 1.2 ticks of jitter
+            })
+            .collect();
+        // Without accounting for jitter, the buffer runs dry often.
+        let (dry, ..) = play(&delays, 0.0);
+        let (deep, renders, _) = play(&delays, 1.2);
+        assert!(deep.target_delay() > dry.target_delay() + 2.0);
+        assert!(renders.windows(2).all(|w| w[1] >= w[0]), "never backwards");
+        assert!(
+            deep.stats().underruns * 4 < dry.stats().underruns.max(4),
+            "with jitter {:?}, without {:?}",
+            deep.stats(),
+            dry.stats()
+        );
+    }
+
+    #[test]
+    fn a_stall_holds_then_catches_up_forward() {
+        let t0 = Instant::now();
+        let mut it = Interpolator::new(60, 2);
+        it.push(100, vec![player(1, 0)], t0);
+        it.push(102, vec![player(1, 2)], ms(t0, 33.0));
+        let r1 = it.advance(ms(t0, 500.0)).unwrap();
+        assert_eq!(r1, 102.0, "held at the newest");
+        assert!(it.stats().underruns >= 1);
+        // Snapshots resume 2 s later, far ahead.
+        it.push(220, vec![player(1, 10)], ms(t0, 2000.0));
+        let r2 = it.advance(ms(t0, 2001.0)).unwrap();
+        assert!(r2 > 200.0 && r2 <= 220.0, "{r2}");
+        assert_eq!(it.stats().resyncs, 1);
+    }
+}

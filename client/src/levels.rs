@@ -1,0 +1,56 @@
+//! Which level a server plays: the client needs the same one to predict.
+//!
+//! The server sends the level's id and content hash in `Welcome`; the
+//! client has the embedded default level and, optionally, level files. The
+//! hash is the server's: FNV-1a over the level's bincode encoding.
+
+use std::path::Path;
+
+use ledge_shared::level::{self, Level};
+use ledge_shared::protocol::Welcome;
+
+use crate::error::ClientError;
+
+/// FNV-1a over the bincode (standard configuration) encoding of `level`:
+/// the server's `level_hash`, sent in `Welcome`.
+pub fn level_hash(level: &Level) -> u64 {
+    let bytes = bincode::serde::encode_to_vec(level, bincode::config::standard())
+        .expect("a level always encodes");
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// The level `welcome` names: `file` if given (it must match), else the
+/// embedded default level. Refuses a level whose hash differs from the
+/// server's ([`ClientError::LevelMismatch`]): predicting another level
+/// would mispredict every tick.
+pub fn level_for(welcome: &Welcome, file: Option<&Path>) -> Result<Level, ClientError> {
+    let (level, source) = match file {
+        Some(path) => (
+            level::load_file(path).map_err(|e| ClientError::Level(e.to_string()))?,
+            path.display().to_string(),
+        ),
+        None => (
+            level::default_level(),
+            "the embedded default level".to_owned(),
+        ),
+    };
+    check_level(welcome, &level, &source)?;
+    Ok(level)
+}
+
+/// Checks `level` (described as `source` in the error) is the server's.
+pub fn check_level(welcome: &Welcome, level: &Level, source: &str) -> Result<(), ClientError> {
+    let ours = level_hash(level);
+    if ours == welcome.level_hash {
+        Ok(())
+    } else {
+        Err(ClientError::LevelMismatch {
+            level_id: welcome.level_id.clone(),
+            tried: source.to_owned(),
+            server: welcome.level_hash,
+            ours,
+        })
+    }
+}

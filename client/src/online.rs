@@ -1,0 +1,232 @@
+//! [`OnlineGame`]: everything a GUI front end needs, on its own thread's
+//! terms: the network on a [`NetThread`] and the predicted game
+//! ([`ClientGame`]) on the caller's thread, polled once per frame.
+//!
+//! ```no_run
+//! use std::time::Instant;
+//! use ledge_client::{OnlineGame, OnlineRequest, Trust};
+//! use ledge_shared::input::Buttons;
+//!
+//! let trust = Trust::KnownHosts("known_hosts".into());
+//! let mut online = OnlineGame::connect(OnlineRequest::new("127.0.0.1:4433", trust, "ada"))?;
+//! loop {
+//!     // Each frame: feed the held buttons, then draw the view and the HUD.
+//!     online.update(Instant::now(), Buttons::NONE);
+//!     if let (Some(view), Some(level)) = (online.view(), online.level()) {
+//!         let _ = (view.tick, level.name.as_str());
+//!     }
+//!     let _ = (online.status(), online.net_stats(Instant::now()));
+//! }
+//! # #[allow(unreachable_code)]
+//! # Ok::<(), std::io::Error>(())
+//! ```
+//!
+//! Nothing here blocks: events are drained with `try_recv`, inputs queued
+//! with `try_send`.
+
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use ledge_shared::input::Buttons;
+use ledge_shared::level::Level;
+use ledge_shared::protocol::{Fingerprint, NoticeKind, PlayerId};
+
+use crate::background::{ConnectRequest, NetEvent, NetOptions, NetStatus, NetThread};
+use crate::game::ClientGame;
+use crate::levels::level_for;
+use crate::trust::Trust;
+use crate::view::{FrameView, NetStats};
+
+/// Chat lines kept.
+pub const CHAT_LINES: usize = 32;
+
+/// Where, as whom, and how to trust.
+#[derive(Debug, Clone)]
+pub struct OnlineRequest {
+    /// `HOST:PORT`.
+    pub server: String,
+    /// Pinned fingerprint or trust on first use.
+    pub trust: Trust,
+    /// Our name.
+    pub player_name: String,
+    /// Room to join (`None`: any).
+    pub room: Option<String>,
+    /// The server's level file, when it is not the embedded default level.
+    pub level: Option<PathBuf>,
+}
+
+impl OnlineRequest {
+    /// Joins any room of `server` as `player_name` on the default level.
+    pub fn new(server: &str, trust: Trust, player_name: &str) -> OnlineRequest {
+        OnlineRequest {
+            server: server.to_owned(),
+            trust,
+            player_name: player_name.to_owned(),
+            room: None,
+            level: None,
+        }
+    }
+}
+
+/// A networked game for a GUI: the network thread plus the predicted game.
+#[derive(Debug)]
+pub struct OnlineGame {
+    net: NetThread,
+    status: NetStatus,
+    game: Option<ClientGame>,
+    level_file: Option<PathBuf>,
+    name: String,
+    chat: VecDeque<(PlayerId, String)>,
+    notices: VecDeque<NoticeKind>,
+    /// A problem with the game itself (wrong level): shown, not fatal to
+    /// the connection.
+    error: Option<String>,
+}
+
+impl OnlineGame {
+    /// Starts connecting in the background.
+    pub fn connect(request: OnlineRequest) -> std::io::Result<OnlineGame> {
+        let pin = match &request.trust {
+            Trust::Pinned(pin) => *pin,
+            Trust::KnownHosts(_) => Fingerprint([0; 32]),
+        };
+        let net = NetThread::spawn_with(
+            ConnectRequest {
+                server: request.server.clone(),
+                cert_fingerprint: pin,
+                player_name: request.player_name.clone(),
+            },
+            NetOptions {
+                room: request.room.clone(),
+                trust: Some(request.trust.clone()),
+            },
+        )?;
+        Ok(OnlineGame {
+            net,
+            status: NetStatus::Connecting(request.server),
+            game: None,
+            level_file: request.level,
+            name: request.player_name,
+            chat: VecDeque::new(),
+            notices: VecDeque::new(),
+            error: None,
+        })
+    }
+
+    /// Call once per frame: takes the network's events, runs the due ticks
+    /// with `buttons` and queues our inputs.
+    pub fn update(&mut self, now: Instant, buttons: Buttons) {
+        while let Some(event) = self.net.try_recv() {
+            self.handle(&event, now);
+            self.status.apply(event);
+        }
+        if let Some(t) = self.net.transport() {
+            if let Some(game) = &mut self.game {
+                game.on_transport(t, now);
+            }
+        }
+        if let Some(game) = &mut self.game {
+            let net = &self.net;
+            game.update(now, buttons, |tick, b| {
+                net.send_input(tick, b);
+            });
+        }
+    }
+
+    fn handle(&mut self, event: &NetEvent, now: Instant) {
+        match event {
+            NetEvent::Connected(welcome) => {
+                let rtt = self
+                    .net
+                    .transport()
+                    .map_or(std::time::Duration::from_millis(50), |t| t.rtt);
+                let made = level_for(welcome, self.level_file.as_deref())
+                    .and_then(|level| ClientGame::new(welcome, level, rtt, now));
+                match made {
+                    Ok(mut game) => {
+                        game.set_name(&self.name);
+                        self.game = Some(game);
+                    }
+                    Err(e) => self.error = Some(e.to_string()),
+                }
+            }
+            NetEvent::Snapshot(update) => {
+                if let Some(game) = &mut self.game {
+                    game.on_snapshot(update);
+                }
+            }
+            NetEvent::Rtt(rtt) => {
+                if let Some(game) = &mut self.game {
+                    game.on_rtt(*rtt);
+                }
+            }
+            NetEvent::Chat { from, text } => {
+                if self.chat.len() == CHAT_LINES {
+                    self.chat.pop_front();
+                }
+                self.chat.push_back((*from, text.clone()));
+            }
+            NetEvent::Notice(kind) => {
+                if self.notices.len() == CHAT_LINES {
+                    self.notices.pop_front();
+                }
+                self.notices.push_back(kind.clone());
+            }
+            NetEvent::Failed(_) | NetEvent::Disconnected(_) => {}
+        }
+    }
+
+    /// What to draw, once the server welcomed us and we have its level.
+    pub fn view(&self) -> Option<FrameView> {
+        self.game.as_ref().map(ClientGame::view)
+    }
+
+    /// The network panel.
+    pub fn net_stats(&self, now: Instant) -> NetStats {
+        self.game
+            .as_ref()
+            .map_or_else(NetStats::default, |g| g.net_stats(now))
+    }
+
+    /// Connection status (for the HUD line).
+    pub fn status(&self) -> &NetStatus {
+        &self.status
+    }
+
+    /// The game, once welcomed.
+    pub fn game(&self) -> Option<&ClientGame> {
+        self.game.as_ref()
+    }
+
+    /// The level, once welcomed (draw its tilemap).
+    pub fn level(&self) -> Option<&Level> {
+        self.game.as_ref().map(ClientGame::level)
+    }
+
+    /// A problem that keeps us from playing (the server's level is not
+    /// ours), if any.
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_deref()
+    }
+
+    /// The last chat lines, oldest first.
+    pub fn chat_lines(&self) -> impl Iterator<Item = &(PlayerId, String)> {
+        self.chat.iter()
+    }
+
+    /// The last notices, oldest first.
+    pub fn notices(&self) -> impl Iterator<Item = &NoticeKind> {
+        self.notices.iter()
+    }
+
+    /// Says `text` in the room; `false` if it could not be queued.
+    pub fn say(&self, text: &str) -> bool {
+        self.net.chat(text)
+    }
+
+    /// The network thread (queues, counters).
+    pub fn net(&self) -> &NetThread {
+        &self.net
+    }
+}

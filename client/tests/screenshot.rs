@@ -1,0 +1,341 @@
+//! The real client binary, under Xvfb, joined to a real server, scripted
+//! to run right and stop; its screenshot must show the level and our player
+//! where the server says it is.
+//!
+//! Needs `xvfb-run` (Debian: `apt-get install xvfb`; `.ci/run` installs
+//! it). Without it the test fails when `CI=true` and otherwise prints a
+//! loud notice and passes without checking anything.
+
+use std::net::SocketAddr;
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use ledge_server::{Server, ServerConfig};
+use ledge_shared::fixed::UNITS_PER_PX;
+use ledge_shared::game::Game;
+use ledge_shared::level::default_level;
+use ledge_shared::tilemap::Tile;
+use serde_json::Value;
+
+/// The client must have saved its screenshot within this time.
+const CLIENT_TIMEOUT: Duration = Duration::from_secs(90);
+/// Ticks of play before the screenshot: run right, then come to rest.
+const TICKS: u64 = 150;
+const SCRIPT: &str = "0-14 -> right";
+
+fn xvfb_run() -> Option<std::path::PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join("xvfb-run"))
+        .find(|p| p.is_file())
+}
+
+struct Png {
+    width: u32,
+    height: u32,
+    rgba: Vec<u8>,
+}
+
+impl Png {
+    fn load(path: &Path) -> Png {
+        let file = std::fs::File::open(path).expect("screenshot exists");
+        let mut decoder = png::Decoder::new(file);
+        decoder.set_transformations(png::Transformations::EXPAND);
+        let mut reader = decoder.read_info().expect("a PNG");
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).expect("PNG data");
+        buf.truncate(info.buffer_size());
+        let channels = match info.color_type {
+            png::ColorType::Rgba => 4,
+            png::ColorType::Rgb => 3,
+            other => panic!("unexpected PNG colour type {other:?}"),
+        };
+        let rgba = if channels == 4 {
+            buf
+        } else {
+            buf.chunks(3)
+                .flat_map(|c| [c[0], c[1], c[2], 255])
+                .collect()
+        };
+        Png {
+            width: info.width,
+            height: info.height,
+            rgba,
+        }
+    }
+
+    fn at(&self, x: f64, y: f64) -> Option<[u8; 3]> {
+        let (x, y) = (x.floor(), y.floor());
+        if x < 0.0 || y < 0.0 || x >= self.width as f64 || y >= self.height as f64 {
+            return None;
+        }
+        let i = (y as usize * self.width as usize + x as usize) * 4;
+        Some([self.rgba[i], self.rgba[i + 1], self.rgba[i + 2]])
+    }
+}
+
+fn close(a: [u8; 3], b: [u8; 3]) -> bool {
+    a.iter().zip(b).all(|(&x, y)| x.abs_diff(y) <= 3)
+}
+
+fn rgb(v: &Value) -> [u8; 3] {
+    let a = v.as_array().expect("[r, g, b]");
+    [0, 1, 2].map(|i| a[i].as_u64().expect("byte") as u8)
+}
+
+fn pair(v: &Value) -> (f64, f64) {
+    let a = v.as_array().expect("[x, y]");
+    (a[0].as_f64().unwrap(), a[1].as_f64().unwrap())
+}
+
+#[test]
+fn the_client_draws_the_level_and_our_player_where_the_server_says() {
+    let Some(xvfb) = xvfb_run() else {
+        if std::env::var("CI").as_deref() == Ok("true") {
+            panic!("xvfb-run is not on PATH: install xvfb (apt-get install xvfb) to run the screenshot test in CI");
+        }
+        // Straight to the process's stderr: the test harness captures
+        // `eprintln!`, and this notice must be seen.
+        let notice = "\n\
+            ************************************************************\n\
+            *  SKIPPED screenshot test: xvfb-run is not on PATH.       *\n\
+            *  Install it (apt-get install xvfb xauth) to run it;      *\n\
+            *  with CI=true this test fails instead of skipping.       *\n\
+            ************************************************************\n\n";
+        let _ = std::io::Write::write_all(&mut std::io::stderr(), notice.as_bytes());
+        return;
+    };
+
+    // A real server, in-process, on loopback.
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()
+        .unwrap();
+    let certs = tempfile::tempdir().unwrap();
+    let (addr, fingerprint, shutdown, task) = runtime.block_on(async {
+        let server = Server::bind(ServerConfig {
+            bind: SocketAddr::from(([127, 0, 0, 1], 0)),
+            cert_dir: certs.path().to_owned(),
+            ..ServerConfig::default()
+        })
+        .expect("server binds");
+        (
+            server.local_addr(),
+            server.fingerprint(),
+            server.shutdown_handle(),
+            tokio::spawn(server.run()),
+        )
+    });
+
+    // The real client, scripted, in a virtual X server.
+    // LEDGE_SCREENSHOT_DIR keeps the picture (to look at it); by default
+    // a temporary directory.
+    let out = tempfile::tempdir().unwrap();
+    let dir = std::env::var_os("LEDGE_SCREENSHOT_DIR")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| out.path().to_owned());
+    std::fs::create_dir_all(&dir).unwrap();
+    let png_path = dir.join("shot.png");
+    let mut child = Command::new(xvfb)
+        .args(["-a", "-s", "-screen 0 1280x720x24"])
+        .arg(env!("CARGO_BIN_EXE_ledge-client"))
+        .args(["--connect", &addr.to_string()])
+        .args(["--cert-hash", &fingerprint.to_string()])
+        .args(["--name", "shot"])
+        .args(["--script", SCRIPT])
+        .args(["--exit-after-ticks", &TICKS.to_string()])
+        .arg("--screenshot")
+        .arg(&png_path)
+        .args(["--window", "960x540"])
+        .env("LIBGL_ALWAYS_SOFTWARE", "1")
+        .stdin(Stdio::null())
+        .spawn()
+        .expect("xvfb-run starts");
+    let deadline = Instant::now() + CLIENT_TIMEOUT;
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("the client did not exit within {CLIENT_TIMEOUT:?}");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    shutdown.shutdown();
+    runtime.block_on(async {
+        let _ = tokio::time::timeout(Duration::from_secs(5), task).await;
+    });
+    assert!(status.success(), "the client failed: {status}");
+
+    let json_path = dir.join("shot.png.json");
+    let json: Value = serde_json::from_str(
+        &std::fs::read_to_string(&json_path).expect("the screenshot's JSON exists"),
+    )
+    .expect("valid JSON");
+    let img = Png::load(&png_path);
+    let screen = pair(&json["screen"]);
+    assert_eq!((img.width as f64, img.height as f64), screen, "{json}");
+    let zoom = json["camera"]["zoom"].as_f64().unwrap();
+    let (ox, oy) = pair(&json["camera"]["offset"]);
+    let to_screen = |x: f64, y: f64| (x * zoom + ox, y * zoom + oy);
+    let colors = &json["colors"];
+    let (sky, solid, grass, me) = (
+        rgb(&colors["sky"]),
+        rgb(&colors["solid"]),
+        rgb(&colors["grass"]),
+        rgb(&colors["local_player"]),
+    );
+
+    // The level: every visible interior solid tile (itself and its four
+    // neighbours solid) has the solid colour at its centre, and exposed
+    // ground tops are grass.
+    let level = default_level();
+    let map = &level.tilemap;
+    let t = (map.tile_size() / UNITS_PER_PX) as f64;
+    let o = (
+        (map.origin().x / UNITS_PER_PX) as f64,
+        (map.origin().y / UNITS_PER_PX) as f64,
+    );
+    let tile = |c: i32, r: i32| map.tile(glam::IVec2::new(c, r));
+    let (mut interior, mut solid_ok, mut tops, mut grass_ok) = (0, 0, 0, 0);
+    for r in 0..map.height() as i32 {
+        for c in 0..map.width() as i32 {
+            if tile(c, r) != Tile::Solid {
+                continue;
+            }
+            let (x, y) = (o.0 + c as f64 * t, o.1 + r as f64 * t);
+            let around = [(-1, 0), (1, 0), (0, -1), (0, 1)].map(|(dc, dr)| tile(c + dc, r + dr));
+            if around.iter().all(|&n| n == Tile::Solid) {
+                let (sx, sy) = to_screen(x + t / 2.0, y + t / 2.0);
+                if let Some(p) = img.at(sx, sy) {
+                    interior += 1;
+                    solid_ok += close(p, solid) as u32;
+                }
+            }
+            if tile(c, r - 1) == Tile::Empty {
+                let (sx, sy) = to_screen(x + t / 2.0, y + 1.0);
+                if let Some(p) = img.at(sx, sy) {
+                    tops += 1;
+                    grass_ok += close(p, grass) as u32;
+                }
+            }
+        }
+    }
+    assert!(
+        interior >= 20,
+        "only {interior} interior solid tiles on screen: {json}"
+    );
+    assert!(
+        solid_ok * 10 >= interior * 9,
+        "{solid_ok} of {interior} interior solid tiles have the solid colour {solid:?}"
+    );
+    assert!(tops >= 5, "only {tops} ground tops on screen");
+    assert!(
+        grass_ok * 10 >= tops * 8,
+        "{grass_ok} of {tops} ground tops are grass"
+    );
+
+    // Our player: where the server says, at rest, drawn there.
+    let player = &json["player"];
+    assert!(player.is_object(), "no player in {json}");
+    let (px, py) = pair(&player["server_pos_px"]);
+    let spawn_x = 88.0;
+    assert!(
+        px > spawn_x + 8.0,
+        "the scripted run moved us right: x = {px}"
+    );
+    let (cx, cy) = pair(&player["server_screen"]);
+    assert_eq!(
+        to_screen(px, py),
+        (cx, cy),
+        "server_screen follows the camera"
+    );
+    let (dx, dy) = pair(&player["drawn_screen"]);
+    assert!(
+        (dx - cx).abs() <= 3.0 && (dy - cy).abs() <= 3.0,
+        "drawn at ({dx}, {dy}), the server says ({cx}, {cy})"
+    );
+    let (w, h) = pair(&player["size_px"]);
+    let (hw, hh) = (w * zoom / 2.0, h * zoom / 2.0);
+    // The centre of the body (a few pixels around it, eyes are higher up).
+    let mut body = 0;
+    for ddy in -3..=3 {
+        for ddx in -3..=3 {
+            let p = img.at(cx + ddx as f64, cy + 2.0 + ddy as f64).unwrap();
+            body += close(p, me) as u32;
+        }
+    }
+    assert!(
+        body >= 40,
+        "player colour {me:?} at only {body}/49 pixels around ({cx}, {cy})"
+    );
+    // Nowhere else: every player-coloured pixel is inside its box (+-3 px).
+    let mut stray = Vec::new();
+    let mut total = 0;
+    for y in 0..img.height {
+        for x in 0..img.width {
+            if close(img.at(x as f64, y as f64).unwrap(), me) {
+                total += 1;
+                let (fx, fy) = (x as f64 + 0.5, y as f64 + 0.5);
+                if (fx - cx).abs() > hw + 3.0 || (fy - cy).abs() > hh + 3.0 {
+                    stray.push((x, y));
+                }
+            }
+        }
+    }
+    assert!(
+        total as f64 >= hw * hh * 2.0,
+        "player drawn too small: {total} px"
+    );
+    assert!(
+        stray.len() <= 4,
+        "player colour away from the player: {:?}",
+        &stray[..stray.len().min(10)]
+    );
+    // Background around it, where the level is empty (no tile, no entity
+    // near: flags, labels and animations reach a little outside boxes).
+    let game = Game::from_level(&level).unwrap();
+    let clear = |x: f64, y: f64| {
+        let tile_empty = tile(
+            ((x - o.0) / t).floor() as i32,
+            ((y - o.1) / t).floor() as i32,
+        ) == Tile::Empty;
+        tile_empty
+            && game.entities().all(|e| {
+                let u = UNITS_PER_PX as f64;
+                let (ex, ey) = (e.pos.x as f64 / u, e.pos.y as f64 / u);
+                let (ew, eh) = (e.half.x as f64 / u + 6.0, e.half.y as f64 / u + 16.0);
+                (x - ex).abs() > ew || (y - ey).abs() > eh
+            })
+    };
+    let mut checked = 0;
+    for (kx, ky) in [
+        (-1.0, 0.0),
+        (1.0, 0.0),
+        (-2.0, 0.0),
+        (2.0, 0.0),
+        (0.0, -2.0),
+        (0.0, -3.0),
+        (-1.5, -2.0),
+        (1.5, -2.0),
+        (-2.0, -3.0),
+        (2.0, -3.0),
+    ] {
+        let (wx, wy) = (px + kx * w, py + ky * h);
+        if !clear(wx, wy) {
+            continue;
+        }
+        let (sx, sy) = to_screen(wx, wy);
+        let p = img.at(sx, sy).expect("on screen");
+        assert!(
+            close(p, sky),
+            "background {sky:?} expected at world ({wx}, {wy}), screen ({sx}, {sy}): {p:?}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 4, "only {checked} background points checked");
+}

@@ -1,0 +1,198 @@
+//! Prediction and reconciliation over real QUIC: an unimpaired client
+//! predicts the server exactly; a lost input burst is corrected, blended
+//! (small) or snapped (large), and the prediction converges again.
+
+use std::time::{Duration, Instant};
+
+use ledge_client::predict::BLEND_KEEP;
+use ledge_client::view::Vec2;
+use ledge_client::ClientGame;
+use ledge_shared::input::Buttons;
+use ledge_tests::{starvation, PredictedClient, TestServer};
+
+/// A varied script: runs, jumps, turns, stands (around the spawn, the crate
+/// and the elevator), repeating every 4 seconds.
+fn script(tick: u64) -> Buttons {
+    let t = tick % 240;
+    let b = match t {
+        0..=49 => Buttons::RIGHT,
+        50..=70 => Buttons::RIGHT | Buttons::JUMP,
+        71..=100 => Buttons::RIGHT,
+        101..=110 => 0,
+        111..=160 => Buttons::LEFT,
+        161..=175 => Buttons::LEFT | Buttons::JUMP,
+        176..=200 => Buttons::LEFT,
+        201..=205 => Buttons::JUMP,
+        _ => 0,
+    };
+    Buttons(b)
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_unimpaired_client_predicts_the_server_exactly_for_ten_seconds() {
+    let server = TestServer::start().await;
+    // Three ticks of margin (50 ms) so a loaded test machine does not make
+    // inputs late: exact timing is the precondition of exact prediction.
+    let mut c = PredictedClient::join(&server, "scripted", 3.0).await;
+    let me = c.game.me();
+    let (mut min_x, mut max_x) = (i32::MAX, i32::MIN);
+    let mut compared = 0;
+    // The server counts the ticks between its tick at the join and our
+    // first input as starved: count only after a warm-up second.
+    let warm_up = Instant::now() + Duration::from_secs(1);
+    c.run(warm_up, |_, tick| (script(tick), true), |_, _, _| {})
+        .await;
+    let starved_before = starvation(&server, "room-1");
+    let until = Instant::now() + Duration::from_secs(9);
+    c.run(
+        until,
+        |_, tick| (script(tick), true),
+        |_, update, r| {
+            if let Some(e) = update.state.get(me.0) {
+                min_x = min_x.min(e.pos.x);
+                max_x = max_x.max(e.pos.x);
+            }
+            compared += usize::from(r.compared);
+        },
+    )
+    .await;
+    let starved = starvation(&server, "room-1") - starved_before;
+    let stats = c.game.predictor().stats();
+    let net = c.game.net_stats(Instant::now());
+    eprintln!(
+        "{} ticks, {} snapshots ({compared} compared), {stats:?}, starved {starved}, \
+         margin {:.2} (target {:.2}), rtt {:.2} ms, jitter {:.3} ms, moved {} px",
+        c.ticks,
+        c.snapshots,
+        net.input_margin_ticks,
+        net.target_margin_ticks,
+        net.rtt_ms,
+        net.jitter_ms,
+        (max_x - min_x) / 256
+    );
+    assert_eq!(starved, 0.0, "inputs arrived late: timing was not exact");
+    assert!(c.snapshots >= 250, "{} snapshots in 10 s", c.snapshots);
+    assert!(compared >= 220, "predictions compared: {compared}");
+    assert!(
+        stats.replayed_ticks >= stats.snapshots,
+        "the client ran ahead of the server"
+    );
+    assert!(max_x - min_x > 40 * 256, "the player moved");
+    assert_eq!(stats.mispredictions, 0, "mispredicted: {stats:?}");
+    assert_eq!(stats.corrections, 0, "corrected: {stats:?}");
+    assert_eq!(net.corrections, 0);
+    c.session.close().await;
+    server.stop().await.unwrap();
+}
+
+/// The local player as drawn minus as predicted (the blending offset).
+fn drawn_offset(game: &ClientGame) -> f32 {
+    let v = game.view();
+    let me = game.game().player(game.me()).unwrap();
+    let local = v.local.unwrap();
+    // `alpha` blends from the previous tick: compare with that blend.
+    let cur = ledge_client::view::px2(me.pos);
+    let prev = game
+        .predictor()
+        .prev_pos()
+        .map_or(cur, ledge_client::view::px2);
+    (local.pos - prev.lerp(cur, v.alpha)).length()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_lost_input_burst_is_corrected_with_blending_and_prediction_converges() {
+    let server = TestServer::start().await;
+    let mut c = PredictedClient::join(&server, "lossy", 3.0).await;
+    // Stand still until the prediction runs.
+    c.run(
+        Instant::now() + Duration::from_millis(500),
+        |_, _| (Buttons::NONE, true),
+        |_, _, _| {},
+    )
+    .await;
+    assert!(c.game.synced());
+    let t0 = c.game.next_tick();
+    // 8 ticks of RIGHT predicted but never sent: the server applies the
+    // previous buttons (none) instead, so our player did not move there.
+    let burst = t0 + 30..t0 + 38;
+    let mut corrections = Vec::new();
+    let mut blending = Vec::new();
+    c.run(
+        Instant::now() + Duration::from_millis(3000),
+        |game, t| {
+            if game.predictor().offset() != Vec2::ZERO {
+                blending.push((t, game.predictor().offset().length(), drawn_offset(game)));
+            }
+            if burst.contains(&t) {
+                (Buttons(Buttons::RIGHT), false)
+            } else {
+                (Buttons::NONE, true)
+            }
+        },
+        |game, update, r| {
+            if r.correction_px > 0.0 || r.mispredicted {
+                corrections.push((
+                    update.state.tick,
+                    *r,
+                    game.predictor().offset().length(),
+                    game.next_tick(),
+                ));
+            }
+        },
+    )
+    .await;
+    let stats = c.game.predictor().stats();
+    eprintln!("{stats:?}");
+    for (tick, r, offset, local) in &corrections {
+        eprintln!("snapshot {tick} (local {local}): {r:?}, offset {offset:.2} px");
+    }
+    let first = corrections
+        .iter()
+        .find(|(_, r, _, _)| r.correction_px > 0.0)
+        .expect("the burst was corrected");
+    assert!(
+        first.1.correction_px >= 0.5 && !first.1.snapped,
+        "blended, not snapped: {first:?}"
+    );
+    assert!(
+        (first.2 - first.1.correction_px).abs() < 0.5,
+        "the drawn position starts where it was: offset {} for a {} px correction",
+        first.2,
+        first.1.correction_px
+    );
+    // The visible offset is drawn, decays tick by tick, and is gone within
+    // 40 ticks of the last correction.
+    let last_fix = corrections.iter().map(|c| c.3).max().unwrap();
+    assert!(blending.len() >= 5, "{blending:?}");
+    let mut decays = 0;
+    for w in blending.windows(2) {
+        // Consecutive ticks with no correction in between.
+        if w[1].0 == w[0].0 + 1 && !corrections.iter().any(|c| c.3 == w[1].0) {
+            assert!(w[1].1 <= w[0].1 * BLEND_KEEP + 1e-3, "decays: {w:?}");
+            decays += 1;
+        }
+    }
+    assert!(decays >= 5, "{blending:?}");
+    for (_, offset, drawn) in &blending {
+        assert!((offset - drawn).abs() < 1e-3, "drawn with the offset");
+    }
+    assert!(
+        blending.iter().all(|(t, _, _)| *t < last_fix + 40 + 10),
+        "gone within 40 ticks: {blending:?}"
+    );
+    assert_eq!(c.game.predictor().offset(), Vec2::ZERO);
+    // Converged: no misprediction later than 20 ticks after the burst,
+    // and the last second of snapshots were all compared and right.
+    assert!(
+        corrections.iter().all(|(tick, ..)| *tick <= burst.end + 20),
+        "not converged: {corrections:?}"
+    );
+    let tail: Vec<_> = c.log.iter().rev().take(30).collect();
+    assert!(
+        tail.iter().all(|r| r.compared && !r.mispredicted),
+        "{tail:?}"
+    );
+    assert!(stats.mispredictions >= 1 && stats.corrections >= 1);
+    c.session.close().await;
+    server.stop().await.unwrap();
+}
