@@ -1,8 +1,8 @@
 //! The broad phase against brute force: same pairs, same MTVs, same order,
 //! whatever the scene (huge and tiny boxes, touching boxes, boxes at the
 //! world bounds, static and dynamic mixes, many updates in a row), the
-//! configuration and the number of threads; and no allocation per tick in
-//! steady state.
+//! configuration and the number of threads; box queries against both sets
+//! equal brute force too; and no allocation per tick in steady state.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -135,6 +135,35 @@ fn check_all(
     }
 }
 
+/// The box queries: every box of both sets (and a point at each one's
+/// corner) as a query finds exactly the boxes of each set whose interior
+/// overlaps it.
+fn check_queries(bp: &BroadPhase, statics: &[(u32, Bounds)], dynamics: &[(u32, Bounds)]) {
+    let brute = |set: &[(u32, Bounds)], q: &Bounds| {
+        let mut v: Vec<u32> = set
+            .iter()
+            .filter(|b| b.1.overlaps(q))
+            .map(|b| b.0)
+            .collect();
+        v.sort_unstable();
+        v
+    };
+    let mut got = Vec::new();
+    for (_, b) in statics.iter().chain(dynamics) {
+        let p = Bounds::new(b.min + 1, b.min + 1);
+        for q in [*b, p] {
+            got.clear();
+            bp.query_static(&q, |id| got.push(id));
+            got.sort_unstable();
+            assert_eq!(got, brute(statics, &q), "static query {q:?}");
+            got.clear();
+            bp.query_dynamic(&q, |id| got.push(id));
+            got.sort_unstable();
+            assert_eq!(got, brute(dynamics, &q), "dynamic query {q:?}");
+        }
+    }
+}
+
 /// Checks one static + dynamic scene under every configuration.
 fn check_scene(statics: &[(u32, Bounds)], dynamics: &[(u32, Bounds)]) {
     let mut expect = Vec::new();
@@ -145,6 +174,7 @@ fn check_scene(statics: &[(u32, Bounds)], dynamics: &[(u32, Bounds)]) {
         bp.set_static(statics);
         bp.update_dynamic(dynamics);
         check_all(&mut bp, dynamics, &all, &expect);
+        check_queries(&bp, statics, dynamics);
     }
 }
 
@@ -283,6 +313,7 @@ proptest! {
                     pools()[tick % 3].install(|| bp.update_dynamic_par(&d));
                 }
                 check_all(bp, &d, &all, &expect);
+                check_queries(bp, &s, &d);
             }
         }
     }

@@ -474,6 +474,7 @@ fn a_body_pressed_between_walls_closer_than_itself_is_squished() {
         let mut w = World::new(SimConfig {
             substeps: 1,
             restitution_iterations: iterations,
+            ..SimConfig::default()
         })
         .unwrap();
         // Faces at x = -6 px and +6 px: 12 px of room for a 16 px body.
@@ -530,6 +531,7 @@ fn substeps_stop_tunnelling_through_thin_walls() {
         let mut w = World::new(SimConfig {
             substeps,
             restitution_iterations: 4,
+            ..SimConfig::default()
         })
         .unwrap();
         // A 2 px thin wall, face at x = 0.
@@ -548,6 +550,7 @@ fn substeps_move_exactly_by_the_velocity() {
         let mut w = World::new(SimConfig {
             substeps,
             restitution_iterations: 1,
+            ..SimConfig::default()
         })
         .unwrap();
         let (b, _) = square(&mut w, IVec2::new(5, -3), IVec2::new(1001, -37));
@@ -614,12 +617,14 @@ fn building_rejects_values_outside_the_bounds_and_names_them() {
     assert!(w.set_position(b, IVec2::new(0, MAX_COORD + 1)).is_err());
     assert!(World::new(SimConfig {
         substeps: 0,
-        restitution_iterations: 1
+        restitution_iterations: 1,
+        ..SimConfig::default()
     })
     .is_err());
     assert!(World::new(SimConfig {
         substeps: 1,
-        restitution_iterations: 0
+        restitution_iterations: 0,
+        ..SimConfig::default()
     })
     .is_err());
 }
@@ -648,6 +653,7 @@ fn events_are_sorted_unique_and_merge_substeps() {
     let mut w = World::new(SimConfig {
         substeps: 4,
         restitution_iterations: 4,
+        ..SimConfig::default()
     })
     .unwrap();
     let (_, floor) = fixed(&mut w, IVec2::new(0, px(8)), IVec2::new(px(200), px(8)));

@@ -240,6 +240,7 @@ fn sliding_along_every_surface_never_snags_at_any_subpixel_offset() {
         SimConfig {
             substeps: 3,
             restitution_iterations: 2,
+            ..SimConfig::default()
         },
     ];
     for config in configs {

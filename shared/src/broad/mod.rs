@@ -171,7 +171,10 @@ enum Work {
 
 /// The broad phase: a static set indexed once, a dynamic set updated every
 /// tick, and the pair search over both. See the [module docs](self).
-#[derive(Debug)]
+///
+/// Cloning copies the sets and every buffer: the clone continues
+/// incrementally from the same state.
+#[derive(Debug, Clone)]
 pub struct BroadPhase {
     levels: Levels,
     batch: usize,
@@ -297,6 +300,26 @@ impl BroadPhase {
         F: Fn(u32, u32) -> Option<IVec2> + Sync,
     {
         self.run(&NarrowKernel(narrow), out, true);
+    }
+
+    /// Calls `f(id)` for every box of the static set whose interior overlaps
+    /// `b`'s (in no particular order): one box query, for callers that know
+    /// which few boxes changed.
+    pub fn query_static(&self, b: &Bounds, f: impl FnMut(u32)) {
+        Self::query(&self.levels, &self.statics, b, f);
+    }
+
+    /// [`Self::query_static`] over the dynamic set as the last update left it.
+    pub fn query_dynamic(&self, b: &Bounds, f: impl FnMut(u32)) {
+        Self::query(&self.levels, &self.dynamics, b, f);
+    }
+
+    fn query(lv: &Levels, set: &Strips, b: &Bounds, mut f: impl FnMut(u32)) {
+        if set.len() == 0 {
+            return;
+        }
+        let q = (b.min.x, b.max.x, b.min.y, b.max.y);
+        sweep::query(lv, set, q, |j| f(set.id[j]));
     }
 
     /// Plans the batches, runs `kernel` over them and sorts the result.

@@ -35,7 +35,7 @@ const MAX_BUCKET_BITS: u32 = 16;
 const LEAF_PAIRS: usize = 4096;
 
 /// Reused buffers of one output type.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(crate) struct Buffers<T> {
     /// One output buffer per work item.
     pub bufs: Vec<Vec<T>>,

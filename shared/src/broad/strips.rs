@@ -159,7 +159,7 @@ impl Entry {
 
 /// One slice of the old strips, updated on its own (in parallel with the
 /// others when asked).
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 struct Chunk {
     /// Old row-table indices covered.
     rows: Range<usize>,
@@ -276,7 +276,7 @@ impl Chunk {
 }
 
 /// One set of boxes (the static or the dynamic ones) in strip order.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone)]
 pub(crate) struct Strips {
     /// Left edges in sorted order, strips separated by sentinels.
     pub minx: Vec<i32>,

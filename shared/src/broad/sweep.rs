@@ -222,6 +222,27 @@ pub(crate) fn cross_level<S: Sink>(
     }
 }
 
+/// Calls `hit(j)` for every entry `j` of `y` whose box overlaps box `(x0,
+/// x1, y0, y1)` (interiors, strictly): the larger-box side of
+/// [`cross_level`] for one box of any size, over every level of `y`.
+pub(crate) fn query(lv: &Levels, y: &Strips, b: (i32, i32, i32, i32), mut hit: impl FnMut(usize)) {
+    let (x0, x1, y0, y1) = b;
+    for l in 0..lv.count {
+        if y.level_rows[l] == y.level_rows[l + 1] {
+            continue;
+        }
+        let lo = lv.strip(l, y0 as i64 - lv.height(l) + 1);
+        let hi = lv.strip(l, y1 as i64 - 1);
+        for ri in y.rows_in(l, lo, hi) {
+            let r = y.rows[ri];
+            let from = x0 as i64 - r.max_w as i64;
+            let first = r.start as usize
+                + y.minx[r.start as usize..r.end as usize].partition_point(|&m| (m as i64) <= from);
+            scan(y, first, x0, x1, y0, y1, &mut hit);
+        }
+    }
+}
+
 /// The level of entry `e` (from the set's level boundaries).
 #[inline]
 fn level_of_entry(s: &Strips, e: usize) -> usize {

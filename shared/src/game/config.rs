@@ -148,6 +148,8 @@ impl PlayerConfig {
 pub struct GameConfig {
     /// The player (and walker gravity) constants.
     pub player: PlayerConfig,
-    /// The simulation knobs (substeps, restitution passes).
+    /// The simulation knobs: substeps and restitution passes (these change
+    /// results), broad phase, pipeline and detection threads (these never
+    /// do).
     pub sim: SimConfig,
 }

@@ -480,6 +480,14 @@ impl Game {
         &self.world
     }
 
+    /// The pool the world's detection runs on when the configuration asks
+    /// for threads (`config.sim.threads != 1`); see
+    /// [`World::set_thread_pool`]. A server running many rooms shares one
+    /// pool this way. Results never depend on it.
+    pub fn set_thread_pool(&mut self, pool: Option<std::sync::Arc<rayon::ThreadPool>>) {
+        self.world.set_thread_pool(pool);
+    }
+
     /// Adds a player at its spawn point (spawn `id % spawn count` in level
     /// order); a [`GameEvent::Joined`] opens the next step's events.
     pub fn add_player(&mut self, id: PlayerId) -> Result<(), GameError> {

@@ -1,4 +1,10 @@
 //! The simulation's speed/accuracy knobs.
+//!
+//! `substeps` and `restitution_iterations` change results (and are part of
+//! [`super::World::state_hash`]). The other three only change how the work
+//! is done: every combination of `broad_phase`, `pipeline` and `threads`
+//! gives the same contacts in the same order and bit-identical states
+//! (`tests/world_threads.rs`), so they are not hashed.
 
 use serde::{Deserialize, Serialize};
 
@@ -7,10 +13,70 @@ use super::BuildError;
 /// Most substeps or restitution passes a configuration may ask for.
 pub const MAX_ROUNDS: u32 = 64;
 
-/// How hard the simulation works per tick. Both knobs trade cost for
-/// accuracy; the defaults suit the warm-up room (speeds well under a body's
-/// half size per tick).
+/// Most threads [`SimConfig::threads`] may ask for.
+pub const MAX_THREADS: u32 = 256;
+
+/// How detection finds the pairs of colliders to test.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum BroadPhaseKind {
+    /// Every pair of colliders, one monomorphised loop per pair of shape
+    /// kinds with a bounding-box reject: quadratic, the reference for tests
+    /// and comparisons (and what the world did before the broad phase).
+    BruteForce,
+    /// The levelled-strip sort-and-sweep of [`crate::broad`]: static
+    /// colliders indexed once, the others updated every detection.
+    Strips {
+        /// `log2` of the finest strip height in units, `4..=31` (14 is
+        /// 64 px).
+        strip_shift: u32,
+        /// `log2` of the height ratio between consecutive levels, `1..=28`
+        /// (2 is x4).
+        level_shift: u32,
+    },
+}
+
+impl BroadPhaseKind {
+    /// The default: strips of 64 px growing x4 per level (the best of the
+    /// settings measured on the world benchmarks, `docs/PERFORMANCE.md`,
+    /// "World pipeline: general vs specialised").
+    pub const DEFAULT: BroadPhaseKind = BroadPhaseKind::Strips {
+        strip_shift: 14,
+        level_shift: 2,
+    };
+}
+
+impl Default for BroadPhaseKind {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// Which passes a tick runs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Pipeline {
+    /// Only the passes the scene needs, chosen from its
+    /// [`super::SceneFeatures`] whenever colliders, bodies or the tilemap
+    /// change: the AABB fast path when every collider is a box, no rider
+    /// search without riders and kinematic boxes, no tile queries without a
+    /// tilemap, no trigger logging without triggers (the default).
+    #[default]
+    Specialised,
+    /// Every pass for every scene, through the general narrow-phase
+    /// dispatch: the comparison point for the specialised pipeline.
+    General,
+}
+
+/// How hard the simulation works per tick, and how. `substeps` and
+/// `restitution_iterations` trade cost for accuracy; the defaults suit the
+/// warm-up room (speeds well under a body's half size per tick).
+/// `broad_phase`, `pipeline` and `threads` never change a result, so a
+/// client predicting with a server's configuration (sent in the welcome) may
+/// replace them with its own.
+///
+/// Deserialising from a self-describing format (JSON, ...) fills missing
+/// fields with their defaults.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(default)]
 pub struct SimConfig {
     /// Move/detect/restitute rounds per tick, `1..=MAX_ROUNDS`. Each substep
     /// moves every body by its share of its current velocity: substep `k` of
@@ -23,6 +89,27 @@ pub struct SimConfig {
     /// overlapping a solid after the last pass is reported squished. More
     /// passes: fewer false squishes in piles, more detection.
     pub restitution_iterations: u32,
+    /// How pairs are found (default: [`BroadPhaseKind::DEFAULT`]).
+    pub broad_phase: BroadPhaseKind,
+    /// Which passes run (default: [`Pipeline::Specialised`]).
+    pub pipeline: Pipeline,
+    /// Threads for detection (the broad-phase update, the pair search and
+    /// the narrow phase), `0..=MAX_THREADS`:
+    ///
+    /// * `1` (default): this thread only; rayon is never touched.
+    /// * `0`: rayon's *current* pool: the pool attached with
+    ///   [`super::World::set_thread_pool`] if any, else the pool `step` is
+    ///   called from (inside `ThreadPool::install`), else rayon's global
+    ///   pool.
+    /// * `n >= 2`: the attached pool if any, else a pool of `n` threads the
+    ///   world builds at its first step (shared by its clones).
+    ///
+    /// Only full detections through the broad phase are split (update, pair
+    /// search and narrow phase); brute force, restitution and incremental
+    /// re-detections run on the stepping thread, and so does everything in
+    /// scenes with fewer than 2,048 moving colliders (too little work to
+    /// share).
+    pub threads: u32,
 }
 
 impl Default for SimConfig {
@@ -30,22 +117,41 @@ impl Default for SimConfig {
         Self {
             substeps: 1,
             restitution_iterations: 4,
+            broad_phase: BroadPhaseKind::DEFAULT,
+            pipeline: Pipeline::Specialised,
+            threads: 1,
         }
     }
 }
 
 impl SimConfig {
-    /// Checks both knobs are in range.
+    /// Checks every knob is in range.
     pub fn validate(&self) -> Result<(), BuildError> {
+        let bad = |what, v: u32| BuildError::Config {
+            what,
+            value: v as i64,
+        };
         for (what, v) in [
             ("substeps", self.substeps),
             ("restitution_iterations", self.restitution_iterations),
         ] {
             if !(1..=MAX_ROUNDS).contains(&v) {
-                return Err(BuildError::Config {
-                    what,
-                    value: v as i64,
-                });
+                return Err(bad(what, v));
+            }
+        }
+        if self.threads > MAX_THREADS {
+            return Err(bad("threads", self.threads));
+        }
+        if let BroadPhaseKind::Strips {
+            strip_shift,
+            level_shift,
+        } = self.broad_phase
+        {
+            if !(4..=31).contains(&strip_shift) {
+                return Err(bad("broad_phase.strip_shift", strip_shift));
+            }
+            if !(1..=28).contains(&level_shift) {
+                return Err(bad("broad_phase.level_shift", level_shift));
             }
         }
         Ok(())

@@ -1,24 +1,53 @@
 //! Detection: every pair of colliders that may interact, tested exactly.
 //!
-//! Brute force over pairs for now: one generic loop per pair of shape kinds
-//! (21 monomorphised instances, same-kind pairs with `j > i`), a bounding-box
-//! reject, then the narrow phase ([`Contact`]). Then [`detect_tiles`] asks the
-//! world's tilemap ([`Tilemap::box_contacts`]) about every solid box collider
-//! of an enabled dynamic body: tile contacts are records against one static
-//! end, [`BodyId::TILEMAP`] (no per-tile collider exists). These are the only
-//! entry points, so a broad phase can replace the pair enumeration without
-//! touching restitution.
+//! Two ways to find the pairs ([`super::BroadPhaseKind`]):
+//!
+//! * **Strips** ([`detect_broad`], the default): the world's [`BroadPhase`]
+//!   holds the colliders of static bodies (indexed once, whenever statics
+//!   change) and, refreshed at each detection, those of kinematic and
+//!   dynamic bodies (one reused buffer, collider id order, so the update is
+//!   incremental). Every pair whose bounding boxes overlap goes through one
+//!   closure that applies the pair filters ([`interacts`]) on the colliders'
+//!   [`Slot`]s and calls the monomorphised [`Contact`] of the pair's two
+//!   kinds through the static table [`NARROW`] (no `match` on kinds, no trait
+//!   object). When every collider is a box, the broad phase's AABB fast path
+//!   computes the MTV straight from its sorted arrays instead, and the
+//!   filters run on its output. Optionally on a rayon pool.
+//! * **Brute force** ([`detect_all`]): one generic loop per pair of shape
+//!   kinds (21 monomorphised instances, same-kind pairs with `j > i`), a
+//!   bounding-box reject, then the narrow phase. The reference.
+//!
+//! The specialised pipeline adds two shortcuts with the same output:
+//! [`detect_small`] tests moving colliders against all colliders directly
+//! when the scene is tiny (the broad phase's fixed costs would dominate),
+//! and [`redetect`] redoes detection after a restitution pass only around
+//! the bodies the pass moved.
+//!
+//! All give the same records in the same order: sorted by `(smaller
+//! collider id, larger collider id)`, each with A the collider of the lower
+//! shape kind (of the lower id for equal kinds), exactly as the brute-force
+//! loops orient them, so restitution sees identical input.
+//!
+//! Then [`detect_tiles`] asks the world's tilemap
+//! ([`Tilemap::box_contacts`]) about every solid box collider of an enabled
+//! dynamic body: tile contacts are records against one static end,
+//! [`BodyId::TILEMAP`] (no per-tile collider exists), appended in collider
+//! order.
 
+use crate::broad::{Bounds, BroadPhase, BroadPhaseConfig};
 use crate::query::{Contact, Proximity};
 use crate::shape::{Aabb, Circle, ConvexPolygon, Obb, Point, Segment};
 use crate::tilemap::{ContactFlags, Tile, TileContact, Tilemap};
 use glam::IVec2;
 
-use super::body::{Body, BodyId};
+use super::body::{Body, BodyId, BodyKind};
 use super::collider::{ColliderData, Colliders, Stored};
-use super::contact::{ContactKind, ContactRecord, End};
+use super::config::BroadPhaseKind;
+use super::contact::{ContactKind, ContactRecord, End, RecheckFn};
+use super::layout::{Layout, Slot, GONE};
 
-/// Clears `out` and fills it with every overlapping pair that matters:
+/// Clears `out` and fills it with every overlapping pair that matters
+/// (brute force):
 ///
 /// * not two colliders of the same body;
 /// * layers and masks agree both ways;
@@ -28,8 +57,7 @@ use super::contact::{ContactKind, ContactRecord, End};
 ///   body's trigger reports any solid);
 /// * both bodies are enabled.
 ///
-/// The output order is fixed (kind pair, then set indices), so it is
-/// deterministic before any sort.
+/// The output is sorted by collider ids, like [`detect_broad`]'s.
 pub(crate) fn detect_all(cols: &Colliders, bodies: &[Body], out: &mut Vec<ContactRecord>) {
     out.clear();
     detect_pair::<Point, Point>(cols, bodies, out);
@@ -53,6 +81,10 @@ pub(crate) fn detect_all(cols: &Colliders, bodies: &[Body], out: &mut Vec<Contac
     detect_pair::<Obb, Obb>(cols, bodies, out);
     detect_pair::<Obb, ConvexPolygon>(cols, bodies, out);
     detect_pair::<ConvexPolygon, ConvexPolygon>(cols, bodies, out);
+    out.sort_unstable_by_key(|c| {
+        let (a, b) = (c.a.collider, c.b.collider);
+        (a.min(b), a.max(b))
+    });
 }
 
 /// All pairs of a kind-`A` collider and a kind-`B` collider.
@@ -146,6 +178,500 @@ where
         .contact(pos_a + a.offset, &b.shape, pos_b + b.offset)
 }
 
+/// `[kind of A][kind of B]`: the narrow phase of every ordered pair of shape
+/// kinds, monomorphised ([`recheck`]). The reverse of a mixed pair is its
+/// negation by construction, so any orientation gives the exact MTV.
+pub(crate) static NARROW: [[RecheckFn; 6]; 6] = {
+    macro_rules! row {
+        ($a:ty) => {
+            [
+                recheck::<$a, Point>,
+                recheck::<$a, Segment>,
+                recheck::<$a, Circle>,
+                recheck::<$a, Aabb>,
+                recheck::<$a, Obb>,
+                recheck::<$a, ConvexPolygon>,
+            ]
+        };
+    }
+    [
+        row!(Point),
+        row!(Segment),
+        row!(Circle),
+        row!(Aabb),
+        row!(Obb),
+        row!(ConvexPolygon),
+    ]
+};
+
+/// The pair filters of [`detect_all`] that need no body: different bodies,
+/// at least one dynamic, at least one solid, layers and masks agree both
+/// ways.
+#[inline(always)]
+pub(crate) fn interacts(a: &Slot, b: &Slot) -> bool {
+    a.body != b.body
+        && (a.dynamic || b.dynamic)
+        && (a.solid || b.solid)
+        && a.layer & b.mask != 0
+        && b.layer & a.mask != 0
+}
+
+/// The broad phase and its reused buffers.
+#[derive(Debug, Clone)]
+pub(crate) struct Detector {
+    broad: BroadPhase,
+    /// This detection's boxes of the colliders of kinematic and dynamic
+    /// bodies, in collider id order.
+    items: Vec<(u32, Bounds)>,
+    /// The broad phase's output: `(smaller id, larger id, MTV moving the
+    /// first)`, sorted.
+    pairs: Vec<(u32, u32, IVec2)>,
+    /// Incremental re-detection state.
+    stale: Stale,
+}
+
+/// What incremental re-detection ([`redetect`]) keeps between detections.
+#[derive(Debug, Clone, Default)]
+struct Stale {
+    /// Per body: moved since the broad phase's dynamic set was last updated.
+    flag: Vec<bool>,
+    /// Those bodies.
+    bodies: Vec<u32>,
+    /// Their colliders.
+    colliders: usize,
+    /// Per body: moved by the last restitution pass.
+    moved: Vec<bool>,
+    /// Candidate pairs `(smaller id, larger id)`.
+    cand: Vec<(u32, u32)>,
+    /// Stale colliders by left edge: `(min x, id)`.
+    sweep: Vec<(i32, u32)>,
+    /// New records.
+    fresh: Vec<ContactRecord>,
+    /// The merged buffer (swapped with the world's).
+    next: Vec<ContactRecord>,
+}
+
+impl Detector {
+    /// An empty detector for `kind` (brute force keeps an unused, empty
+    /// broad phase).
+    pub fn new(kind: BroadPhaseKind) -> Self {
+        let config = match kind {
+            BroadPhaseKind::Strips {
+                strip_shift,
+                level_shift,
+            } => BroadPhaseConfig {
+                strip_shift,
+                level_shift,
+                ..BroadPhaseConfig::default()
+            },
+            BroadPhaseKind::BruteForce => BroadPhaseConfig::default(),
+        };
+        Self {
+            broad: BroadPhase::new(config),
+            items: Vec::new(),
+            pairs: Vec::new(),
+            stale: Stale::default(),
+        }
+    }
+
+    /// Sizes the per-body flags for `n` bodies.
+    pub fn fit(&mut self, n: usize) {
+        if self.stale.flag.len() < n {
+            self.stale.flag.resize(n, false);
+            self.stale.moved.resize(n, false);
+        }
+    }
+
+    /// Forgets the bodies moved since the last update (after an update).
+    fn fresh_update(&mut self) {
+        let st = &mut self.stale;
+        for &b in &st.bodies {
+            st.flag[b as usize] = false;
+        }
+        st.bodies.clear();
+        st.colliders = 0;
+    }
+
+    /// Indexes the colliders of enabled static bodies (when statics change).
+    pub fn set_static(&mut self, slots: &[Slot], bodies: &[Body]) {
+        self.items.clear();
+        for (id, s) in slots.iter().enumerate() {
+            if s.index == GONE {
+                continue;
+            }
+            let b = &bodies[s.body as usize];
+            if b.kind == BodyKind::Static && b.enabled {
+                self.items.push((id as u32, bounds(s, b.pos)));
+            }
+        }
+        self.broad.set_static(&self.items);
+        self.items.clear();
+    }
+
+    /// Statistics of the broad phase (for tests and benchmarks).
+    pub fn stats(&self) -> crate::broad::BroadPhaseStats {
+        self.broad.stats()
+    }
+}
+
+/// A collider's world bounding box with its body at `pos`.
+#[inline(always)]
+fn bounds(s: &Slot, pos: IVec2) -> Bounds {
+    Bounds::new(pos + s.lo, pos + s.hi)
+}
+
+/// What [`detect_broad`] reads.
+#[derive(Clone, Copy)]
+pub(crate) struct Input<'a> {
+    pub slots: &'a [Slot],
+    /// Collider ids of kinematic and dynamic bodies, in id order.
+    pub moving: &'a [u32],
+    pub cols: &'a Colliders,
+    pub bodies: &'a [Body],
+}
+
+/// Clears `out` and fills it with the same records as [`detect_all`],
+/// through the broad phase: the AABB fast path when `aabb_fast` (every
+/// collider is a box), else the general narrow-phase dispatch; on the
+/// current rayon pool when `par`.
+pub(crate) fn detect_broad(
+    det: &mut Detector,
+    inp: Input<'_>,
+    aabb_fast: bool,
+    par: bool,
+    out: &mut Vec<ContactRecord>,
+) {
+    out.clear();
+    let Input {
+        slots,
+        moving,
+        cols,
+        bodies,
+    } = inp;
+    det.items.clear();
+    for &id in moving {
+        let s = &slots[id as usize];
+        let b = &bodies[s.body as usize];
+        if b.enabled {
+            det.items.push((id, bounds(s, b.pos)));
+        }
+    }
+    if par {
+        det.broad.update_dynamic_par(&det.items);
+    } else {
+        det.broad.update_dynamic(&det.items);
+    }
+    det.fresh_update();
+    if aabb_fast {
+        if par {
+            det.broad.contacts_aabb_par(&mut det.pairs);
+        } else {
+            det.broad.contacts_aabb(&mut det.pairs);
+        }
+        for &(x, y, m) in &det.pairs {
+            let (sx, sy) = (&slots[x as usize], &slots[y as usize]);
+            if !interacts(sx, sy) {
+                continue;
+            }
+            let (bx, by) = (&bodies[sx.body as usize], &bodies[sy.body as usize]);
+            if bx.enabled && by.enabled {
+                out.push(record(x, sx, bx.pos, y, sy, by.pos, m));
+            }
+        }
+        return;
+    }
+    let narrow = |x: u32, y: u32| -> Option<IVec2> {
+        let (sx, sy) = (&slots[x as usize], &slots[y as usize]);
+        if !interacts(sx, sy) {
+            return None;
+        }
+        let (bx, by) = (&bodies[sx.body as usize], &bodies[sy.body as usize]);
+        if !(bx.enabled && by.enabled) {
+            return None;
+        }
+        NARROW[sx.kind as usize][sy.kind as usize](cols, sx.index, bx.pos, sy.index, by.pos).mtv()
+    };
+    if par {
+        det.broad.contacts_with_par(&narrow, &mut det.pairs);
+    } else {
+        det.broad.contacts_with(&narrow, &mut det.pairs);
+    }
+    for &(x, y, m) in &det.pairs {
+        let (sx, sy) = (&slots[x as usize], &slots[y as usize]);
+        let (px, py) = (bodies[sx.body as usize].pos, bodies[sy.body as usize].pos);
+        out.push(record(x, sx, px, y, sy, py, m));
+    }
+}
+
+/// Clears `out` and fills it with the same records as [`detect_all`] by
+/// testing every moving collider against every other collider (each pair
+/// once), through the same filters and [`NARROW`] table as
+/// [`detect_broad`]: the specialised path of scenes so small that the broad
+/// phase's fixed costs exceed the few pair tests (see
+/// [`super::layout::SMALL_PAIRS`]).
+pub(crate) fn detect_small(inp: Input<'_>, statics: &[u32], out: &mut Vec<ContactRecord>) {
+    out.clear();
+    let Input {
+        slots,
+        moving,
+        cols,
+        bodies,
+    } = inp;
+    for (k, &x) in moving.iter().enumerate() {
+        let sx = &slots[x as usize];
+        let bx = &bodies[sx.body as usize];
+        if !bx.enabled {
+            continue;
+        }
+        let (xlo, xhi) = (bx.pos + sx.lo, bx.pos + sx.hi);
+        // Later moving colliders (ids ascending: x < y), then static ones.
+        for &y in moving[k + 1..].iter().chain(statics) {
+            let sy = &slots[y as usize];
+            if !interacts(sx, sy) {
+                continue;
+            }
+            let by = &bodies[sy.body as usize];
+            let (ylo, yhi) = (by.pos + sy.lo, by.pos + sy.hi);
+            if !by.enabled || yhi.x <= xlo.x || ylo.x >= xhi.x || yhi.y <= xlo.y || ylo.y >= xhi.y {
+                continue;
+            }
+            let (a, sa, pa, b, sb, pb) = if x < y {
+                (x, sx, bx.pos, y, sy, by.pos)
+            } else {
+                (y, sy, by.pos, x, sx, bx.pos)
+            };
+            let p = NARROW[sa.kind as usize][sb.kind as usize](cols, sa.index, pa, sb.index, pb);
+            if let Some(m) = p.mtv() {
+                out.push(record(a, sa, pa, b, sb, pb, m));
+            }
+        }
+    }
+    out.sort_unstable_by_key(|c| {
+        let (a, b) = (c.a.collider, c.b.collider);
+        (a.min(b), a.max(b))
+    });
+}
+
+/// Re-detection after a restitution pass that moved the bodies `pushed`
+/// (sorted, distinct): the same records as a full [`detect_broad`] (then
+/// [`detect_tiles`]), computed only around those bodies. Records between
+/// bodies that did not move are kept (same positions, same answer); the
+/// moved bodies' colliders query the broad phase's static set and the
+/// dynamic boxes that are still where the last update put them, and are
+/// swept against the other colliders moved since that update; their tile
+/// contacts are asked again. The result is merged back into canonical order.
+///
+/// Returns `false`, doing nothing, when the bodies moved since the last
+/// update have more than an eighth of the moving colliders: a full
+/// detection is then cheaper.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn redetect(
+    det: &mut Detector,
+    inp: Input<'_>,
+    layout: &Layout,
+    pushed: &[u32],
+    tiles: Option<&Tilemap>,
+    scratch: &mut Vec<TileContact>,
+    contacts: &mut Vec<ContactRecord>,
+) -> bool {
+    let Input {
+        slots,
+        cols,
+        bodies,
+        ..
+    } = inp;
+    let limit = (layout.moving.len() / 8).max(8);
+    let st = &mut det.stale;
+    let mut colliders = st.colliders;
+    for &b in pushed {
+        if !st.flag[b as usize] {
+            colliders += layout.colliders_of(b).len();
+        }
+    }
+    if colliders > limit {
+        return false;
+    }
+    for &b in pushed {
+        if !st.flag[b as usize] {
+            st.flag[b as usize] = true;
+            st.bodies.push(b);
+        }
+        st.moved[b as usize] = true;
+    }
+    st.colliders = colliders;
+    let here = |id: u32| {
+        let s = &slots[id as usize];
+        bounds(s, bodies[s.body as usize].pos)
+    };
+    // Candidates: each moved collider against the static set and the
+    // up-to-date dynamic boxes ...
+    st.cand.clear();
+    for &b in pushed {
+        for &x in layout.colliders_of(b) {
+            let bx = here(x);
+            let cand = &mut st.cand;
+            let pair = |y: u32| if x < y { (x, y) } else { (y, x) };
+            det.broad.query_static(&bx, |y| cand.push(pair(y)));
+            let flag = &st.flag;
+            det.broad.query_dynamic(&bx, |y| {
+                if !flag[slots[y as usize].body as usize] {
+                    cand.push(pair(y));
+                }
+            });
+        }
+    }
+    // ... and against every collider moved since the update (sort and
+    // sweep on x over their current boxes), keeping pairs with a moved one.
+    st.sweep.clear();
+    for &b in &st.bodies {
+        for &x in layout.colliders_of(b) {
+            st.sweep.push((here(x).min.x, x));
+        }
+    }
+    st.sweep.sort_unstable();
+    for (i, &(_, x)) in st.sweep.iter().enumerate() {
+        let bx = here(x);
+        let mx = st.moved[slots[x as usize].body as usize];
+        for &(minx, y) in &st.sweep[i + 1..] {
+            if minx >= bx.max.x {
+                break;
+            }
+            if (mx || st.moved[slots[y as usize].body as usize]) && bx.overlaps(&here(y)) {
+                st.cand.push(if x < y { (x, y) } else { (y, x) });
+            }
+        }
+    }
+    st.cand.sort_unstable();
+    st.cand.dedup();
+    // Their records, in canonical order.
+    st.fresh.clear();
+    for &(x, y) in &st.cand {
+        let (sx, sy) = (&slots[x as usize], &slots[y as usize]);
+        if !interacts(sx, sy) {
+            continue;
+        }
+        let (bx, by) = (&bodies[sx.body as usize], &bodies[sy.body as usize]);
+        if !(bx.enabled && by.enabled) {
+            continue;
+        }
+        let p =
+            NARROW[sx.kind as usize][sy.kind as usize](cols, sx.index, bx.pos, sy.index, by.pos);
+        if let Some(m) = p.mtv() {
+            st.fresh.push(record(x, sx, bx.pos, y, sy, by.pos, m));
+        }
+    }
+    // Merge with the records of bodies that did not move: pairs first ...
+    let moved = &st.moved;
+    let keep =
+        |c: &ContactRecord| !moved[c.a.body as usize] && (c.is_tile() || !moved[c.b.body as usize]);
+    let split = contacts
+        .iter()
+        .position(|c| c.is_tile())
+        .unwrap_or(contacts.len());
+    let key = |c: &ContactRecord| {
+        let (a, b) = (c.a.collider, c.b.collider);
+        (a.min(b), a.max(b))
+    };
+    st.next.clear();
+    merge(
+        contacts[..split].iter().filter(|c| keep(c)),
+        st.fresh.iter(),
+        key,
+        &mut st.next,
+    );
+    // ... then tiles, by collider (each collider's tiles are all kept or
+    // all asked again).
+    if let Some(map) = tiles {
+        st.fresh.clear();
+        for &i in &layout.tile_boxes {
+            let c = &cols.aabbs.items[i as usize];
+            if moved[c.body as usize] {
+                tile_box(map, i as usize, c, bodies, scratch, &mut st.fresh);
+            }
+        }
+        merge(
+            contacts[split..].iter().filter(|c| keep(c)),
+            st.fresh.iter(),
+            |c| c.a.collider,
+            &mut st.next,
+        );
+    }
+    core::mem::swap(contacts, &mut st.next);
+    for &b in pushed {
+        st.moved[b as usize] = false;
+    }
+    true
+}
+
+/// Appends the merge of two sequences sorted by `key` (disjoint keys).
+fn merge<'a, K: Ord>(
+    a: impl Iterator<Item = &'a ContactRecord>,
+    b: impl Iterator<Item = &'a ContactRecord>,
+    key: impl Fn(&ContactRecord) -> K,
+    out: &mut Vec<ContactRecord>,
+) {
+    let (mut a, mut b) = (a.peekable(), b.peekable());
+    loop {
+        let next = match (a.peek(), b.peek()) {
+            (Some(x), Some(y)) => {
+                if key(x) <= key(y) {
+                    a.next()
+                } else {
+                    b.next()
+                }
+            }
+            (Some(_), None) => a.next(),
+            (None, Some(_)) => b.next(),
+            (None, None) => return,
+        };
+        out.extend(next.copied());
+    }
+}
+
+/// The record of colliders `x < y` overlapping with MTV `m` (moving `x`),
+/// oriented like [`detect_all`]'s: A is the collider of the lower shape
+/// kind, or `x` for equal kinds.
+#[inline(always)]
+fn record(x: u32, sx: &Slot, px: IVec2, y: u32, sy: &Slot, py: IVec2, m: IVec2) -> ContactRecord {
+    let (ia, a, pa, ib, b, pb, m) = if sx.kind <= sy.kind {
+        (x, sx, px, y, sy, py, m)
+    } else {
+        (y, sy, py, x, sx, px, -m)
+    };
+    let (alo, ahi) = (pa + a.lo, pa + a.hi);
+    let (blo, bhi) = (pb + b.lo, pb + b.hi);
+    let ix = (ahi.x.min(bhi.x) as i64 - alo.x.max(blo.x) as i64) as u64;
+    let iy = (ahi.y.min(bhi.y) as i64 - alo.y.max(blo.y) as i64) as u64;
+    ContactRecord {
+        a: slot_end(ia, a),
+        b: slot_end(ib, b),
+        mtv: m,
+        kind: if a.solid && b.solid {
+            ContactKind::Solid
+        } else {
+            ContactKind::Trigger
+        },
+        pos_a: pa,
+        pos_b: pb,
+        area: ix.saturating_mul(iy),
+        recheck: NARROW[a.kind as usize][b.kind as usize],
+        tile: IVec2::ZERO,
+    }
+}
+
+/// The contact end of collider `id`.
+#[inline(always)]
+fn slot_end(id: u32, s: &Slot) -> End {
+    End {
+        body: s.body,
+        collider: id,
+        index: s.index,
+        tag: s.tag,
+        one_way: s.one_way,
+        solid: s.solid,
+    }
+}
+
 /// The layer bit of the world's tilemap: a collider interacts with tiles when
 /// its `mask` has this bit (the default mask has every bit).
 pub const TILEMAP_LAYER: u32 = 1 << 31;
@@ -165,65 +691,91 @@ pub(crate) fn tile_flags(b: &Body) -> ContactFlags {
 /// (mask with [`TILEMAP_LAYER`]) of an enabled dynamic body, in collider
 /// order then row-major tile order: a solid record for a tile that pushes, a
 /// trigger record (zero MTV) for an overlapped hazard. `scratch` is reused.
+///
+/// With `boxes` (the specialised pipeline's list of those colliders' indices,
+/// in set order) only they are visited; without, every box is checked.
 pub(crate) fn detect_tiles(
     map: &Tilemap,
     cols: &Colliders,
+    bodies: &[Body],
+    boxes: Option<&[u32]>,
+    scratch: &mut Vec<TileContact>,
+    out: &mut Vec<ContactRecord>,
+) {
+    let set = &cols.aabbs.items;
+    match boxes {
+        Some(list) => {
+            for &i in list {
+                tile_box(map, i as usize, &set[i as usize], bodies, scratch, out);
+            }
+        }
+        None => {
+            for (i, c) in set.iter().enumerate() {
+                if c.dynamic && c.solid && c.mask & TILEMAP_LAYER != 0 {
+                    tile_box(map, i, c, bodies, scratch, out);
+                }
+            }
+        }
+    }
+}
+
+/// The tile contacts of box collider `c` (index `i` in its set).
+#[inline]
+fn tile_box(
+    map: &Tilemap,
+    i: usize,
+    c: &ColliderData<Aabb>,
     bodies: &[Body],
     scratch: &mut Vec<TileContact>,
     out: &mut Vec<ContactRecord>,
 ) {
     let t = map.tile_size() as i64;
     let origin = map.origin().as_i64vec2();
-    for (i, c) in cols.aabbs.items.iter().enumerate() {
-        if !c.dynamic || !c.solid || c.mask & TILEMAP_LAYER == 0 {
+    let b = &bodies[c.body as usize];
+    if !b.enabled {
+        return;
+    }
+    let centre = b.pos + c.offset;
+    scratch.clear();
+    map.box_contacts(
+        centre,
+        c.shape.half(),
+        b.pos - b.start,
+        tile_flags(b),
+        scratch,
+    );
+    let (lo, hi) = ((b.pos + c.lo).as_i64vec2(), (b.pos + c.hi).as_i64vec2());
+    for tc in scratch.iter() {
+        if !tile_push_ok(map, tc.tile, tc.kind, centre, tc.mtv) {
             continue;
         }
-        let b = &bodies[c.body as usize];
-        if !b.enabled {
-            continue;
-        }
-        let centre = b.pos + c.offset;
-        scratch.clear();
-        map.box_contacts(
-            centre,
-            c.shape.half(),
-            b.pos - b.start,
-            tile_flags(b),
-            scratch,
-        );
-        let (lo, hi) = ((b.pos + c.lo).as_i64vec2(), (b.pos + c.hi).as_i64vec2());
-        for tc in scratch.iter() {
-            if !tile_push_ok(map, tc.tile, tc.kind, centre, tc.mtv) {
-                continue;
-            }
-            let tlo = origin + tc.tile.as_i64vec2() * t;
-            let thi = tlo + t;
-            let ix = (hi.x.min(thi.x) - lo.x.max(tlo.x)).max(0) as u64;
-            let iy = (hi.y.min(thi.y) - lo.y.max(tlo.y)).max(0) as u64;
-            let solid = tc.kind != Tile::Hazard;
-            out.push(ContactRecord {
-                a: end_of(i, c),
-                b: End {
-                    body: BodyId::TILEMAP.0,
-                    collider: BodyId::TILEMAP.0,
-                    index: 0,
-                    tag: TILEMAP_TAG,
-                    one_way: None,
-                    solid,
-                },
-                mtv: tc.mtv,
-                kind: if solid {
-                    ContactKind::Solid
-                } else {
-                    ContactKind::Trigger
-                },
-                pos_a: b.pos,
-                pos_b: IVec2::ZERO,
-                area: ix.saturating_mul(iy),
-                recheck: no_recheck,
-                tile: tc.tile,
-            });
-        }
+        let tlo = origin + tc.tile.as_i64vec2() * t;
+        let thi = tlo + t;
+        let ix = (hi.x.min(thi.x) - lo.x.max(tlo.x)).max(0) as u64;
+        let iy = (hi.y.min(thi.y) - lo.y.max(tlo.y)).max(0) as u64;
+        let solid = tc.kind != Tile::Hazard;
+        out.push(ContactRecord {
+            a: end_of(i, c),
+            b: End {
+                body: BodyId::TILEMAP.0,
+                collider: BodyId::TILEMAP.0,
+                index: 0,
+                tag: TILEMAP_TAG,
+                one_way: None,
+                solid,
+            },
+            mtv: tc.mtv,
+            kind: if solid {
+                ContactKind::Solid
+            } else {
+                ContactKind::Trigger
+            },
+            pos_a: b.pos,
+            pos_b: IVec2::ZERO,
+            area: ix.saturating_mul(iy),
+            recheck: no_recheck,
+            tile: tc.tile,
+        });
     }
 }
 

@@ -1,9 +1,11 @@
 //! Bodies, colliders and the tick pipeline.
 //!
 //! ```text
-//! step(inputs): controllers -> find carriers -> for each substep { carry riders
-//!               -> move -> detect (colliders, then tiles) -> restitute
-//!               (-> detect again after each pass that moved something) } -> events
+//! step(inputs): [refresh features, passes and the static index if the content
+//!               changed] -> controllers -> find carriers -> for each substep {
+//!               carry riders -> move -> detect (colliders, then tiles) ->
+//!               restitute (-> detect again after each pass that moved
+//!               something) } -> events
 //! ```
 //!
 //! * **Tilemap** ([`World::set_tilemap`]): detection asks the tilemap about
@@ -27,10 +29,34 @@
 //! * **Removal** ([`World::remove_body`]) frees a body's slot (reused by the
 //!   next [`World::add_body`]) and drops its colliders and controllers;
 //!   [`World::set_enabled`] only suspends a body.
+//! * **Detection** goes through the broad phase ([`crate::broad`]) by
+//!   default ([`BroadPhaseKind`]): colliders of static bodies are indexed
+//!   once (again only when statics change: a static body added, moved,
+//!   enabled, disabled or removed), those of kinematic and dynamic bodies
+//!   are updated at each detection (one reused buffer, collider id order),
+//!   and every overlapping pair runs the monomorphised narrow phase of its
+//!   two kinds through a static dispatch table. Contacts come out in
+//!   canonical order (pairs by collider ids, then tiles by collider and
+//!   tile), identical for brute force, either pipeline and any thread count
+//!   ([`SimConfig::threads`], [`World::set_thread_pool`]); restitution walks
+//!   them in its own order through a sorted index, so the buffer stays
+//!   canonical.
+//! * **Only what the scene needs** ([`Pipeline::Specialised`]): whenever the
+//!   content changes the world recomputes its [`SceneFeatures`] and runs
+//!   only what they imply: direct pair tests without the broad phase for a
+//!   tiny scene, the AABB fast path for a scene of boxes, no rider search
+//!   without riders and kinematic boxes (and then only riders against
+//!   platforms), tile queries only for the boxes that can touch tiles, no
+//!   trigger logging without triggers, and re-detection after a
+//!   restitution pass only around the bodies the pass moved. Same results,
+//!   bit for bit, as [`Pipeline::General`].
 //! * [`body`]: static, kinematic and dynamic bodies, touched [`Sides`];
 //! * [`collider`]: shapes attached to bodies, one `Vec` per shape kind;
 //! * [`contact`]: the element of the single, reused contact buffer;
-//! * `detect`: one monomorphised loop per pair of shape kinds;
+//! * `detect`: broad phase + dispatch table, or brute force (one
+//!   monomorphised loop per pair of shape kinds);
+//! * `layout`: scene features and the specialised passes' lists;
+//! * [`scenes`]: seeded scenes for tests and benchmarks;
 //! * `restitute`: largest overlap first, no push-back, mass split;
 //! * [`event`]: what a tick reports;
 //! * [`controller`]: input to velocity;
@@ -51,26 +77,32 @@ mod detect;
 mod error;
 pub mod event;
 pub mod hash;
+mod layout;
 mod restitute;
+pub mod scenes;
 
 pub use body::{Body, BodyDesc, BodyId, BodyKind, Sides};
 pub use collider::{AnyShape, ColliderDesc, ColliderId, ColliderMode, ColliderView, OneWay};
-pub use config::SimConfig;
+pub use config::{BroadPhaseKind, Pipeline, SimConfig, MAX_THREADS};
 pub use contact::{ContactKind, ContactRecord};
 pub use controller::{Controller, Mover, MoverConfig};
 pub use detect::{TILEMAP_LAYER, TILEMAP_TAG};
 pub use error::BuildError;
 pub use event::Event;
+pub use layout::SceneFeatures;
 pub use restitute::ONE_WAY_SLOP;
 
 use crate::input::Buttons;
 use crate::shape::ShapeKind;
 use crate::tilemap::{TileContact, Tilemap};
 use glam::IVec2;
+use std::sync::Arc;
 
-use collider::{make_data, view, ColliderSet, Colliders, Stored};
+use collider::{make_data, view, ColliderData, ColliderSet, Colliders, Stored};
+use detect::Detector;
 use event::Logs;
 use hash::Fnv1a;
+use layout::{Layout, Slot, GONE};
 use restitute::Scene;
 
 /// Contacts reserved up front: the most a scene could produce in one
@@ -85,8 +117,9 @@ pub struct World {
     tick: u64,
     bodies: Vec<Body>,
     colliders: Colliders,
-    /// Where each collider lives, by id: its kind and index in that kind's set.
-    collider_index: Vec<(ShapeKind, u32)>,
+    /// Each collider by id: its kind, index in that kind's set (or [`GONE`])
+    /// and what the pair filters need.
+    slots: Vec<Slot>,
     /// Colliders attached to dynamic bodies.
     dynamic_colliders: usize,
     controllers: Vec<Controller>,
@@ -97,10 +130,41 @@ pub struct World {
     /// Hash of the tilemap (computed once when it is set).
     tilemap_digest: u64,
     tile_scratch: Vec<TileContact>,
+    /// Features, passes and the lists they walk.
+    layout: Layout,
+    /// Removed bodies whose slots are free.
+    free_bodies: usize,
+    /// Restitution order scratch: sorted keys and contact indices.
+    order: Vec<(restitute::OrderKey, u32)>,
+    /// Bodies the last restitution pass moved.
+    pushed: Vec<u32>,
+    /// How detections ran.
+    stats: DetectionStats,
+    /// Rider search scratch: carriers' top edges and set indices.
+    carrier_tops: Vec<(i64, u32)>,
+    /// The content changed since `layout` was built.
+    layout_dirty: bool,
+    /// The static colliders changed since the broad phase indexed them.
+    statics_dirty: bool,
+    /// The broad phase and its buffers.
+    detector: Detector,
+    /// The pool detection runs on (attached, or built for `threads >= 2`).
+    pool: Option<Arc<rayon::ThreadPool>>,
+    /// `pool` was given by [`World::set_thread_pool`] (else the world built it).
+    pool_attached: bool,
+    /// Building the world's own pool failed: run on one thread.
+    pool_failed: bool,
 }
 
-/// `collider_index` entry of a removed collider.
-const GONE: u32 = u32::MAX;
+/// Fewer moving colliders than this are detected on the calling thread
+/// whatever [`SimConfig::threads`] says: the broad phase would make at most
+/// two parallel batches of them, and the hand-over to a pool costs more
+/// than it saves (`benches/world.rs`).
+const PAR_MIN_MOVING: usize = 2048;
+
+/// Above this many (riders x carriers) the specialised rider search sorts
+/// the carriers by top edge instead of testing every pair.
+const SORTED_CARRIERS: usize = 256;
 
 impl Default for World {
     fn default() -> Self {
@@ -121,7 +185,7 @@ impl World {
             tick: 0,
             bodies: Vec::new(),
             colliders: Colliders::default(),
-            collider_index: Vec::new(),
+            slots: Vec::new(),
             dynamic_colliders: 0,
             controllers: Vec::new(),
             contacts: Vec::new(),
@@ -130,6 +194,79 @@ impl World {
             tilemap: None,
             tilemap_digest: 0,
             tile_scratch: Vec::new(),
+            layout: Layout::default(),
+            free_bodies: 0,
+            order: Vec::new(),
+            pushed: Vec::new(),
+            stats: DetectionStats::default(),
+            carrier_tops: Vec::new(),
+            layout_dirty: true,
+            statics_dirty: true,
+            detector: Detector::new(config.broad_phase),
+            pool: None,
+            pool_attached: false,
+            pool_failed: false,
+        }
+    }
+
+    /// Detection runs on `pool` (`Some`) whenever [`SimConfig::threads`] is
+    /// not 1, whatever its value; `None` detaches it (then `threads >= 2`
+    /// builds the world's own pool at the next step, and `threads == 0` uses
+    /// the pool `step` is called from). The server shares one pool among
+    /// its rooms this way. Results never depend on the pool.
+    pub fn set_thread_pool(&mut self, pool: Option<Arc<rayon::ThreadPool>>) {
+        self.pool_attached = pool.is_some();
+        self.pool = pool;
+        self.pool_failed = false;
+    }
+
+    /// What the scene uses (recomputed when the content changes; see
+    /// [`Pipeline::Specialised`]).
+    pub fn features(&self) -> SceneFeatures {
+        if self.layout_dirty {
+            layout::features(&self.slots, &self.bodies, self.tilemap.as_ref())
+        } else {
+            self.layout.features
+        }
+    }
+
+    /// Statistics of the broad phase's sets after the last detection (all
+    /// zero in brute-force mode).
+    pub fn broad_phase_stats(&self) -> crate::broad::BroadPhaseStats {
+        self.detector.stats()
+    }
+
+    /// How this world's detections ran so far (cumulative, for tuning and
+    /// tests; not part of the state).
+    pub fn detection_stats(&self) -> DetectionStats {
+        self.stats
+    }
+
+    /// Marks the content changed: features, passes and (with `statics`) the
+    /// broad phase's static set are rebuilt before the next tick.
+    fn touch(&mut self, statics: bool) {
+        self.layout_dirty = true;
+        self.statics_dirty |= statics;
+    }
+
+    /// Rebuilds what [`World::touch`] marked stale.
+    fn refresh(&mut self) {
+        self.detector.fit(self.bodies.len());
+        if self.layout_dirty {
+            self.layout.rebuild(
+                self.config.pipeline,
+                &self.slots,
+                &self.colliders,
+                &self.bodies,
+                self.tilemap.as_ref(),
+            );
+            self.layout_dirty = false;
+        }
+        if self.statics_dirty {
+            if self.config.broad_phase != BroadPhaseKind::BruteForce {
+                self.detector.set_static(&self.slots, &self.bodies);
+            }
+            self.statics_dirty = false;
         }
     }
 
@@ -143,9 +280,12 @@ impl World {
     pub fn add_body(&mut self, desc: BodyDesc) -> Result<BodyId, BuildError> {
         desc.validate()?;
         let body = Body::new(&desc);
-        if let Some(i) = self.bodies.iter().position(|b| b.removed) {
-            self.bodies[i] = body;
-            return Ok(BodyId(i as u32));
+        if self.free_bodies > 0 {
+            if let Some(i) = self.bodies.iter().position(|b| b.removed) {
+                self.bodies[i] = body;
+                self.free_bodies -= 1;
+                return Ok(BodyId(i as u32));
+            }
         }
         let id = BodyId(self.bodies.len() as u32);
         self.bodies.push(body);
@@ -156,9 +296,11 @@ impl World {
     /// the controllers driving it (later controllers move down one input
     /// slot each), and frees its slot for the next [`World::add_body`].
     pub fn remove_body(&mut self, id: BodyId) -> Result<(), BuildError> {
-        let dynamic = self.live(id)?.is_dynamic();
+        let body = self.live(id)?;
+        let dynamic = body.is_dynamic();
+        let is_static = body.kind == BodyKind::Static;
         let c = &mut self.colliders;
-        let ix = &mut self.collider_index;
+        let ix = &mut self.slots;
         let n = remove_colliders(&mut c.points, ShapeKind::Point, id.0, ix)
             + remove_colliders(&mut c.segments, ShapeKind::Segment, id.0, ix)
             + remove_colliders(&mut c.circles, ShapeKind::Circle, id.0, ix)
@@ -173,6 +315,8 @@ impl World {
         *b = Body::new(&BodyDesc::fixed(IVec2::ZERO));
         b.enabled = false;
         b.removed = true;
+        self.free_bodies += 1;
+        self.touch(is_static);
         Ok(())
     }
 
@@ -194,14 +338,23 @@ impl World {
     /// Suspends (`false`) or resumes a body: a disabled body keeps its state
     /// but neither moves, collides, carries nor is carried.
     pub fn set_enabled(&mut self, body: BodyId, enabled: bool) -> Result<(), BuildError> {
-        self.live_mut(body)?.enabled = enabled;
+        let b = self.live_mut(body)?;
+        let changed = b.enabled != enabled;
+        b.enabled = enabled;
+        if changed && b.kind == BodyKind::Static {
+            self.touch(true);
+        }
         Ok(())
     }
 
     /// Makes a body a rider (`true`): kinematic boxes it stands on carry it
     /// (see the module docs). Off by default.
     pub fn set_rider(&mut self, body: BodyId, rider: bool) -> Result<(), BuildError> {
-        self.live_mut(body)?.rider = rider;
+        let b = self.live_mut(body)?;
+        if b.rider != rider {
+            b.rider = rider;
+            self.touch(false);
+        }
         Ok(())
     }
 
@@ -223,6 +376,9 @@ impl World {
         crate::fixed::check_coord("body position x", p.x)?;
         crate::fixed::check_coord("body position y", p.y)?;
         b.pos = p.as_ivec2();
+        if b.kind == BodyKind::Static && d != IVec2::ZERO {
+            self.touch(true);
+        }
         Ok(())
     }
 
@@ -237,12 +393,14 @@ impl World {
             h.u8(t.code());
         }
         self.tilemap_digest = h.finish();
+        self.touch(false);
         self.tilemap.replace(map)
     }
 
     /// Removes the world's tilemap and returns it.
     pub fn take_tilemap(&mut self) -> Option<Tilemap> {
         self.tilemap_digest = 0;
+        self.touch(false);
         self.tilemap.take()
     }
 
@@ -257,23 +415,26 @@ impl World {
         body: BodyId,
         desc: ColliderDesc,
     ) -> Result<ColliderId, BuildError> {
-        let dynamic = self.live(body)?.is_dynamic();
+        let owner = self.live(body)?;
+        let dynamic = owner.is_dynamic();
+        let is_static = owner.kind == BodyKind::Static;
         desc.validate()?;
-        let id = self.collider_index.len() as u32;
+        let id = self.slots.len() as u32;
         let c = &mut self.colliders;
         let (b, d) = (body.0, &desc);
-        let entry = match desc.shape {
-            AnyShape::Point(s) => (ShapeKind::Point, c.push(make_data(id, b, dynamic, s, d))),
-            AnyShape::Segment(s) => (ShapeKind::Segment, c.push(make_data(id, b, dynamic, s, d))),
-            AnyShape::Circle(s) => (ShapeKind::Circle, c.push(make_data(id, b, dynamic, s, d))),
-            AnyShape::Aabb(s) => (ShapeKind::Aabb, c.push(make_data(id, b, dynamic, s, d))),
-            AnyShape::Obb(s) => (ShapeKind::Obb, c.push(make_data(id, b, dynamic, s, d))),
-            AnyShape::Polygon(s) => (ShapeKind::Polygon, c.push(make_data(id, b, dynamic, s, d))),
+        let slot = match desc.shape {
+            AnyShape::Point(s) => slot_of(c, make_data(id, b, dynamic, s, d)),
+            AnyShape::Segment(s) => slot_of(c, make_data(id, b, dynamic, s, d)),
+            AnyShape::Circle(s) => slot_of(c, make_data(id, b, dynamic, s, d)),
+            AnyShape::Aabb(s) => slot_of(c, make_data(id, b, dynamic, s, d)),
+            AnyShape::Obb(s) => slot_of(c, make_data(id, b, dynamic, s, d)),
+            AnyShape::Polygon(s) => slot_of(c, make_data(id, b, dynamic, s, d)),
         };
-        self.collider_index.push(entry);
+        self.slots.push(slot);
         if dynamic {
             self.dynamic_colliders += 1;
         }
+        self.touch(is_static);
         // Grow the contact buffer now rather than during the first ticks.
         let want = (self.dynamic_colliders * self.colliders.len()).min(RESERVE_CAP);
         self.contacts
@@ -309,14 +470,58 @@ impl World {
         crate::fixed::check_coord("body position x", pos.x as i64)?;
         crate::fixed::check_coord("body position y", pos.y as i64)?;
         let b = self.live_mut(body)?;
+        let moved = b.pos != pos;
         b.pos = pos;
         b.start = pos;
+        if moved && b.kind == BodyKind::Static {
+            self.touch(true);
+        }
         Ok(())
     }
 
     /// Runs one fixed tick with one input per controller slot (missing
     /// inputs count as no button held); returns the tick's events.
     pub fn step(&mut self, inputs: &[Buttons]) -> &[Event] {
+        self.refresh();
+        match self.parallelism() {
+            None => self.run_tick(inputs, false),
+            Some(None) => self.run_tick(inputs, true),
+            Some(Some(pool)) => pool.install(|| self.run_tick(inputs, true)),
+        }
+        &self.events
+    }
+
+    /// How detection runs this tick: `None` on this thread only,
+    /// `Some(None)` on the current rayon pool, `Some(Some(pool))` on `pool`.
+    fn parallelism(&mut self) -> Option<Option<Arc<rayon::ThreadPool>>> {
+        let n = self.config.threads;
+        if n == 1
+            || self.config.broad_phase == BroadPhaseKind::BruteForce
+            || self.layout.small
+            || self.layout.moving.len() < PAR_MIN_MOVING
+        {
+            return None;
+        }
+        if self.pool.is_none() && n >= 2 && !self.pool_failed {
+            match rayon::ThreadPoolBuilder::new()
+                .num_threads(n as usize)
+                .thread_name(|i| format!("ledge-world-{i}"))
+                .build()
+            {
+                Ok(p) => self.pool = Some(Arc::new(p)),
+                // Results never depend on threads: carry on with one.
+                Err(_) => self.pool_failed = true,
+            }
+        }
+        match &self.pool {
+            Some(p) => Some(Some(p.clone())),
+            None if n == 0 => Some(None),
+            None => None,
+        }
+    }
+
+    /// The tick itself (on whichever thread or pool `step` chose).
+    fn run_tick(&mut self, inputs: &[Buttons], par: bool) {
         self.tick += 1;
         self.events.clear();
         self.logs.clear();
@@ -329,51 +534,69 @@ impl World {
         for (i, c) in self.controllers.iter().enumerate() {
             c.apply(inputs.get(i).copied().unwrap_or_default(), &mut self.bodies);
         }
-        let carried = self.find_carriers();
+        let carried = self.layout.carry && self.find_carriers();
         let n = self.config.substeps;
         for k in 0..n {
             if carried {
                 self.carry_riders(k, n);
             }
             self.move_bodies(k, n);
-            self.resolve_substep();
+            self.resolve_substep(par);
         }
         self.logs.emit(&mut self.events);
-        &self.events
     }
 
     /// Sets the carrier of every rider standing flush on a kinematic box
-    /// (see the module docs); returns whether any rider is carried.
+    /// (see the module docs); returns whether any rider is carried. The
+    /// specialised pipeline walks only the riders' and the carriers' boxes
+    /// (same order, same answer); the general one every box against every
+    /// box.
     fn find_carriers(&mut self) -> bool {
         let set = &self.colliders.aabbs.items;
+        let bodies = &mut self.bodies;
         let mut any = false;
-        for rc in set {
-            let rb = &self.bodies[rc.body as usize];
-            if !rc.dynamic || !rc.solid || !rb.rider || !rb.enabled || rb.carrier.is_some() {
-                continue;
+        let (riders, carriers) = (&self.layout.riders, &self.layout.carriers);
+        if self.config.pipeline == Pipeline::Specialised
+            && riders.len() * carriers.len() > SORTED_CARRIERS
+        {
+            // Many of both: carriers sorted by top edge (then set index), each
+            // rider looks at those whose top is its bottom, in set order.
+            let tops = &mut self.carrier_tops;
+            tops.clear();
+            tops.extend(carriers.iter().map(|&k| {
+                let kc = &set[k as usize];
+                (bodies[kc.body as usize].pos.y as i64 + kc.lo.y as i64, k)
+            }));
+            tops.sort_unstable();
+            for &i in riders {
+                let rc = &set[i as usize];
+                let rb = &bodies[rc.body as usize];
+                let bottom = rb.pos.y as i64 + rc.hi.y as i64;
+                let from = tops.partition_point(|t| t.0 < bottom);
+                let level = tops[from..]
+                    .iter()
+                    .take_while(|t| t.0 == bottom)
+                    .map(|t| &set[t.1 as usize]);
+                if let Some(c) = carrier_of(rc, bodies, level) {
+                    bodies[rc.body as usize].carrier = Some(c);
+                    any = true;
+                }
             }
-            let bottom = rb.pos.y as i64 + rc.hi.y as i64;
-            let (l, r) = (rb.pos.x + rc.lo.x, rb.pos.x + rc.hi.x);
-            let found = set.iter().find(|kc| {
-                let kb = &self.bodies[kc.body as usize];
-                kb.kind == BodyKind::Kinematic
-                    && kb.enabled
-                    && kc.solid
-                    && rc.layer & kc.mask != 0
-                    && kc.layer & rc.mask != 0
-                    && match kc.one_way {
-                        None => true,
-                        Some(OneWay::Up) => !rb.drop_through,
-                        Some(_) => false,
-                    }
-                    && kb.pos.y as i64 + kc.lo.y as i64 == bottom
-                    && kb.pos.x + kc.lo.x < r
-                    && kb.pos.x + kc.hi.x > l
-            });
-            if let Some(kc) = found {
-                let body = kc.body;
-                self.bodies[rc.body as usize].carrier = Some(body);
-                any = true;
+        } else if self.config.pipeline == Pipeline::Specialised {
+            for &i in riders {
+                let rc = &set[i as usize];
+                let found = carrier_of(rc, bodies, carriers.iter().map(|&k| &set[k as usize]));
+                if let Some(c) = found {
+                    bodies[rc.body as usize].carrier = Some(c);
+                    any = true;
+                }
+            }
+        } else {
+            for rc in set {
+                if let Some(c) = carrier_of(rc, bodies, set.iter()) {
+                    bodies[rc.body as usize].carrier = Some(c);
+                    any = true;
+                }
             }
         }
         any
@@ -404,49 +627,113 @@ impl World {
 
     /// Detects and restitutes once per pass, up to the configured passes;
     /// reports what is still wedged.
-    fn resolve_substep(&mut self) {
-        self.detect();
-        restitute::log_triggers(&self.contacts, &mut self.logs.triggers);
-        let scene = Scene {
-            cols: &self.colliders,
-            tiles: self.tilemap.as_ref(),
-        };
+    fn resolve_substep(&mut self, par: bool) {
+        self.detect(par);
+        let triggers = self.layout.triggers;
+        if triggers {
+            restitute::log_triggers(&self.contacts, &mut self.logs.triggers);
+        }
         for _ in 0..self.config.restitution_iterations {
             if !restitute::has_solid(&self.contacts) {
                 return;
             }
+            let scene = Scene {
+                cols: &self.colliders,
+                tiles: self.tilemap.as_ref(),
+            };
+            self.pushed.clear();
             if !restitute::pass(
-                &mut self.contacts,
+                &self.contacts,
+                &mut self.order,
                 &mut self.bodies,
                 scene,
                 &mut self.logs.hits,
+                &mut self.pushed,
             ) {
                 // Nothing moved: the buffer is current and nothing more can change.
                 break;
             }
-            detect::detect_all(scene.cols, &self.bodies, &mut self.contacts);
-            if let Some(map) = scene.tiles {
-                detect::detect_tiles(
-                    map,
-                    scene.cols,
-                    &self.bodies,
-                    &mut self.tile_scratch,
-                    &mut self.contacts,
-                );
+            self.redetect(par);
+            if triggers {
+                restitute::log_triggers(&self.contacts, &mut self.logs.triggers);
             }
-            restitute::log_triggers(&self.contacts, &mut self.logs.triggers);
         }
+        let scene = Scene {
+            cols: &self.colliders,
+            tiles: self.tilemap.as_ref(),
+        };
         restitute::log_squished(&self.contacts, &self.bodies, scene, &mut self.logs.squished);
     }
 
-    /// Fills the contact buffer: collider pairs, then tiles.
-    fn detect(&mut self) {
-        detect::detect_all(&self.colliders, &self.bodies, &mut self.contacts);
+    /// Detection again after a restitution pass: only around the bodies it
+    /// moved when the specialised pipeline allows (same result), else in
+    /// full.
+    fn redetect(&mut self, par: bool) {
+        if self.layout.incremental && self.config.broad_phase != BroadPhaseKind::BruteForce {
+            self.pushed.sort_unstable();
+            self.pushed.dedup();
+            let inp = detect::Input {
+                slots: &self.slots,
+                moving: &self.layout.moving,
+                cols: &self.colliders,
+                bodies: &self.bodies,
+            };
+            let tiles = if self.layout.tiles {
+                self.tilemap.as_ref()
+            } else {
+                None
+            };
+            if detect::redetect(
+                &mut self.detector,
+                inp,
+                &self.layout,
+                &self.pushed,
+                tiles,
+                &mut self.tile_scratch,
+                &mut self.contacts,
+            ) {
+                self.stats.incremental += 1;
+                return;
+            }
+        }
+        self.detect(par);
+    }
+
+    /// Fills the contact buffer: collider pairs (broad phase or brute
+    /// force), then tiles.
+    fn detect(&mut self, par: bool) {
+        self.stats.full += 1;
+        self.stats.parallel += par as u64;
+        let inp = detect::Input {
+            slots: &self.slots,
+            moving: &self.layout.moving,
+            cols: &self.colliders,
+            bodies: &self.bodies,
+        };
+        if self.config.broad_phase == BroadPhaseKind::BruteForce {
+            detect::detect_all(&self.colliders, &self.bodies, &mut self.contacts);
+        } else if self.layout.small {
+            detect::detect_small(inp, &self.layout.statics, &mut self.contacts);
+        } else {
+            detect::detect_broad(
+                &mut self.detector,
+                inp,
+                self.layout.aabb_fast,
+                par,
+                &mut self.contacts,
+            );
+        }
+        if !self.layout.tiles {
+            return;
+        }
         if let Some(map) = &self.tilemap {
+            let boxes = (self.config.pipeline == Pipeline::Specialised)
+                .then_some(self.layout.tile_boxes.as_slice());
             detect::detect_tiles(
                 map,
                 &self.colliders,
                 &self.bodies,
+                boxes,
                 &mut self.tile_scratch,
                 &mut self.contacts,
             );
@@ -468,6 +755,21 @@ impl World {
         &self.contacts
     }
 
+    /// Runs detection now, at the bodies' current positions, without
+    /// stepping (displacements for one-way rules are those since the start
+    /// of the last tick): replaces the contact buffer with every contact,
+    /// in canonical order, and returns it. Nothing else changes. For tools
+    /// and tests (the tick detects by itself).
+    pub fn detect_contacts(&mut self) -> &[ContactRecord] {
+        self.refresh();
+        match self.parallelism() {
+            None => self.detect(false),
+            Some(None) => self.detect(true),
+            Some(Some(pool)) => pool.install(|| self.detect(true)),
+        }
+        &self.contacts
+    }
+
     /// A body by id (`None` for a removed one).
     pub fn body(&self, id: BodyId) -> Option<&Body> {
         self.bodies.get(id.0 as usize).filter(|b| !b.removed)
@@ -484,16 +786,17 @@ impl World {
 
     /// Number of collider ids issued (removed colliders included).
     pub fn collider_count(&self) -> usize {
-        self.collider_index.len()
+        self.slots.len()
     }
 
     /// A collider, placed in the world, by id (`None` once removed).
     pub fn collider(&self, id: ColliderId) -> Option<ColliderView> {
-        let &(kind, i) = self.collider_index.get(id.0 as usize)?;
+        let s = self.slots.get(id.0 as usize)?;
+        let i = s.index;
         if i == GONE {
             return None;
         }
-        Some(match kind {
+        Some(match s.kind {
             ShapeKind::Point => self.view_of::<crate::shape::Point>(i),
             ShapeKind::Segment => self.view_of::<crate::shape::Segment>(i),
             ShapeKind::Circle => self.view_of::<crate::shape::Circle>(i),
@@ -506,7 +809,7 @@ impl World {
     /// Every collider, placed in the world, in id order (for rendering and
     /// tools; the simulation never uses this view).
     pub fn colliders(&self) -> impl Iterator<Item = ColliderView> + '_ {
-        (0..self.collider_index.len() as u32).filter_map(|i| self.collider(ColliderId(i)))
+        (0..self.slots.len() as u32).filter_map(|i| self.collider(ColliderId(i)))
     }
 
     fn view_of<S: Stored>(&self, i: u32) -> ColliderView {
@@ -542,7 +845,7 @@ impl World {
             h.u32(b.carrier.unwrap_or(u32::MAX));
         }
         h.u64(self.tilemap_digest);
-        h.u32(self.collider_index.len() as u32);
+        h.u32(self.slots.len() as u32);
         for c in self.colliders() {
             h.u32(c.id.0);
             h.u32(c.body.0);
@@ -562,6 +865,54 @@ impl World {
     }
 }
 
+/// The body of the first of `carriers` that rider box `rc` stands flush on
+/// (see the module docs), if `rc` is a solid box of an enabled, not yet
+/// carried dynamic rider.
+#[inline]
+fn carrier_of<'a>(
+    rc: &ColliderData<crate::shape::Aabb>,
+    bodies: &[Body],
+    mut carriers: impl Iterator<Item = &'a ColliderData<crate::shape::Aabb>>,
+) -> Option<u32> {
+    let rb = &bodies[rc.body as usize];
+    if !rc.dynamic || !rc.solid || !rb.rider || !rb.enabled || rb.carrier.is_some() {
+        return None;
+    }
+    let bottom = rb.pos.y as i64 + rc.hi.y as i64;
+    let (l, r) = (rb.pos.x + rc.lo.x, rb.pos.x + rc.hi.x);
+    carriers
+        .find(|kc| {
+            let kb = &bodies[kc.body as usize];
+            kb.kind == BodyKind::Kinematic
+                && kb.enabled
+                && kc.solid
+                && rc.layer & kc.mask != 0
+                && kc.layer & rc.mask != 0
+                && match kc.one_way {
+                    None => true,
+                    Some(OneWay::Up) => !rb.drop_through,
+                    Some(_) => false,
+                }
+                && kb.pos.y as i64 + kc.lo.y as i64 == bottom
+                && kb.pos.x + kc.lo.x < r
+                && kb.pos.x + kc.hi.x > l
+        })
+        .map(|kc| kc.body)
+}
+
+/// How a world's detections ran ([`World::detection_stats`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub struct DetectionStats {
+    /// Full detections: every pair (brute force, direct pairs of a small
+    /// scene, or the broad phase).
+    pub full: u64,
+    /// Re-detections after a restitution pass done only around the bodies
+    /// the pass moved ([`Pipeline::Specialised`]).
+    pub incremental: u64,
+    /// Full detections split over threads ([`SimConfig::threads`]).
+    pub parallel: u64,
+}
+
 /// Substep `k` of `n`'s share of velocity `v`: `floor(v (k+1) / n) -
 /// floor(v k / n)` per axis. The shares of `n` substeps sum to `v` exactly and
 /// differ by at most one unit.
@@ -578,19 +929,40 @@ pub fn substep_share(v: IVec2, k: u32, n: u32) -> IVec2 {
 /// ids gone and re-points the ids of those that moved; returns how many went.
 fn remove_colliders<S>(
     set: &mut ColliderSet<S>,
-    kind: ShapeKind,
+    _kind: ShapeKind,
     body: u32,
-    index: &mut [(ShapeKind, u32)],
+    slots: &mut [Slot],
 ) -> usize {
     let before = set.items.len();
     for c in set.items.iter().filter(|c| c.body == body) {
-        index[c.id as usize] = (kind, GONE);
+        slots[c.id as usize].index = GONE;
     }
     set.items.retain(|c| c.body != body);
     for (i, c) in set.items.iter().enumerate() {
-        index[c.id as usize] = (kind, i as u32);
+        slots[c.id as usize].index = i as u32;
     }
     before - set.items.len()
+}
+
+/// Stores a new collider in its kind's set; returns its [`Slot`].
+fn slot_of<S: Stored>(cols: &mut Colliders, d: ColliderData<S>) -> Slot {
+    let slot = Slot {
+        kind: S::KIND,
+        index: 0,
+        body: d.body,
+        lo: d.lo,
+        hi: d.hi,
+        layer: d.layer,
+        mask: d.mask,
+        solid: d.solid,
+        dynamic: d.dynamic,
+        one_way: d.one_way,
+        tag: d.tag,
+    };
+    Slot {
+        index: cols.push(d),
+        ..slot
+    }
 }
 
 /// Feeds a shape's kind and parameters to the hash.

@@ -1,8 +1,9 @@
 //! Restitution: separate overlapping solids, largest overlap first.
 //!
-//! One pass walks the contact buffer sorted by
+//! One pass walks the contact buffer in the order of
 //! [`ContactRecord::order_key`] (`|MTV|^2` descending, then overlap area,
-//! then ids) and for each solid contact:
+//! then ids; the keys are sorted with the records' indices, the buffer
+//! itself keeps its canonical detection order) and for each solid contact:
 //!
 //! 1. **re-check**: if either body moved since the contact was detected, the
 //!    stored MTV is stale; the pair's narrow phase runs again at the current
@@ -59,27 +60,47 @@ pub(crate) struct Scene<'a> {
 /// units.
 pub const ONE_WAY_SLOP: i64 = 2;
 
-/// Runs one restitution pass over `contacts` (sorting them first); returns
-/// whether any body moved.
+/// A contact's place in the restitution order ([`ContactRecord::order_key`]).
+pub(crate) type OrderKey = (
+    core::cmp::Reverse<u64>,
+    core::cmp::Reverse<u64>,
+    u32,
+    u32,
+    i32,
+    i32,
+);
+
+/// Runs one restitution pass over `contacts` in restitution order (`order`
+/// is scratch for the sorted keys); returns whether any body moved, and
+/// appends every body it moved to `pushed` (possibly more than once).
 pub(crate) fn pass(
-    contacts: &mut [ContactRecord],
+    contacts: &[ContactRecord],
+    order: &mut Vec<(OrderKey, u32)>,
     bodies: &mut [Body],
     scene: Scene<'_>,
     hits: &mut Vec<Hit>,
+    pushed: &mut Vec<u32>,
 ) -> bool {
-    contacts.sort_unstable_by_key(ContactRecord::order_key);
+    order.clear();
+    order.extend(
+        contacts
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.kind == ContactKind::Solid)
+            .map(|(i, c)| (c.order_key(), i as u32)),
+    );
+    // Keys are unique (ids, tile): any sort gives one order.
+    order.sort_unstable();
     let mut moved = false;
-    for c in contacts.iter() {
-        if c.kind != ContactKind::Solid {
-            continue;
-        }
+    for &(_, i) in order.iter() {
+        let c = &contacts[i as usize];
         let Some(m) = current_mtv(c, bodies, scene) else {
             continue;
         };
         if !one_way_ok(c, m, bodies) {
             continue;
         }
-        moved |= resolve(c, m, bodies, hits);
+        moved |= resolve(c, m, bodies, hits, pushed);
     }
     moved
 }
@@ -211,7 +232,13 @@ fn displacement(b: &Body) -> I64Vec2 {
 }
 
 /// Applies MTV `m` to the contact's bodies; returns whether one moved.
-fn resolve(c: &ContactRecord, m: IVec2, bodies: &mut [Body], hits: &mut Vec<Hit>) -> bool {
+fn resolve(
+    c: &ContactRecord,
+    m: IVec2,
+    bodies: &mut [Body],
+    hits: &mut Vec<Hit>,
+    pushed: &mut Vec<u32>,
+) -> bool {
     let (ia, ib) = (c.a.body as usize, c.b.body as usize);
     let tile = c.is_tile();
     let dyn_a = bodies[ia].is_dynamic();
@@ -256,6 +283,7 @@ fn resolve(c: &ContactRecord, m: IVec2, bodies: &mut [Body], hits: &mut Vec<Hit>
     }
     if da != IVec2::ZERO {
         apply(&mut bodies[ia], da);
+        pushed.push(c.a.body);
         hits.push(Hit {
             body: c.a.body,
             collider: c.a.collider,
@@ -267,6 +295,7 @@ fn resolve(c: &ContactRecord, m: IVec2, bodies: &mut [Body], hits: &mut Vec<Hit>
     }
     if db != IVec2::ZERO {
         apply(&mut bodies[ib], db);
+        pushed.push(c.b.body);
         hits.push(Hit {
             body: c.b.body,
             collider: c.b.collider,
