@@ -23,7 +23,7 @@ use ledge_shared::game::state::{kind, player_flags};
 use ledge_shared::game::{Game, GameConfig};
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
-use ledge_shared::protocol::{EntityState, PlayerId, Welcome};
+use ledge_shared::protocol::{decode_sim_config, EntityState, PlayerId, Welcome};
 
 use crate::clock::SyncClock;
 use crate::error::ClientError;
@@ -72,12 +72,20 @@ impl ClientGame {
     ) -> Result<ClientGame, ClientError> {
         check_level(welcome, &level, "our level")?;
         let clock = SyncClock::for_welcome(welcome, rtt, now);
-        let predictor = Predictor::new(&level, welcome.player_id, clock.tick())?;
+        // The server's constants (an older or minimal server may send none).
+        let mut config: GameConfig = if welcome.sim_config.is_empty() {
+            GameConfig::default()
+        } else {
+            decode_sim_config(&welcome.sim_config)?
+        };
+        // Detection threads never change results; the client uses one.
+        config.sim.threads = 1;
+        let predictor = Predictor::with_config(&level, config, welcome.player_id, clock.tick())?;
         let t = &welcome.timing;
         let mut stats = StatsTracker::new(t.tick_rate, t.snapshot_interval);
         stats.rtt(rtt);
         Ok(ClientGame {
-            player_half: GameConfig::default().player.half,
+            player_half: config.player.half,
             me: welcome.player_id,
             name: None,
             welcome: Some(welcome.clone()),

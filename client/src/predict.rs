@@ -26,7 +26,7 @@
 use std::collections::VecDeque;
 
 use glam::{IVec2, Vec2};
-use ledge_shared::game::{Game, GameError};
+use ledge_shared::game::{Game, GameConfig, GameError};
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
 use ledge_shared::protocol::{EntityState, PlayerId, StateSnapshot};
@@ -113,8 +113,20 @@ impl Predictor {
     /// A predictor for player `me` in `level`, starting to record inputs at
     /// tick `start_tick`. Prediction begins at the first snapshot.
     pub fn new(level: &Level, me: PlayerId, start_tick: u64) -> Result<Predictor, GameError> {
+        Self::with_config(level, GameConfig::default(), me, start_tick)
+    }
+
+    /// [`Predictor::new`] with the server's game constants (from
+    /// [`ledge_shared::protocol::Welcome::sim_config`]): prediction is exact
+    /// only with exactly the server's rules.
+    pub fn with_config(
+        level: &Level,
+        config: GameConfig,
+        me: PlayerId,
+        start_tick: u64,
+    ) -> Result<Predictor, GameError> {
         Ok(Predictor {
-            game: Game::from_level(level)?,
+            game: Game::with_config(level, config)?,
             me,
             synced: false,
             restored: 0,

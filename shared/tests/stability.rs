@@ -1440,7 +1440,6 @@ fn a_stack_as_deep_as_the_pass_budget_settles_exactly_and_stays_put() {
     stack_settles(4, SimConfig::default().restitution_iterations, 1_000);
 }
 
-
 /// A corner where a wall box ends on a floor box (the room's corners are
 /// built so): a body at rest in it is pressed into it every tick for 60
 /// ticks; it must never be squished nor end overlapping either box.
@@ -1498,8 +1497,6 @@ fn boxes_circles_and_oriented_boxes_pressed_into_an_inside_corner_rest_there() {
         }
     }
 }
-
-
 
 // ------------------------------------------------------------ crushing
 
