@@ -36,6 +36,7 @@ fn warmup_room_ticks_allocate_nothing_in_steady_state() {
                     Event::Contact { .. } => 0,
                     Event::Trigger { .. } => 1,
                     Event::Squished { .. } => 2,
+                    Event::SweptHit { .. } => 2,
                 }] += 1;
             }
             std::hint::black_box(world.state_hash());

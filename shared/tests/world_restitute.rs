@@ -468,6 +468,112 @@ fn a_later_contact_never_pushes_a_body_back_against_an_earlier_push() {
     assert_eq!(w.body(b).unwrap().sides(), Sides::BOTTOM | Sides::TOP);
 }
 
+/// A box resting on the floor (pressed 3 px into it) with a second box
+/// falling 5 px into it: the floor goes first (support before dynamic
+/// pairs), pins the lower box against moving down, and the upper box then
+/// takes the whole push instead of splitting it by mass.
+#[test]
+fn a_body_pushed_out_of_immovable_support_is_immovable_to_the_bodies_on_it() {
+    for (m_low, m_high) in [(1, 1), (1, 9), (9, 1)] {
+        let mut w = World::default();
+        let (_, floor) = fixed(&mut w, IVec2::new(0, px(8)), IVec2::new(px(50), px(8)));
+        let (low, low_c) =
+            square_mass(&mut w, IVec2::new(0, -H + px(3)), IVec2::new(0, 100), m_low);
+        let (high, _) = square_mass(
+            &mut w,
+            IVec2::new(0, -3 * H + px(8)),
+            IVec2::new(0, 100),
+            m_high,
+        );
+        let events = w.step(&[]).to_vec();
+        let ctx = format!("masses {m_low}:{m_high}");
+        assert!(squished(&events).is_empty(), "{ctx}");
+        assert_eq!(pos(&w, low), IVec2::new(0, -H), "{ctx}");
+        assert_eq!(pos(&w, high), IVec2::new(0, -3 * H), "{ctx}");
+        assert_eq!((vel(&w, low), vel(&w, high)), (IVec2::ZERO, IVec2::ZERO));
+        // The lower box was pushed by the floor only (never down by the
+        // upper one); the upper one by the lower one.
+        assert_eq!(w.body(low).unwrap().pushed(), IVec2::new(0, -px(3) - 100));
+        let c = contacts(&events);
+        assert!(c.contains(&(low, floor, Sides::BOTTOM)), "{ctx}: {c:?}");
+        assert!(c.contains(&(high, low_c, Sides::BOTTOM)), "{ctx}: {c:?}");
+        assert!(
+            !c.iter().any(|x| x.0 == low && x.1 != floor),
+            "{ctx}: {c:?}"
+        );
+    }
+}
+
+/// Immovable support overrides the no-push-back rule against a push from a
+/// dynamic body: a box shoved into a wall by another is pushed back out
+/// (flush), and the shover takes the whole push.
+#[test]
+fn immovable_support_overrides_a_push_back_from_a_dynamic_body() {
+    let mut w = World::default();
+    let (_, wall) = fixed(&mut w, IVec2::new(px(8), 0), IVec2::new(px(8), px(50)));
+    // B flush against the wall; A 6 px into B, moving right.
+    let (b, _) = square(&mut w, IVec2::new(-H, 0), IVec2::ZERO);
+    let (a, _) = square(
+        &mut w,
+        IVec2::new(-3 * H + px(6) - 64, 0),
+        IVec2::new(64, 0),
+    );
+    let events = w.step(&[]).to_vec();
+    assert!(squished(&events).is_empty());
+    assert_eq!(pos(&w, b), IVec2::new(-H, 0));
+    assert_eq!(pos(&w, a), IVec2::new(-3 * H, 0));
+    assert_eq!(vel(&w, a), IVec2::ZERO);
+    assert!(contacts(&events).contains(&(b, wall, Sides::RIGHT)));
+}
+
+/// A wall box standing on a floor box: the wall's bottom face is covered.
+/// A triangle pressed into the inside corner gets no push out of the wall's
+/// bottom corner along its slanted edge (that would point into the floor):
+/// it is pushed out of the wall's open side and rests flush in the corner.
+#[test]
+fn a_static_box_never_pushes_through_a_face_another_static_box_covers() {
+    use ledge_shared::shape::ConvexPolygon;
+    let tri = |w: &mut World, at: IVec2, vel: IVec2| {
+        let v: Vec<IVec2> = [(-6, 5), (6, 5), (0, -6)]
+            .iter()
+            .map(|&(x, y)| IVec2::new(px(x), px(y)))
+            .collect();
+        let b = w.add_body(BodyDesc::dynamic(at).with_vel(vel)).unwrap();
+        w.add_collider(b, ColliderDesc::solid(ConvexPolygon::new(&v).unwrap()))
+            .unwrap();
+        b
+    };
+    let flush = IVec2::new(px(6), -px(5));
+    // The corner as two boxes of one static body, and (the same corner) as
+    // one box alone: its bottom face is then open, and the slanted push is
+    // the right one.
+    let mut w = World::default();
+    let room = w.add_body(BodyDesc::fixed(IVec2::ZERO)).unwrap();
+    for (c, h) in [
+        (IVec2::new(0, px(8)), IVec2::new(px(100), px(8))),
+        (IVec2::new(-px(8), -px(50)), IVec2::new(px(8), px(50))),
+    ] {
+        w.add_collider(room, ColliderDesc::solid(aabb(h)).at(c))
+            .unwrap();
+    }
+    let t = tri(&mut w, flush + IVec2::new(-1, 1), IVec2::ZERO);
+    let events = w.step(&[]).to_vec();
+    assert!(squished(&events).is_empty(), "{events:?}");
+    assert_eq!(pos(&w, t), flush);
+    // The same triangle against the wall box alone, just below its bottom
+    // corner: the slanted push out of the corner applies (down and right).
+    let mut w = World::default();
+    fixed(
+        &mut w,
+        IVec2::new(-px(8), -px(50)),
+        IVec2::new(px(8), px(50)),
+    );
+    let t = tri(&mut w, flush + IVec2::new(-1, 1), IVec2::ZERO);
+    w.step(&[]);
+    let p = pos(&w, t) - flush - IVec2::new(-1, 1);
+    assert!(p.x > 0 && p.y > 0, "pushed by {p}");
+}
+
 #[test]
 fn a_body_pressed_between_walls_closer_than_itself_is_squished() {
     for iterations in [1, 4, 16] {

@@ -25,6 +25,60 @@ pub enum CarryMode {
     None,
 }
 
+/// How faithfully the player's body is modelled: the shape-fidelity knob.
+///
+/// Both shapes span the same box (`half`), so every rule that reads the
+/// player's extents (stomps, pickups, snapping, rendering) is unchanged;
+/// only what the world collides differs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum PlayerShape {
+    /// One box of half extents `half` (the default): cheapest, and its
+    /// square corners catch on ledge corners and tile seams.
+    #[default]
+    Box,
+    /// Three boxes on one body: a torso of full width, [`FOOT_HEIGHT`]
+    /// shorter at both ends, and a feet box and a head box of that height,
+    /// each [`FOOT_INSET`] narrower on both sides, at the bottom and top.
+    /// The corners are chamfered: a jump that clips a ledge corner with
+    /// the head, or a walk off an edge, catches less. Three colliders cost
+    /// about three times the player's detection work. (All boxes: the
+    /// tilemap only collides box colliders.)
+    BoxFeetHead,
+}
+
+/// Height of the feet and head boxes of [`PlayerShape::BoxFeetHead`]: 2 px.
+pub const FOOT_HEIGHT: i32 = 2 * 256;
+
+/// How much narrower, on each side, the feet and head boxes of
+/// [`PlayerShape::BoxFeetHead`] are than the torso: 2 px.
+pub const FOOT_INSET: i32 = 2 * 256;
+
+impl PlayerShape {
+    /// The boxes of a player of half extents `half`: `(half extents, offset
+    /// from the body)` each, torso first. For `BoxFeetHead` the box must be
+    /// more than `FOOT_HEIGHT` tall and `FOOT_INSET` wide (per half);
+    /// smaller players fall back to one box.
+    pub fn boxes(self, half: IVec2) -> ([(IVec2, IVec2); 3], usize) {
+        let one = [(half, IVec2::ZERO); 3];
+        match self {
+            PlayerShape::Box => (one, 1),
+            PlayerShape::BoxFeetHead if half.x <= FOOT_INSET || half.y <= FOOT_HEIGHT => (one, 1),
+            PlayerShape::BoxFeetHead => {
+                let end = IVec2::new(half.x - FOOT_INSET, FOOT_HEIGHT / 2);
+                let y = half.y - FOOT_HEIGHT / 2;
+                (
+                    [
+                        (IVec2::new(half.x, half.y - FOOT_HEIGHT), IVec2::ZERO),
+                        (end, IVec2::new(0, y)),
+                        (end, IVec2::new(0, -y)),
+                    ],
+                    3,
+                )
+            }
+        }
+    }
+}
+
 /// Every player constant (also used by walkers for gravity).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct PlayerConfig {
@@ -72,6 +126,8 @@ pub struct PlayerConfig {
     pub stomp_tolerance: i32,
     /// What leaving a platform keeps of its velocity.
     pub carry_mode: CarryMode,
+    /// How the player's body is modelled (default: one box).
+    pub shape: PlayerShape,
 }
 
 impl Default for PlayerConfig {
@@ -95,6 +151,7 @@ impl Default for PlayerConfig {
             stomp_bounce_speed: 1024,
             stomp_tolerance: 1024,
             carry_mode: CarryMode::Add,
+            shape: PlayerShape::Box,
         }
     }
 }
@@ -148,8 +205,9 @@ impl PlayerConfig {
 pub struct GameConfig {
     /// The player (and walker gravity) constants.
     pub player: PlayerConfig,
-    /// The simulation knobs: substeps and restitution passes (these change
-    /// results), broad phase, pipeline and detection threads (these never
-    /// do).
+    /// The simulation knobs: substeps, restitution passes and swept
+    /// collision (these change results; the game marks no body swept, so
+    /// only [`crate::world::SweepMode::Auto`] sweeps its fast movers),
+    /// broad phase, pipeline and detection threads (these never do).
     pub sim: SimConfig,
 }

@@ -108,6 +108,37 @@ impl core::ops::BitOrAssign for Sides {
     }
 }
 
+/// What a swept body does when its sweep hits something (see
+/// [`super::SweepMode`] and [`super::World::set_sweep_response`]). In every
+/// case the body stops at the contact point for the rest of the substep:
+/// the remaining motion is dropped, and the next substep (or tick) moves it
+/// by its new velocity.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum SweepResponse {
+    /// Velocity into the surface removed, the rest kept (the default, and
+    /// what the discrete contact pass does: a fast-falling body lands and
+    /// keeps running).
+    #[default]
+    Slide,
+    /// Velocity zeroed: a projectile sticks where it hit.
+    Stop,
+    /// Velocity reflected about the hit normal (exact for axis-aligned
+    /// surfaces, rounded away from the surface on slanted ones; see
+    /// [`crate::query::sweep::reflect`]): a bouncing projectile.
+    Reflect,
+}
+
+impl SweepResponse {
+    /// The bits this response hashes as (in [`Body`]'s flag byte).
+    fn code(self) -> u8 {
+        match self {
+            SweepResponse::Slide => 0,
+            SweepResponse::Stop => 1,
+            SweepResponse::Reflect => 2,
+        }
+    }
+}
+
 /// What [`super::World::add_body`] needs to create a body.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct BodyDesc {
@@ -212,6 +243,14 @@ pub struct Body {
     pub(crate) drop_through: bool,
     /// The kinematic body that carried it this tick.
     pub(crate) carrier: Option<u32>,
+    /// Marked for swept collision ([`super::World::set_swept`]).
+    pub(crate) swept: bool,
+    /// What a sweep hit does to it.
+    pub(crate) sweep_response: SweepResponse,
+    /// The surfaces its last sweep hit, `(other collider, normal)`: a hit
+    /// at time 0 on one of them (resting against it and still pushing) is
+    /// not reported again.
+    pub(crate) swept_rest: super::sweep::Rest,
 }
 
 impl Body {
@@ -229,6 +268,9 @@ impl Body {
             rider: false,
             drop_through: false,
             carrier: None,
+            swept: false,
+            sweep_response: SweepResponse::Slide,
+            swept_rest: [None; super::sweep::MAX_SWEEPS],
         }
     }
 
@@ -260,6 +302,19 @@ impl Body {
         self.drop_through
     }
 
+    /// Whether it is marked for swept collision (see
+    /// [`super::World::set_swept`]).
+    #[inline]
+    pub fn is_swept(&self) -> bool {
+        self.swept
+    }
+
+    /// What a sweep hit does to it (see [`super::World::set_sweep_response`]).
+    #[inline]
+    pub fn sweep_response(&self) -> SweepResponse {
+        self.sweep_response
+    }
+
     /// The kinematic body that carried it during the last tick, if any.
     #[inline]
     pub fn carrier(&self) -> Option<BodyId> {
@@ -272,6 +327,8 @@ impl Body {
             | (self.removed as u8) << 1
             | (self.rider as u8) << 2
             | (self.drop_through as u8) << 3
+            | (self.swept as u8) << 4
+            | self.sweep_response.code() << 5
     }
 
     /// Static, kinematic or dynamic.

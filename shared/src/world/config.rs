@@ -1,14 +1,18 @@
 //! The simulation's speed/accuracy knobs.
 //!
 //! `substeps` and `restitution_iterations` change results (and are part of
-//! [`super::World::state_hash`]). The other three only change how the work
-//! is done: every combination of `broad_phase`, `pipeline` and `threads`
-//! gives the same contacts in the same order and bit-identical states
+//! [`super::World::state_hash`]). `sweep` changes results only for bodies
+//! it sweeps (a scene with none gives the same states whatever its value,
+//! `tests/world_sweep.rs`), so it is not hashed either: its effect is in
+//! the bodies' states. The other three only change how the work is done:
+//! every combination of `broad_phase`, `pipeline` and `threads` gives the
+//! same contacts in the same order and bit-identical states
 //! (`tests/world_threads.rs`), so they are not hashed.
 
 use serde::{Deserialize, Serialize};
 
 use super::BuildError;
+use crate::fixed::{px, MAX_SPEED};
 
 /// Most substeps or restitution passes a configuration may ask for.
 pub const MAX_ROUNDS: u32 = 64;
@@ -43,12 +47,71 @@ impl BroadPhaseKind {
         strip_shift: 14,
         level_shift: 2,
     };
+
+    /// The broad phase's own configuration for this kind (brute force keeps
+    /// an unused broad phase with the defaults).
+    pub fn broad_config(self) -> crate::broad::BroadPhaseConfig {
+        match self {
+            BroadPhaseKind::Strips {
+                strip_shift,
+                level_shift,
+            } => crate::broad::BroadPhaseConfig {
+                strip_shift,
+                level_shift,
+                ..crate::broad::BroadPhaseConfig::default()
+            },
+            BroadPhaseKind::BruteForce => crate::broad::BroadPhaseConfig::default(),
+        }
+    }
 }
 
 impl Default for BroadPhaseKind {
     fn default() -> Self {
         Self::DEFAULT
     }
+}
+
+/// Which bodies the move phase sweeps (time of impact against static and
+/// kinematic solids and the tilemap, instead of a plain move that a fast
+/// body can tunnel through). See "Swept collision in the world" in
+/// `docs/ARCHITECTURE.md`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum SweepMode {
+    /// No body is swept, even one marked with [`super::World::set_swept`]:
+    /// every body moves by its velocity and the discrete contact pass alone
+    /// separates overlaps (a body faster than about its half size per
+    /// substep may tunnel through a thin wall).
+    Off,
+    /// Only bodies marked with [`super::World::set_swept`] are swept (the
+    /// default): projectiles opt in, everything else moves as without
+    /// sweeps, and a scene with no marked body runs no sweep code at all.
+    #[default]
+    Flagged,
+    /// Marked bodies, and also every enabled dynamic body whose displacement
+    /// in a substep exceeds `min_speed` units on some axis (with the
+    /// response [`super::SweepResponse::Slide`] unless marked otherwise).
+    Auto {
+        /// Per-substep displacement (units, largest axis) above which an
+        /// unmarked dynamic body is swept: [`SweepMode::AUTO_MIN_SPEED`] in
+        /// [`SweepMode::AUTO`].
+        min_speed: u32,
+    },
+}
+
+impl SweepMode {
+    /// The default threshold of [`SweepMode::Auto`]: 4 px (1,024 units) per
+    /// substep. A box of half width `h` moving `d` into a wall of thickness
+    /// `w` from touching it is pushed back out (not through) while
+    /// `d <= h + w / 2`; the game's smallest moving boxes have `h >= 4 px`,
+    /// so below this speed the discrete pass cannot lose them through even a
+    /// 1 px wall, and above it the sweep takes over. (The player's run
+    /// speed is 2.5 px and its fall speed 6 px per tick.)
+    pub const AUTO_MIN_SPEED: u32 = px(4) as u32;
+
+    /// [`SweepMode::Auto`] with [`SweepMode::AUTO_MIN_SPEED`].
+    pub const AUTO: SweepMode = SweepMode::Auto {
+        min_speed: Self::AUTO_MIN_SPEED,
+    };
 }
 
 /// Which passes a tick runs.
@@ -66,9 +129,10 @@ pub enum Pipeline {
     General,
 }
 
-/// How hard the simulation works per tick, and how. `substeps` and
-/// `restitution_iterations` trade cost for accuracy; the defaults suit the
-/// warm-up room (speeds well under a body's half size per tick).
+/// How hard the simulation works per tick, and how. `substeps`,
+/// `restitution_iterations` and `sweep` trade cost for accuracy; the
+/// defaults suit the warm-up room (speeds well under a body's half size per
+/// tick), and fast movers opt in to sweeps ([`SweepMode::Flagged`]).
 /// `broad_phase`, `pipeline` and `threads` never change a result, so a
 /// client predicting with a server's configuration (sent in the welcome) may
 /// replace them with its own.
@@ -86,8 +150,11 @@ pub struct SimConfig {
     pub substeps: u32,
     /// Restitution passes per substep, `1..=MAX_ROUNDS`. After each pass that
     /// moved something, contacts are detected again; a dynamic body still
-    /// overlapping a solid after the last pass is reported squished. More
-    /// passes: fewer false squishes in piles, more detection.
+    /// overlapping a solid after the last pass is reported squished. A pass
+    /// that only pushes bodies away from pinned or immovable ends, each for
+    /// the first time this substep (support propagating up a stack), is not
+    /// counted. More passes: fewer false
+    /// squishes in piles, more detection.
     pub restitution_iterations: u32,
     /// How pairs are found (default: [`BroadPhaseKind::DEFAULT`]).
     pub broad_phase: BroadPhaseKind,
@@ -110,6 +177,15 @@ pub struct SimConfig {
     /// scenes with fewer than 2,048 moving colliders (too little work to
     /// share).
     pub threads: u32,
+    /// Which bodies the move phase sweeps (default:
+    /// [`SweepMode::Flagged`], only bodies marked with
+    /// [`super::World::set_swept`]). A swept body moves to its first time of
+    /// impact against solid static and kinematic colliders it can collide
+    /// with and the tilemap, then stops, slides or reflects
+    /// ([`super::SweepResponse`]) and reports one [`super::Event::SweptHit`]:
+    /// nothing moving up to [`crate::fixed::MAX_SPEED`] per tick passes
+    /// through a 1 px wall. Costs nothing in a scene without swept bodies.
+    pub sweep: SweepMode,
 }
 
 impl Default for SimConfig {
@@ -120,6 +196,7 @@ impl Default for SimConfig {
             broad_phase: BroadPhaseKind::DEFAULT,
             pipeline: Pipeline::Specialised,
             threads: 1,
+            sweep: SweepMode::Flagged,
         }
     }
 }
@@ -137,6 +214,14 @@ impl SimConfig {
         ] {
             if !(1..=MAX_ROUNDS).contains(&v) {
                 return Err(bad(what, v));
+            }
+        }
+        if let SweepMode::Auto { min_speed } = self.sweep {
+            if min_speed > MAX_SPEED as u32 {
+                return Err(BuildError::Config {
+                    what: "sweep.min_speed",
+                    value: min_speed as i64,
+                });
             }
         }
         if self.threads > MAX_THREADS {

@@ -97,32 +97,28 @@ impl ContactRecord {
         self.b.body == BodyId::TILEMAP.0
     }
 
-    /// Restitution order: `|MTV|^2` descending, then bounding-box overlap area
-    /// descending, then the two collider ids (smaller first), then (tile
-    /// contacts only: the tilemap is one collider) the tile's row and column.
-    /// Collider pairs and tiles are unique within a detection, so this is a
-    /// total order and an unstable sort is deterministic.
+    /// Restitution order: first the class (`0` for a contact with an
+    /// immovable end, static, kinematic or the tilemap, `1` between two
+    /// dynamic bodies), then `|mtv|^2` descending (`mtv` is the push
+    /// restitution would apply, the stored MTV unless a covered face
+    /// replaced it), then bounding-box overlap area descending, then the two
+    /// collider ids (smaller first), then (tile contacts only: the tilemap is
+    /// one collider) the tile's row and column. Collider pairs and tiles are
+    /// unique within a detection, so this is a total order and an unstable
+    /// sort is deterministic.
+    ///
+    /// The class puts the support a body rests on before the bodies resting
+    /// on it: a body pushed out of immovable geometry is pinned along that
+    /// push, so the dynamic contacts after it in the same pass treat it as
+    /// immovable along that axis instead of splitting the push with it.
     ///
     /// The area key settles equal depths in favour of the surface the body
     /// rests on: crossing a floor seam, the box being entered can offer a
     /// sideways push exactly as deep as the floor's upward one, and resolving
     /// it first would snag.
     #[inline]
-    #[allow(clippy::type_complexity)]
-    pub(crate) fn order_key(
-        &self,
-    ) -> (
-        core::cmp::Reverse<u64>,
-        core::cmp::Reverse<u64>,
-        u32,
-        u32,
-        i32,
-        i32,
-    ) {
-        let (x, y) = (
-            self.mtv.x.unsigned_abs() as u64,
-            self.mtv.y.unsigned_abs() as u64,
-        );
+    pub(crate) fn order_key(&self, class: u8, mtv: IVec2) -> OrderKey {
+        let (x, y) = (mtv.x.unsigned_abs() as u64, mtv.y.unsigned_abs() as u64);
         let l2 = x * x + y * y;
         let (lo, hi) = if self.a.collider < self.b.collider {
             (self.a.collider, self.b.collider)
@@ -130,6 +126,7 @@ impl ContactRecord {
             (self.b.collider, self.a.collider)
         };
         (
+            class,
             core::cmp::Reverse(l2),
             core::cmp::Reverse(self.area),
             lo,
@@ -139,3 +136,14 @@ impl ContactRecord {
         )
     }
 }
+
+/// A contact's place in the restitution order ([`ContactRecord::order_key`]).
+pub(crate) type OrderKey = (
+    u8,
+    core::cmp::Reverse<u64>,
+    core::cmp::Reverse<u64>,
+    u32,
+    u32,
+    i32,
+    i32,
+);

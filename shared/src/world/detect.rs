@@ -34,7 +34,7 @@
 //! [`BodyId::TILEMAP`] (no per-tile collider exists), appended in collider
 //! order.
 
-use crate::broad::{Bounds, BroadPhase, BroadPhaseConfig};
+use crate::broad::{Bounds, BroadPhase};
 use crate::query::{Contact, Proximity};
 use crate::shape::{Aabb, Circle, ConvexPolygon, Obb, Point, Segment};
 use crate::tilemap::{ContactFlags, Tile, TileContact, Tilemap};
@@ -255,17 +255,7 @@ impl Detector {
     /// An empty detector for `kind` (brute force keeps an unused, empty
     /// broad phase).
     pub fn new(kind: BroadPhaseKind) -> Self {
-        let config = match kind {
-            BroadPhaseKind::Strips {
-                strip_shift,
-                level_shift,
-            } => BroadPhaseConfig {
-                strip_shift,
-                level_shift,
-                ..BroadPhaseConfig::default()
-            },
-            BroadPhaseKind::BruteForce => BroadPhaseConfig::default(),
-        };
+        let config = kind.broad_config();
         Self {
             broad: BroadPhase::new(config),
             items: Vec::new(),

@@ -1,5 +1,6 @@
 //! Events: what happened during a tick, in a deterministic order.
 
+use glam::IVec2;
 use serde::{Deserialize, Serialize};
 
 use super::body::{BodyId, Sides};
@@ -10,8 +11,10 @@ use super::collider::ColliderId;
 /// [`super::World::step`] returns a tick's events in this order: all
 /// `Contact`s sorted by `(body, collider, other_collider)`, then all
 /// `Trigger`s sorted by `(trigger, collider)`, then all `Squished` sorted by
-/// body. Each pair is reported at most once per tick, whatever the number of
-/// substeps and restitution passes.
+/// body, then all `SweptHit`s sorted by body (a body's own hits in the order
+/// they happened). Each pair is reported at most once per tick, whatever the
+/// number of substeps and restitution passes; a `SweptHit` once per impact
+/// (at most once per body and substep).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Event {
     /// A solid contact pushed `body` (its `collider` out of `other_collider`).
@@ -50,6 +53,31 @@ pub enum Event {
         /// The body.
         body: BodyId,
     },
+    /// A swept body's motion was stopped by the first time of impact of its
+    /// sweep ([`super::SweepMode`]): it stopped at the contact and its
+    /// velocity was changed by its [`super::SweepResponse`]. Reported once
+    /// per impact: a body resting against the same surface and pushing into
+    /// it again (a hit at time 0 on the same collider, same normal) is not
+    /// reported again until a sweep of it hits something else or nothing.
+    SweptHit {
+        /// The swept body.
+        body: BodyId,
+        /// Its collider that hit first.
+        collider: ColliderId,
+        /// The body hit ([`BodyId::TILEMAP`] for a tile).
+        other_body: BodyId,
+        /// The collider hit ([`ColliderId::TILEMAP`] for a tile).
+        other_collider: ColliderId,
+        /// That collider's tag ([`super::TILEMAP_TAG`] for a tile).
+        other_tag: u16,
+        /// Surface normal at the impact, out of the obstacle towards the
+        /// body, reduced (gcd 1): `(-1, 0)` for the left face of a wall.
+        normal: IVec2,
+        /// Where the body stopped (its position, in units).
+        pos: IVec2,
+        /// The tile hit (tile coordinates) for a tile, else zero.
+        tile: IVec2,
+    },
 }
 
 /// A push, logged by restitution (possibly many times a tick per pair).
@@ -80,6 +108,9 @@ pub(crate) struct Logs {
     pub hits: Vec<Hit>,
     pub triggers: Vec<TriggerHit>,
     pub squished: Vec<u32>,
+    /// Swept hits (`Event::SweptHit` only) with their body and their rank
+    /// in the order they happened.
+    pub swept: Vec<(u32, u32, Event)>,
 }
 
 impl Logs {
@@ -87,6 +118,7 @@ impl Logs {
         self.hits.clear();
         self.triggers.clear();
         self.squished.clear();
+        self.swept.clear();
     }
 
     /// Sorts, merges and appends the tick's events to `out` (no allocation
@@ -137,5 +169,13 @@ impl Logs {
         for &b in &self.squished {
             out.push(Event::Squished { body: BodyId(b) });
         }
+        self.swept.sort_unstable_by_key(|s| (s.0, s.1));
+        out.extend(self.swept.iter().map(|s| s.2));
+    }
+
+    /// Logs a swept hit of `body` (after those already logged this tick).
+    pub fn swept_hit(&mut self, body: u32, e: Event) {
+        let rank = self.swept.len() as u32;
+        self.swept.push((body, rank, e));
     }
 }

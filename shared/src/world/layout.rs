@@ -42,6 +42,9 @@ pub struct SceneFeatures {
     pub riders: bool,
     /// Some collider is rotated: an oriented box or a polygon.
     pub rotated: bool,
+    /// Some dynamic body is marked for swept collision
+    /// ([`super::World::set_swept`]).
+    pub swept: bool,
 }
 
 impl SceneFeatures {
@@ -215,6 +218,9 @@ pub(crate) fn features(slots: &[Slot], bodies: &[Body], map: Option<&Tilemap>) -
     }
     f.rotated = f.has_kind(ShapeKind::Obb) || f.has_kind(ShapeKind::Polygon);
     f.riders = bodies.iter().any(|b| b.rider && !b.removed);
+    f.swept = bodies
+        .iter()
+        .any(|b| b.swept && !b.removed && b.kind == BodyKind::Dynamic);
     if let Some(m) = map {
         for t in m.tiles() {
             match t {

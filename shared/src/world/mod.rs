@@ -3,7 +3,8 @@
 //! ```text
 //! step(inputs): [refresh features, passes and the static index if the content
 //!               changed] -> controllers -> find carriers -> for each substep {
-//!               carry riders -> move -> detect (colliders, then tiles) ->
+//!               carry riders -> move (swept bodies last, to their first
+//!               impact) -> detect (colliders, then tiles) ->
 //!               restitute (-> detect again after each pass that moved
 //!               something) } -> events
 //! ```
@@ -26,6 +27,14 @@
 //!   through) is carried: in each substep it first moves by the kinematic
 //!   body's share of the tick's motion, then by its own velocity. Standing
 //!   on a platform moving any way thus keeps the rider's offset exact.
+//! * **Swept collision** ([`SweepMode`], [`World::set_swept`]): a swept
+//!   dynamic body moves to the first time of impact of its colliders against
+//!   the solid static and kinematic colliders it can collide with and the
+//!   tilemap, then slides, stops or reflects ([`SweepResponse`]) and reports
+//!   one [`Event::SweptHit`]; nothing up to [`crate::fixed::MAX_SPEED`] per
+//!   tick tunnels through a 1 px wall. Bodies not swept move first, so
+//!   kinematic obstacles are where the substep leaves them. See `sweep`;
+//!   a scene without swept bodies runs none of it.
 //! * **Removal** ([`World::remove_body`]) frees a body's slot (reused by the
 //!   next [`World::add_body`]) and drops its colliders and controllers;
 //!   [`World::set_enabled`] only suspends a body.
@@ -57,7 +66,9 @@
 //!   monomorphised loop per pair of shape kinds);
 //! * `layout`: scene features and the specialised passes' lists;
 //! * [`scenes`]: seeded scenes for tests and benchmarks;
-//! * `restitute`: largest overlap first, no push-back, mass split;
+//! * `sweep`: the swept move (candidates, choice, response, events);
+//! * `restitute`: support first, largest overlap first, pins, no push-back,
+//!   mass split;
 //! * [`event`]: what a tick reports;
 //! * [`controller`]: input to velocity;
 //! * [`config`]: the speed/accuracy knobs;
@@ -78,12 +89,14 @@ mod error;
 pub mod event;
 pub mod hash;
 mod layout;
+mod presets;
 mod restitute;
 pub mod scenes;
+mod sweep;
 
-pub use body::{Body, BodyDesc, BodyId, BodyKind, Sides};
+pub use body::{Body, BodyDesc, BodyId, BodyKind, Sides, SweepResponse};
 pub use collider::{AnyShape, ColliderDesc, ColliderId, ColliderMode, ColliderView, OneWay};
-pub use config::{BroadPhaseKind, Pipeline, SimConfig, MAX_THREADS};
+pub use config::{BroadPhaseKind, Pipeline, SimConfig, SweepMode, MAX_THREADS};
 pub use contact::{ContactKind, ContactRecord};
 pub use controller::{Controller, Mover, MoverConfig};
 pub use detect::{TILEMAP_LAYER, TILEMAP_TAG};
@@ -134,8 +147,8 @@ pub struct World {
     layout: Layout,
     /// Removed bodies whose slots are free.
     free_bodies: usize,
-    /// Restitution order scratch: sorted keys and contact indices.
-    order: Vec<(restitute::OrderKey, u32)>,
+    /// Restitution's order scratch, pins and covered box faces.
+    solver: restitute::Solver,
     /// Bodies the last restitution pass moved.
     pushed: Vec<u32>,
     /// How detections ran.
@@ -154,6 +167,9 @@ pub struct World {
     pool_attached: bool,
     /// Building the world's own pool failed: run on one thread.
     pool_failed: bool,
+    /// The swept move phase's static index and scratch (built at the first
+    /// sweep).
+    sweep_index: sweep::SweepIndex,
 }
 
 /// Fewer moving colliders than this are detected on the calling thread
@@ -196,7 +212,7 @@ impl World {
             tile_scratch: Vec::new(),
             layout: Layout::default(),
             free_bodies: 0,
-            order: Vec::new(),
+            solver: restitute::Solver::default(),
             pushed: Vec::new(),
             stats: DetectionStats::default(),
             carrier_tops: Vec::new(),
@@ -206,6 +222,7 @@ impl World {
             pool: None,
             pool_attached: false,
             pool_failed: false,
+            sweep_index: sweep::SweepIndex::default(),
         }
     }
 
@@ -247,6 +264,7 @@ impl World {
     fn touch(&mut self, statics: bool) {
         self.layout_dirty = true;
         self.statics_dirty |= statics;
+        self.sweep_index.touch();
     }
 
     /// Rebuilds what [`World::touch`] marked stale.
@@ -266,6 +284,7 @@ impl World {
             if self.config.broad_phase != BroadPhaseKind::BruteForce {
                 self.detector.set_static(&self.slots, &self.bodies);
             }
+            self.solver.cover(&self.slots, &self.bodies);
             self.statics_dirty = false;
         }
     }
@@ -363,6 +382,34 @@ impl World {
     /// platform).
     pub fn set_drop_through(&mut self, body: BodyId, drop: bool) -> Result<(), BuildError> {
         self.live_mut(body)?.drop_through = drop;
+        Ok(())
+    }
+
+    /// Marks a body for swept collision (`true`): with
+    /// [`SweepMode::Flagged`] or [`SweepMode::Auto`], a dynamic body so
+    /// marked moves each substep to the first time of impact of its sweep
+    /// against the solid static and kinematic colliders and tiles it can
+    /// collide with, whatever its speed, then responds as
+    /// [`World::set_sweep_response`] says (see [`SweepMode`] and "Swept
+    /// collision in the world" in `docs/ARCHITECTURE.md`). Off by default;
+    /// ignored for static and kinematic bodies.
+    pub fn set_swept(&mut self, body: BodyId, swept: bool) -> Result<(), BuildError> {
+        let b = self.live_mut(body)?;
+        if b.swept != swept {
+            b.swept = swept;
+            self.touch(false);
+        }
+        Ok(())
+    }
+
+    /// What a sweep hit does to the body: slide (the default), stop or
+    /// reflect ([`SweepResponse`]).
+    pub fn set_sweep_response(
+        &mut self,
+        body: BodyId,
+        response: SweepResponse,
+    ) -> Result<(), BuildError> {
+        self.live_mut(body)?.sweep_response = response;
         Ok(())
     }
 
@@ -614,45 +661,93 @@ impl World {
     }
 
     /// Moves every enabled non-static body by substep `k`'s share of its
-    /// velocity.
+    /// velocity. When the configuration and the scene call for sweeps
+    /// ([`SweepMode`]), the bodies that are not swept move first (kinematic
+    /// obstacles are where this substep leaves them), then each swept body,
+    /// in id order, moves to its first impact (`sweep`).
     fn move_bodies(&mut self, k: u32, n: u32) {
+        let mode = self.config.sweep;
+        let sweeping = match mode {
+            SweepMode::Off => false,
+            SweepMode::Flagged => self.layout.features.swept,
+            SweepMode::Auto { .. } => true,
+        };
+        let mut any = false;
         for b in &mut self.bodies {
             if b.kind == BodyKind::Static || b.vel == IVec2::ZERO || !b.enabled {
                 continue;
             }
             let d = substep_share(b.vel, k, n);
+            if sweeping && sweep::is_swept(mode, b, d) {
+                any = true;
+                continue;
+            }
             b.translate(d);
+        }
+        if !any {
+            return;
+        }
+        let scene = sweep::Scene {
+            slots: &self.slots,
+            cols: &self.colliders,
+            layout: &self.layout,
+            tiles: self.tilemap.as_ref(),
+        };
+        for i in 0..self.bodies.len() {
+            let b = &self.bodies[i];
+            if b.kind == BodyKind::Static || b.vel == IVec2::ZERO || !b.enabled {
+                continue;
+            }
+            let d = substep_share(b.vel, k, n);
+            if sweep::is_swept(mode, b, d) {
+                sweep::move_swept(
+                    &mut self.sweep_index,
+                    self.config.broad_phase,
+                    &scene,
+                    &mut self.bodies,
+                    i as u32,
+                    d,
+                    &mut self.logs,
+                );
+            }
         }
     }
 
-    /// Detects and restitutes once per pass, up to the configured passes;
-    /// reports what is still wedged.
+    /// Detects and restitutes once per pass, up to the configured passes
+    /// (passes that only propagate pushes are not counted); reports what is
+    /// still wedged.
     fn resolve_substep(&mut self, par: bool) {
         self.detect(par);
         let triggers = self.layout.triggers;
         if triggers {
             restitute::log_triggers(&self.contacts, &mut self.logs.triggers);
         }
-        for _ in 0..self.config.restitution_iterations {
+        self.solver.begin(self.bodies.len());
+        // Passes that only propagate pushes to bodies not moved yet this
+        // substep are free (at most one per dynamic body).
+        let mut budget = self.config.restitution_iterations;
+        while budget > 0 {
             if !restitute::has_solid(&self.contacts) {
                 return;
             }
             let scene = Scene {
                 cols: &self.colliders,
+                slots: &self.slots,
                 tiles: self.tilemap.as_ref(),
             };
             self.pushed.clear();
-            if !restitute::pass(
+            let pass = self.solver.pass(
                 &self.contacts,
-                &mut self.order,
                 &mut self.bodies,
                 scene,
                 &mut self.logs.hits,
                 &mut self.pushed,
-            ) {
+            );
+            if !pass.moved {
                 // Nothing moved: the buffer is current and nothing more can change.
                 break;
             }
+            budget -= !pass.propagating as u32;
             self.redetect(par);
             if triggers {
                 restitute::log_triggers(&self.contacts, &mut self.logs.triggers);
@@ -660,9 +755,11 @@ impl World {
         }
         let scene = Scene {
             cols: &self.colliders,
+            slots: &self.slots,
             tiles: self.tilemap.as_ref(),
         };
-        restitute::log_squished(&self.contacts, &self.bodies, scene, &mut self.logs.squished);
+        self.solver
+            .log_squished(&self.contacts, &self.bodies, scene, &mut self.logs.squished);
     }
 
     /// Detection again after a restitution pass: only around the bodies it
@@ -843,6 +940,11 @@ impl World {
             h.ivec2(b.push);
             h.u8(b.flag_bits());
             h.u32(b.carrier.unwrap_or(u32::MAX));
+            for r in b.swept_rest {
+                let (c, n) = r.unwrap_or((u32::MAX, IVec2::ZERO));
+                h.u32(c);
+                h.ivec2(n);
+            }
         }
         h.u64(self.tilemap_digest);
         h.u32(self.slots.len() as u32);
