@@ -395,7 +395,11 @@ fn worlds_report_the_features_of_their_scene() {
     let mut g = Game::from_level(&level).unwrap();
     g.add_player(PlayerId(1)).unwrap();
     let f = g.world().features();
-    assert!(f.aabb_only());
+    // Boxes, and the level's one polygon solid.
+    assert_eq!(
+        f.kinds,
+        (1 << ShapeKind::Aabb as u8) | (1 << ShapeKind::Polygon as u8)
+    );
     assert_eq!(f.slopes, lf.slopes);
     assert_eq!(f.one_way_tiles, lf.one_way_tiles);
     assert_eq!(f.hazard_tiles, lf.hazard_tiles);

@@ -157,6 +157,7 @@ EIDS = {
     "goal": "10000008",
     "spikes": "10000009",
     "waypoint": "10000010",
+    "polygon": "10000011",
 }
 
 
@@ -172,6 +173,13 @@ def platform(c, r, nodes, speed=1, one_way=False, loop=False):
         nodes=[{"x": nc * T, "y": nr * T} for nc, nr in nodes],
         values={"speed": speed, "one_way": one_way, "loop": loop},
     )
+
+
+def polygon(points):
+    """A convex polygon solid: its position is the first vertex, its nodes the
+    others (pixels)."""
+    (x, y), rest = points[0], points[1:]
+    return ent("polygon", x, y, nodes=[{"x": nx, "y": ny} for nx, ny in rest])
 
 
 def coin(c, r):
@@ -197,6 +205,10 @@ entities = [
     coin(c, r)
     for c, r in [(8, 9), (11, 9), (13, 22), (21, 22), (30, 16), (37, 22), (41, 20),
                  (48, 18), (64, 10), (76, 19), (79, 22), (92, 9), (93, 24)]
+] + [
+    # A 1:4 wedge on the bonus shelf between two coins, off the bot route
+    # (last, so the other entities keep their ids).
+    polygon([(9 * T, 10 * T), (11 * T, 10 * T - 8), (11 * T, 10 * T)]),
 ]
 
 
@@ -261,6 +273,15 @@ def entity_def(name, w, h, color, origin=(0, 0), nodes=False, values=(), resize=
     }
 
 
+def polygon_def():
+    """Polygon solids: the entity's position and its nodes are the vertices,
+    drawn as a closed outline (node display 1, "path loop")."""
+    d = entity_def("polygon", 4, 4, "#a4b0beff", origin=(2, 2), nodes=True)
+    d["nodeLimit"] = 7
+    d["nodeDisplay"] = 1
+    return d
+
+
 def fval(name, default):
     return {"name": name, "definition": "Float", "display": 0, "defaults": default,
             "bounded": True, "min": 0.0, "max": 64.0, "decimals": 2}
@@ -309,6 +330,7 @@ project = {
         entity_def("checkpoint", 16, 32, "#48dbfbff"),
         entity_def("goal", 16, 32, "#1dd1a1ff"),
         entity_def("spikes", 16, 8, "#c8d6e5ff", resize=True),
+        polygon_def(),
         entity_def("waypoint", 16, 16, "#ffffff66", origin=(8, 16),
                    values=[{"name": "action", "definition": "Enum", "display": 0,
                             "choices": ["walk", "jump", "spring"], "defaults": 0}]),

@@ -8,9 +8,10 @@
 //! # How a level becomes a world
 //! * The level's tilemap is the [`World`]'s tilemap: collision by lookup, no
 //!   collider per tile ([`World::set_tilemap`]).
-//! * Blocks are static boxes; moving platforms kinematic boxes (one-way ones
-//!   solid from above) whose centre is a pure function of the tick
-//!   ([`PathSchedule`]); walkers and players dynamic boxes that ride
+//! * Blocks are static boxes, polygon blocks static convex polygons
+//!   ([`EntityKind::PolygonBlock`]); moving platforms kinematic boxes
+//!   (one-way ones solid from above) whose centre is a pure function of the
+//!   tick ([`PathSchedule`]); walkers and players dynamic boxes that ride
 //!   platforms ([`World::set_rider`]). Players and walkers do not collide
 //!   with each other (layers): stomping and hurting are rules, checked on
 //!   the boxes after the physics step.
@@ -46,7 +47,7 @@ mod path;
 mod rules;
 pub mod state;
 
-pub use config::{CarryMode, GameConfig, PlayerConfig};
+pub use config::{CarryMode, GameConfig, PlayerConfig, PlayerShape, FOOT_HEIGHT, FOOT_INSET};
 pub use path::PathSchedule;
 pub use state::{kind, ENTITY_ID_BASE};
 
@@ -54,7 +55,7 @@ use crate::fixed::{check_coord, check_speed};
 use crate::input::Buttons;
 use crate::level::{EntityKind, Level};
 use crate::protocol::{is_replicated, EntityState, PlayerId, StateSnapshot};
-use crate::shape::Aabb;
+use crate::shape::{Aabb, ConvexPolygon};
 use crate::tilemap::Tilemap;
 use crate::world::hash::Fnv1a;
 use crate::world::{BodyDesc, BodyId, ColliderDesc, OneWay, Sides, World, TILEMAP_LAYER};
@@ -184,6 +185,10 @@ pub enum EntityType {
     Spawn,
     /// A static block.
     Block,
+    /// A static convex polygon solid: its view's box holds the polygon (the
+    /// level's [`EntityKind::PolygonBlock`] has the vertices). The walker
+    /// ledge test and the drop-through test do not look at it.
+    PolygonBlock,
     /// A moving platform.
     Platform,
     /// A walker enemy.
@@ -205,7 +210,7 @@ impl EntityType {
     pub fn code(self) -> u8 {
         match self {
             EntityType::Spawn => kind::SPAWN,
-            EntityType::Block => kind::BLOCK,
+            EntityType::Block | EntityType::PolygonBlock => kind::BLOCK,
             EntityType::Platform => kind::PLATFORM,
             EntityType::Walker => kind::WALKER,
             EntityType::Springboard => kind::SPRINGBOARD,
@@ -368,6 +373,7 @@ impl Game {
             let ty = match def.kind {
                 EntityKind::PlayerSpawn => EntityType::Spawn,
                 EntityKind::Block => EntityType::Block,
+                EntityKind::PolygonBlock { .. } => EntityType::PolygonBlock,
                 EntityKind::MovingPlatform { .. } => EntityType::Platform,
                 EntityKind::Walker { .. } => EntityType::Walker,
                 EntityKind::Springboard { .. } => EntityType::Springboard,
@@ -401,6 +407,16 @@ impl Game {
                 EntityKind::Block => {
                     let b = build(g.world.add_body(BodyDesc::fixed(def.pos)))?;
                     let c = ColliderDesc::solid(shape.expect("box")).layers(LAYER_SOLID, u32::MAX);
+                    g.world
+                        .add_collider(b, c)
+                        .map_err(|x| bad(i, x.to_string()))?;
+                    e.body = Some(b);
+                }
+                EntityKind::PolygonBlock { vertices } => {
+                    let poly = ConvexPolygon::new(vertices)
+                        .map_err(|x| bad(i, format!("polygon: {x}")))?;
+                    let b = build(g.world.add_body(BodyDesc::fixed(def.pos)))?;
+                    let c = ColliderDesc::solid(poly).layers(LAYER_SOLID, u32::MAX);
                     g.world
                         .add_collider(b, c)
                         .map_err(|x| bad(i, x.to_string()))?;
@@ -506,13 +522,20 @@ impl Game {
         Ok(())
     }
 
+    /// A player's body at `pos`: one box, or torso, feet and head boxes
+    /// ([`config::PlayerShape`]).
     fn new_player_body(&mut self, pos: IVec2) -> Result<BodyId, GameError> {
         let cfg = &self.config.player;
-        let shape = Aabb::new(cfg.half).map_err(|e| GameError::BadConfig(e.to_string()))?;
+        let (boxes, n) = cfg.shape.boxes(cfg.half);
         let err = |e: crate::world::BuildError| GameError::BadConfig(e.to_string());
         let body = self.world.add_body(BodyDesc::dynamic(pos)).map_err(err)?;
-        let c = ColliderDesc::solid(shape).layers(LAYER_PLAYER, LAYER_SOLID | TILEMAP_LAYER);
-        self.world.add_collider(body, c).map_err(err)?;
+        for &(half, offset) in &boxes[..n] {
+            let shape = Aabb::new(half).map_err(|e| GameError::BadConfig(e.to_string()))?;
+            let c = ColliderDesc::solid(shape)
+                .at(offset)
+                .layers(LAYER_PLAYER, LAYER_SOLID | TILEMAP_LAYER);
+            self.world.add_collider(body, c).map_err(err)?;
+        }
         self.world.set_rider(body, true).map_err(err)?;
         Ok(body)
     }

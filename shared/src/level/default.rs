@@ -11,7 +11,8 @@
 //! that launches to a ledge (row 17, second checkpoint) under a one-way
 //! sideways platform; a long 45 degree slope down to the ground (cols
 //! 73-81); spike tiles (cols 86-87) under a diagonal, looping platform; the
-//! goal (col 96). Coins are scattered along the way and on the bonus areas.
+//! goal (col 96). Coins are scattered along the way and on the bonus areas;
+//! a polygon wedge (1:4, 32 x 8 px, cols 9-10) sits on the bonus shelf.
 //! `docs/LEVELS.md` draws the grid.
 //!
 //! The bot route ([`default_route`]) uses only static ground, one-way tiles

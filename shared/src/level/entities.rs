@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::mapping::normalize;
 use super::{EntityDef, EntityKind, LevelError, PlatformMotion};
 use crate::fixed::{MAX_COORD, MAX_EXTENT, MAX_SPEED, UNITS_PER_PX};
+use crate::shape::{ConvexPolygon, ShapeError, MAX_POLYGON_VERTICES};
 
 /// Every entity name the loaders know, for messages (matching is ASCII
 /// case-insensitive, with `-` and spaces read as `_`):
@@ -14,7 +15,8 @@ use crate::fixed::{MAX_COORD, MAX_EXTENT, MAX_SPEED, UNITS_PER_PX};
 /// | names | becomes | parameters (OGMO `values`, Tiled `properties`) |
 /// |---|---|---|
 /// | `player`, `spawn`, `player_spawn`, `start` | [`EntityKind::PlayerSpawn`] | |
-/// | `block`, `solid`, `crate` | [`EntityKind::Block`] | |
+/// | `block`, `solid`, `crate` | [`EntityKind::Block`]; a Tiled polygon object of these names: [`EntityKind::PolygonBlock`] | |
+/// | `polygon`, `polygon_block`, `ramp` | [`EntityKind::PolygonBlock`]: a static convex polygon of 3 to 8 vertices. OGMO: the vertices are the entity's position followed by its `nodes` (raw positions of the entity's origin, as the editor draws them); Tiled: a polygon object's points (an unnamed polygon object is one too) | |
 /// | `platform`, `moving_platform`, `mover`, `elevator` | [`EntityKind::MovingPlatform`] | `speed` (px/tick, default 1), `one_way` (bool, default false), `loop` (bool, default false); path: OGMO `nodes`, Tiled `path` (object property naming a polyline or polygon) |
 /// | `walker`, `enemy` | [`EntityKind::Walker`] | `speed` (px/tick, default 0.5) |
 /// | `spring`, `springboard`, `trampoline` | [`EntityKind::Springboard`] | `strength` (px/tick, default 10) |
@@ -31,6 +33,9 @@ pub const ENTITY_NAMES: &[&str] = &[
     "block",
     "solid",
     "crate",
+    "polygon",
+    "polygon_block",
+    "ramp",
     "platform",
     "moving_platform",
     "mover",
@@ -128,6 +133,28 @@ pub struct PlacedEntity {
     pub nodes: Vec<IVec2>,
     /// Parameters, in file order.
     pub values: Vec<(String, PropValue)>,
+    /// The outline, for an entity drawn as a polygon (an OGMO polygon
+    /// entity, a Tiled polygon object); `None` for boxes.
+    pub polygon: Option<PlacedPolygon>,
+}
+
+/// The outline of a polygon entity as placed: absolute vertices in units,
+/// each with its path in the file, for errors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlacedPolygon {
+    /// Path of the outline, e.g. `layers[1].objects[2].polygon (object 7
+    /// "ramp")` or `layers[1].entities[4].nodes`.
+    pub field: String,
+    /// Vertices in file order, absolute, in units.
+    pub points: Vec<IVec2>,
+    /// Path of each vertex (same length as `points`).
+    pub point_fields: Vec<String>,
+}
+
+/// Whether `name` is one of the polygon block names of [`ENTITY_NAMES`]
+/// (the OGMO loader reads such an entity's nodes as vertices).
+pub(crate) fn is_polygon_name(name: &str) -> bool {
+    matches!(class_of(name), Some(Class::Polygon))
 }
 
 /// What an entity became.
@@ -201,6 +228,7 @@ pub(crate) fn check_coord_field(file: &str, field: &str, v: i64) -> Result<(), L
 enum Class {
     Spawn,
     Block,
+    Polygon,
     Platform,
     Walker,
     Spring,
@@ -215,6 +243,7 @@ fn class_of(name: &str) -> Option<Class> {
     Some(match normalize(name).as_str() {
         "player" | "spawn" | "player_spawn" | "playerspawn" | "start" => Class::Spawn,
         "block" | "solid" | "crate" => Class::Block,
+        "polygon" | "polygon_block" | "polygonblock" | "ramp" => Class::Polygon,
         "platform" | "moving_platform" | "movingplatform" | "mover" | "elevator" => Class::Platform,
         "walker" | "enemy" => Class::Walker,
         "spring" | "springboard" | "trampoline" => Class::Spring,
@@ -328,9 +357,29 @@ pub(crate) fn classify(file: &str, e: &PlacedEntity) -> Result<Classified, Level
     let Some(class) = class_of(&e.name) else {
         return Ok(Classified::Unknown);
     };
+    if let Some(poly) = &e.polygon {
+        if !matches!(class, Class::Block | Class::Polygon) {
+            return Err(LevelError::BadPolygon {
+                file: file.into(),
+                field: poly.field.clone(),
+                message: format!(
+                    "a polygon can only be a static solid (named \"polygon\" or \"block\", or unnamed), not {:?} (moving polygon platforms are not supported)",
+                    e.name
+                ),
+            });
+        }
+        return polygon_block(file, poly).map(Classified::Entity);
+    }
     let kind = match class {
         Class::Spawn => EntityKind::PlayerSpawn,
         Class::Block => EntityKind::Block,
+        Class::Polygon => {
+            return Err(LevelError::BadPolygon {
+                file: file.into(),
+                field: e.field.clone(),
+                message: "a polygon block needs vertices: in OGMO its position and `nodes` (at least 2), in Tiled a polygon object".into(),
+            });
+        }
         Class::Coin => EntityKind::Coin,
         Class::Checkpoint => EntityKind::Checkpoint,
         Class::Goal => EntityKind::Goal,
@@ -413,4 +462,101 @@ fn platform_path(file: &str, e: &PlacedEntity, looped: bool) -> Result<Vec<IVec2
         }
     }
     Ok(path)
+}
+
+/// A [`EntityKind::PolygonBlock`] from an outline: centred on its bounding
+/// box (rounded down), every vertex checked by [`ConvexPolygon::new`].
+fn polygon_block(file: &str, poly: &PlacedPolygon) -> Result<EntityDef, LevelError> {
+    let bad = |field: &str, message: String| LevelError::BadPolygon {
+        file: file.into(),
+        field: field.into(),
+        message,
+    };
+    let pts = &poly.points;
+    let n = pts.len();
+    if !(3..=MAX_POLYGON_VERTICES).contains(&n) {
+        return Err(bad(
+            &poly.field,
+            format!(
+                "polygon has {n} vertices; it needs 3 to {MAX_POLYGON_VERTICES}{}",
+                if n > MAX_POLYGON_VERTICES {
+                    " (split a larger outline into several convex polygons)"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    let (mut lo, mut hi) = (pts[0].as_i64vec2(), pts[0].as_i64vec2());
+    for p in pts {
+        lo = lo.min(p.as_i64vec2());
+        hi = hi.max(p.as_i64vec2());
+    }
+    let centre = (lo + hi).div_euclid(glam::I64Vec2::splat(2));
+    let half = (hi - centre).max(centre - lo).max(glam::I64Vec2::ONE);
+    if half.max_element() > MAX_EXTENT as i64 {
+        return Err(LevelError::OutOfBounds {
+            file: file.into(),
+            field: poly.field.clone(),
+            message: format!(
+                "polygon spans {} x {} px; each vertex must lie within {} px of its centre",
+                (hi.x - lo.x) as f64 / UNITS_PER_PX as f64,
+                (hi.y - lo.y) as f64 / UNITS_PER_PX as f64,
+                MAX_EXTENT / UNITS_PER_PX
+            ),
+        });
+    }
+    let pos = IVec2::new(centre.x as i32, centre.y as i32);
+    let local: Vec<IVec2> = pts.iter().map(|p| *p - pos).collect();
+    let at = |i: usize| {
+        let p = pts[i % n];
+        format!(
+            "vertex {} ({}, {}) px",
+            i % n,
+            p.x as f64 / UNITS_PER_PX as f64,
+            p.y as f64 / UNITS_PER_PX as f64
+        )
+    };
+    let vertex_field = |i: usize| {
+        poly.point_fields
+            .get(i % n)
+            .map_or(poly.field.as_str(), String::as_str)
+    };
+    match ConvexPolygon::new(&local) {
+        Ok(_) => Ok(EntityDef {
+            kind: EntityKind::PolygonBlock { vertices: local },
+            pos,
+            size: IVec2::new(2 * half.x as i32, 2 * half.y as i32),
+        }),
+        Err(ShapeError::DuplicateVertex(i)) => Err(bad(
+            vertex_field(i),
+            format!(
+                "polygon is degenerate: {} repeats vertex {}",
+                at(i),
+                (i + n - 1) % n
+            ),
+        )),
+        Err(ShapeError::Collinear(i)) => Err(bad(
+            vertex_field(i),
+            format!(
+                "polygon is degenerate at {}: it lies on the line through vertices {} and {} (a straight corner or zero area)",
+                at(i),
+                (i + n - 1) % n,
+                (i + 1) % n
+            ),
+        )),
+        Err(ShapeError::Concave(i)) => Err(bad(
+            vertex_field(i),
+            format!(
+                "polygon is concave at {} (or its outline crosses itself); split it into convex polygons",
+                at(i)
+            ),
+        )),
+        Err(ShapeError::Bounds(b)) => Err(LevelError::OutOfBounds {
+            file: file.into(),
+            field: poly.field.clone(),
+            message: b.to_string(),
+        }),
+        Err(other) => Err(bad(&poly.field, format!("polygon refused: {other}"))),
+    }
 }

@@ -129,6 +129,20 @@ pub enum LevelError {
         /// What is wrong.
         message: String,
     },
+    /// A polygon solid the simulation cannot use: too few or too many
+    /// vertices, a duplicate vertex, three collinear vertices (zero area), a
+    /// concave or self-intersecting outline. `field` is the vertex (or the
+    /// polygon) and the message says which vertex, counted from 0 in file
+    /// order.
+    #[error("{file}: {field}: {message}")]
+    BadPolygon {
+        /// The file.
+        file: String,
+        /// The polygon or its offending vertex.
+        field: String,
+        /// What is wrong, e.g. `polygon is concave at vertex 3 (40, 16) px`.
+        message: String,
+    },
     /// No entity is a player spawn.
     #[error("{file}: {field}: no player spawn (add an entity named \"player\" or \"spawn\")")]
     MissingSpawn {
@@ -154,6 +168,7 @@ impl LevelError {
             | LevelError::UnknownTile { file, .. }
             | LevelError::UnknownEntity { file, .. }
             | LevelError::DegeneratePath { file, .. }
+            | LevelError::BadPolygon { file, .. }
             | LevelError::MissingSpawn { file, .. } => file,
         }
     }
@@ -171,6 +186,7 @@ impl LevelError {
             | LevelError::UnknownTile { field, .. }
             | LevelError::UnknownEntity { field, .. }
             | LevelError::DegeneratePath { field, .. }
+            | LevelError::BadPolygon { field, .. }
             | LevelError::MissingSpawn { field, .. } => Some(field),
         }
     }

@@ -39,7 +39,7 @@ pub use default::{
     default_level, default_route, load_default_level, DEFAULT_LEVEL_FILE, DEFAULT_PROJECT_FILE,
 };
 pub use entities::{
-    PlacedEntity, PropValue, RouteAction, Waypoint, DEFAULT_PLATFORM_SPEED,
+    PlacedEntity, PlacedPolygon, PropValue, RouteAction, Waypoint, DEFAULT_PLATFORM_SPEED,
     DEFAULT_SPRING_STRENGTH, DEFAULT_WALKER_SPEED, ENTITY_NAMES, MAX_PATH_NODES,
 };
 pub use error::LevelError;
@@ -343,7 +343,7 @@ pub struct LevelFeatures {
     pub slopes: bool,
     /// Some tile is [`Tile::Hazard`].
     pub hazard_tiles: bool,
-    /// Some entity is a [`EntityKind::Block`].
+    /// Some entity is a [`EntityKind::Block`] or [`EntityKind::PolygonBlock`].
     pub blocks: bool,
     /// Some entity is a moving platform.
     pub moving_platforms: bool,
@@ -376,7 +376,7 @@ impl Level {
         for e in &self.entities {
             match &e.kind {
                 EntityKind::PlayerSpawn => {}
-                EntityKind::Block => f.blocks = true,
+                EntityKind::Block | EntityKind::PolygonBlock { .. } => f.blocks = true,
                 EntityKind::MovingPlatform { motion, one_way } => {
                     f.moving_platforms = true;
                     f.one_way_platforms |= *one_way;

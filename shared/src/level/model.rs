@@ -47,8 +47,21 @@ pub enum EntityKind {
     /// Where players (re)spawn before reaching a checkpoint. A level has at
     /// least one.
     PlayerSpawn,
-    /// A solid block outside the tile grid (static).
+    /// A solid block outside the tile grid (static): the box of the entity's
+    /// `size` around its `pos`.
     Block,
+    /// A static solid convex polygon outside the tile grid (a ramp, a
+    /// wedge): what Tiled polygon objects and OGMO `polygon` entities become.
+    /// The entity's `size` is an even box around `pos` that holds every
+    /// vertex (for drawing bounds and culling), not the shape.
+    PolygonBlock {
+        /// Vertices relative to the entity's `pos`, in units, in file order
+        /// (either winding): 3 to [`crate::shape::MAX_POLYGON_VERTICES`],
+        /// strictly convex, each component within [`crate::fixed::MAX_EXTENT`]
+        /// ([`crate::shape::ConvexPolygon::new`] accepts them; the loaders
+        /// and [`crate::game::Game`] check it).
+        vertices: Vec<IVec2>,
+    },
     /// A kinematic platform on a fixed path; `one_way` makes it solid only
     /// from above.
     MovingPlatform {

@@ -18,7 +18,10 @@
 //!   `originX`/`originY` (else the project's origin, else 0), `values`,
 //!   `nodes` (each the position of the origin at that node). Positions become
 //!   centres in units: `centre = offsets + (x - originX + width / 2) * 256`.
-//!   Rotation and flips are ignored.
+//!   Rotation and flips are ignored. A polygon entity (a `polygon` name of
+//!   [`super::ENTITY_NAMES`]) is an outline instead: its vertices are its
+//!   `x`, `y` followed by its `nodes`, as raw positions (plus offsets; no
+//!   size or origin needed).
 //! * **Decal layers** are ignored. Any other layer kind is an error.
 //!
 //! Level and layer `offsetX`/`offsetY` shift everything in the layer.
@@ -26,7 +29,10 @@
 use glam::IVec2;
 use serde_json::{Map, Value};
 
-use super::entities::{check_coord_field, place_box, px_to_units, PlacedEntity, PropValue};
+use super::entities::{
+    check_coord_field, is_polygon_name, place_box, px_to_units, PlacedEntity, PlacedPolygon,
+    PropValue,
+};
 use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
 use crate::tilemap::Tile;
 
@@ -735,6 +741,10 @@ fn parse_entity(
     });
     let x = cx.num(cx.req(o, "x", f)?, &join(f, "x"))?;
     let y = cx.num(cx.req(o, "y", f)?, &join(f, "y"))?;
+    let values = parse_values(cx, o, f)?;
+    if is_polygon_name(&name) {
+        return parse_polygon(cx, f, o, layer, name, (x, y), values);
+    }
     let dim = |key: &str, default: Option<f64>| -> Result<f64, LevelError> {
         match (cx.opt_num(o, key, f)?, default) {
             (Some(v), _) => Ok(v),
@@ -777,6 +787,21 @@ fn parse_entity(
             nodes.push(place_box(cx.file, &fi, l, t, w, h)?.0);
         }
     }
+    Ok(PlacedEntity {
+        name,
+        layer: layer.name.clone(),
+        field: f.into(),
+        values_key: "values",
+        centre,
+        size,
+        nodes,
+        values,
+        polygon: None,
+    })
+}
+
+/// An entity's `values`, in file order (nulls skipped).
+fn parse_values(cx: &Cx<'_>, o: &Obj, f: &str) -> Result<Vec<(String, PropValue)>, LevelError> {
     let mut values = Vec::new();
     if let Some(v) = o.get("values") {
         for (k, val) in cx.obj(v, &join(f, "values"))? {
@@ -790,15 +815,69 @@ fn parse_entity(
             values.push((k.clone(), pv));
         }
     }
+    Ok(values)
+}
+
+/// A polygon entity: its vertices are its own position (`x`, `y`: where
+/// the editor draws its origin) followed by its `nodes`, raw (no size or
+/// origin applied), shifted by the layer's offsets. Size and origin are not
+/// needed. More than [`super::MAX_PATH_NODES`] nodes are refused unread.
+fn parse_polygon(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    layer: &OgmoLayer,
+    name: String,
+    (x, y): (f64, f64),
+    values: Vec<(String, PropValue)>,
+) -> Result<PlacedEntity, LevelError> {
+    let point = |px: f64, py: f64, field: &str| -> Result<IVec2, LevelError> {
+        let (fx, fy) = (join(field, "x"), join(field, "y"));
+        let ax = layer.origin.x as i64 + px_to_units(cx.file, &fx, px)?;
+        let ay = layer.origin.y as i64 + px_to_units(cx.file, &fy, py)?;
+        check_coord_field(cx.file, &fx, ax)?;
+        check_coord_field(cx.file, &fy, ay)?;
+        Ok(IVec2::new(ax as i32, ay as i32))
+    };
+    let nf = join(f, "nodes");
+    let mut points = vec![point(x, y, f)?];
+    let mut point_fields = vec![f.to_owned()];
+    if let Some(v) = o.get("nodes") {
+        let list = cx.arr(v, &nf)?;
+        // A very long list is refused before converting it; a shorter one
+        // with too many vertices by the entity table, with the others.
+        if list.len() > super::MAX_PATH_NODES {
+            return Err(LevelError::BadPolygon {
+                file: cx.file.into(),
+                field: nf,
+                message: format!(
+                    "polygon has {} vertices; it needs 3 to {}",
+                    list.len() + 1,
+                    crate::shape::MAX_POLYGON_VERTICES
+                ),
+            });
+        }
+        for (i, n) in list.iter().enumerate() {
+            let fi = format!("{nf}[{i}]");
+            let (nx, ny) = cx.xy(n, &fi)?;
+            points.push(point(nx, ny, &fi)?);
+            point_fields.push(fi);
+        }
+    }
     Ok(PlacedEntity {
         name,
         layer: layer.name.clone(),
         field: f.into(),
         values_key: "values",
-        centre,
-        size,
-        nodes,
+        centre: points[0],
+        size: IVec2::splat(2),
+        nodes: Vec::new(),
         values,
+        polygon: Some(PlacedPolygon {
+            field: nf,
+            points,
+            point_fields,
+        }),
     })
 }
 

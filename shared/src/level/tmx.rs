@@ -13,11 +13,15 @@
 //!   when empty, its name goes through the entity table
 //!   ([`super::ENTITY_NAMES`]); custom properties are the parameters.
 //!   Rectangles, ellipses and tile objects use their bounds; a point object
-//!   is a box of one tile centred on it. A moving platform's `path`
+//!   is a box of one tile centred on it. A polygon object (not a path) is a
+//!   convex polygon solid ([`super::EntityKind::PolygonBlock`], its points
+//!   rotated by the object's rotation): its name must be a block or polygon
+//!   name, or empty. A moving platform's `path`
 //!   property (type object) names a polyline or polygon object whose points
 //!   are the centres the platform passes through (a polygon loops unless
-//!   `loop` says otherwise); those path objects are not entities. Layer and
-//!   group offsets shift objects.
+//!   `loop` says otherwise); those path objects are not entities, and a
+//!   polyline that is not a path is an error. Layer and group offsets shift
+//!   objects.
 //! * Image layers are ignored.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -31,7 +35,9 @@ use ::tiled::{
 };
 use glam::IVec2;
 
-use super::entities::{place_box, px_to_units, PlacedEntity, PropValue};
+use super::entities::{
+    check_coord_field, place_box, px_to_units, PlacedEntity, PlacedPolygon, PropValue,
+};
 use super::mapping::{mirror, parse_tile_kind};
 use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
 use crate::tilemap::Tile;
@@ -403,6 +409,26 @@ impl Conv<'_> {
                 o.user_type.clone()
             };
             let (x, y) = (o.x as f64 + off.0, o.y as f64 + off.1);
+            if let ObjectShape::Polygon { points } = &o.shape {
+                let name = if name.trim().is_empty() {
+                    "polygon".to_owned()
+                } else {
+                    name
+                };
+                let polygon = self.polygon(&f, o.id(), &name, points, (x, y), o.rotation)?;
+                out.push(PlacedEntity {
+                    name,
+                    layer: layer_name.into(),
+                    field: f,
+                    values_key: "properties",
+                    centre: polygon.points.first().copied().unwrap_or_default(),
+                    size: IVec2::splat(2),
+                    nodes: Vec::new(),
+                    values: Vec::new(),
+                    polygon: Some(polygon),
+                });
+                continue;
+            }
             let (left, top, w, h) = match &o.shape {
                 ObjectShape::Rect { width, height } | ObjectShape::Ellipse { width, height } => {
                     let (w, h) = (*width as f64, *height as f64);
@@ -414,13 +440,12 @@ impl Conv<'_> {
                 other => {
                     let shape = match other {
                         ObjectShape::Polyline { .. } => "polyline",
-                        ObjectShape::Polygon { .. } => "polygon",
                         ObjectShape::Text { .. } => "text",
                         _ => "capsule",
                     };
                     return Err(self.bad(
                         format!("{f}.shape"),
-                        format!("a {shape} object is not an entity (polylines and polygons are platform paths: name them in a platform's `path` property)"),
+                        format!("a {shape} object is not an entity (polylines are platform paths: name them in a platform's `path` property)"),
                     ));
                 }
             };
@@ -481,8 +506,58 @@ impl Conv<'_> {
                 size,
                 nodes,
                 values,
+                polygon: None,
             });
         }
         Ok(())
+    }
+
+    /// A polygon object's outline: its points (relative to the object's
+    /// position, rotated clockwise by `rotation` degrees about it) as
+    /// absolute units. At most [`super::MAX_PATH_NODES`] points are
+    /// converted (more is refused).
+    fn polygon(
+        &self,
+        f: &str,
+        id: u32,
+        name: &str,
+        points: &[(f32, f32)],
+        (x, y): (f64, f64),
+        rotation: f32,
+    ) -> Result<PlacedPolygon, LevelError> {
+        let field = format!("{f}.polygon (object {id} {name:?})");
+        if points.len() > super::MAX_PATH_NODES {
+            return Err(LevelError::BadPolygon {
+                file: self.file.into(),
+                field,
+                message: format!(
+                    "polygon has {} vertices; it needs 3 to {}",
+                    points.len(),
+                    crate::shape::MAX_POLYGON_VERTICES
+                ),
+            });
+        }
+        let (sin, cos) = if rotation == 0.0 {
+            (0.0, 1.0)
+        } else {
+            (rotation as f64).to_radians().sin_cos()
+        };
+        let mut out = PlacedPolygon {
+            field,
+            points: Vec::with_capacity(points.len()),
+            point_fields: Vec::with_capacity(points.len()),
+        };
+        for (i, &(px, py)) in points.iter().enumerate() {
+            let pf = format!("{f}.polygon[{i}] (object {id} {name:?})");
+            let (px, py) = (px as f64, py as f64);
+            let (ax, ay) = (x + px * cos - py * sin, y + px * sin + py * cos);
+            let ux = px_to_units(self.file, &format!("{pf}.x"), ax)?;
+            let uy = px_to_units(self.file, &format!("{pf}.y"), ay)?;
+            check_coord_field(self.file, &format!("{pf}.x"), ux)?;
+            check_coord_field(self.file, &format!("{pf}.y"), uy)?;
+            out.points.push(IVec2::new(ux as i32, uy as i32));
+            out.point_fields.push(pf);
+        }
+        Ok(out)
     }
 }

@@ -4,6 +4,7 @@
 
 use ledge_client::view::{EntityType, Facing};
 use ledge_shared::fixed::UNITS_PER_PX;
+use ledge_shared::level::{EntityKind, Level};
 use ledge_shared::tilemap::{Slope, Tile, Tilemap};
 use macroquad::prelude::*;
 
@@ -381,6 +382,8 @@ pub fn draw_entities(entities: &[EntitySprite], view: &View, checkpoint: Option<
         match e.kind {
             EntityType::Spawn => {}
             EntityType::Block => crate_box(view, area),
+            // Drawn from the level's vertices by `draw_polygon_blocks`.
+            EntityType::PolygonBlock => {}
             EntityType::Platform if e.one_way => {
                 rect(view, area.x, area.y, area.w, area.h, palette::ONE_WAY_GHOST);
                 rect(view, area.x, area.y, area.w, 4.0, palette::ONE_WAY);
@@ -480,6 +483,30 @@ pub fn draw_entities(entities: &[EntitySprite], view: &View, checkpoint: Option<
                 tri(view, down(0.0), down(1.0), down(2.0), palette::GOAL);
             }
             EntityType::Hazard => spikes(view, area),
+        }
+    }
+}
+
+/// Draws the level's polygon solids ([`EntityKind::PolygonBlock`]: static,
+/// so drawn from the level): filled like the ground, with an edge outline.
+pub fn draw_polygon_blocks(level: &Level, view: &View) {
+    let seen = view.visible();
+    for e in &level.entities {
+        let EntityKind::PolygonBlock { vertices } = &e.kind else {
+            continue;
+        };
+        let (pos, size) = (e.pos.as_vec2() * PX, e.size.as_vec2() * PX);
+        let tl = pos - size * 0.5;
+        if vertices.len() < 3 || !Rect::new(tl.x, tl.y, size.x, size.y).overlaps(&seen) {
+            continue;
+        }
+        let pts: Vec<Vec2> = vertices.iter().map(|v| pos + v.as_vec2() * PX).collect();
+        // Convex: a fan from the first vertex covers it.
+        for w in pts[1..].windows(2) {
+            tri(view, pts[0], w[0], w[1], palette::SOLID);
+        }
+        for (i, a) in pts.iter().enumerate() {
+            line(view, *a, pts[(i + 1) % pts.len()], 1.0, palette::SOLID_EDGE);
         }
     }
 }
