@@ -5,12 +5,15 @@
 //! connects, then pings once a second so the front end can show the
 //! round-trip time, sends the inputs the front end hands it
 //! ([`NetThread::send_input`], once per tick) and chat lines, and reports
-//! decoded snapshots, chat and notices as [`NetEvent`]s. The front end polls
+//! decoded snapshots, chat, notices and players joining or leaving as
+//! [`NetEvent`]s; the room's roster is also readable at any time
+//! ([`NetThread::players`]). The front end polls
 //! [`NetThread::try_recv`] once per frame (never blocking) and folds events
 //! into a [`NetStatus`]. Both directions are bounded queues: when one is
 //! full (a front end that stopped polling), new events or commands are
 //! dropped and counted rather than piling up.
 
+use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
@@ -21,6 +24,7 @@ use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{Fingerprint, NoticeKind, PlayerId, Welcome};
 use tokio::sync::oneshot;
 
+use crate::error::ClientError;
 use crate::netstats::TransportSample;
 use crate::session::{JoinOptions, SessionEvent, SnapshotUpdate};
 use crate::trust::{connect_trusted, Trust};
@@ -89,8 +93,25 @@ pub enum NetEvent {
     },
     /// A server announcement (shutdown, kick, information).
     Notice(NoticeKind),
+    /// A player is in our room (from the roster after the welcome, us
+    /// included, or joining later).
+    PlayerJoined {
+        /// Its id.
+        id: PlayerId,
+        /// Its name.
+        name: String,
+    },
+    /// A player left our room.
+    PlayerLeft {
+        /// Its id.
+        id: PlayerId,
+    },
     /// Connecting failed; the thread has ended.
     Failed(String),
+    /// Connecting failed because the server's certificate is not the one
+    /// trusted (a wrong pin, or a known host whose certificate changed);
+    /// the message says what to do. The thread has ended.
+    Untrusted(String),
     /// An established session ended; the thread has ended.
     Disconnected(String),
 }
@@ -103,6 +124,7 @@ pub struct NetThread {
     commands: tokio::sync::mpsc::Sender<NetCommand>,
     dropped: Arc<AtomicU64>,
     transport: Arc<Mutex<Option<TransportSample>>>,
+    players: Arc<Mutex<BTreeMap<PlayerId, String>>>,
     quit: Option<oneshot::Sender<()>>,
     thread: Option<thread::JoinHandle<()>>,
 }
@@ -123,10 +145,12 @@ impl NetThread {
         let (quit, quit_rx) = oneshot::channel();
         let dropped = Arc::new(AtomicU64::new(0));
         let transport = Arc::new(Mutex::new(None));
+        let players = Arc::new(Mutex::new(BTreeMap::new()));
         let events_tx = Events {
             tx: events_tx,
             dropped: dropped.clone(),
             transport: transport.clone(),
+            players: players.clone(),
         };
         let thread = thread::Builder::new()
             .name("ledge-net".into())
@@ -138,6 +162,7 @@ impl NetThread {
             commands,
             dropped,
             transport,
+            players,
             quit: Some(quit),
             thread: Some(thread),
         })
@@ -174,6 +199,14 @@ impl NetThread {
         self.transport.lock().ok().and_then(|t| *t)
     }
 
+    /// Who is in our room, by id (us included), as the network thread last
+    /// heard: at most [`ledge_shared::protocol::MAX_ROSTER`] names. Unlike
+    /// the [`NetEvent::PlayerJoined`] events it cannot miss an update when
+    /// the event queue overflows.
+    pub fn players(&self) -> BTreeMap<PlayerId, String> {
+        self.players.lock().map(|p| p.clone()).unwrap_or_default()
+    }
+
     /// Events and commands dropped so far because a queue was full.
     pub fn dropped(&self) -> u64 {
         self.dropped.load(Ordering::Relaxed)
@@ -201,6 +234,7 @@ struct Events {
     tx: mpsc::SyncSender<NetEvent>,
     dropped: Arc<AtomicU64>,
     transport: Arc<Mutex<Option<TransportSample>>>,
+    players: Arc<Mutex<BTreeMap<PlayerId, String>>>,
 }
 
 impl Events {
@@ -240,7 +274,15 @@ async fn run(
         result = connecting => match result {
             Ok((session, _)) => session,
             Err(e) => {
-                events.send(NetEvent::Failed(e.to_string()));
+                let untrusted = matches!(
+                    e,
+                    ClientError::Trust(_) | ClientError::FingerprintMismatch { .. }
+                );
+                events.send(if untrusted {
+                    NetEvent::Untrusted(e.to_string())
+                } else {
+                    NetEvent::Failed(e.to_string())
+                });
                 return;
             }
         },
@@ -248,6 +290,11 @@ async fn run(
     let sample = |s: &crate::session::Session| {
         if let Ok(mut slot) = events.transport.lock() {
             *slot = Some(TransportSample::of(s.connection()));
+        }
+    };
+    let roster = |s: &crate::session::Session| {
+        if let Ok(mut slot) = events.players.lock() {
+            slot.clone_from(s.players());
         }
     };
     sample(&session);
@@ -280,6 +327,14 @@ async fn run(
                 SessionEvent::Notice(kind) => events.send(NetEvent::Notice(kind)),
                 SessionEvent::Pong { rtt: Some(rtt), .. } => events.send(NetEvent::Rtt(rtt)),
                 SessionEvent::Pong { rtt: None, .. } => true,
+                SessionEvent::PlayerJoined { id, name } => {
+                    roster(&session);
+                    events.send(NetEvent::PlayerJoined { id, name })
+                }
+                SessionEvent::PlayerLeft { id, .. } => {
+                    roster(&session);
+                    events.send(NetEvent::PlayerLeft { id })
+                }
             }),
         };
         match result {
@@ -329,9 +384,13 @@ impl NetStatus {
                 NetEvent::Rtt(_)
                 | NetEvent::Snapshot(_)
                 | NetEvent::Chat { .. }
-                | NetEvent::Notice(_),
+                | NetEvent::Notice(_)
+                | NetEvent::PlayerJoined { .. }
+                | NetEvent::PlayerLeft { .. },
             ) => status,
-            (_, NetEvent::Failed(reason)) => NetStatus::Failed(reason),
+            (_, NetEvent::Failed(reason) | NetEvent::Untrusted(reason)) => {
+                NetStatus::Failed(reason)
+            }
             (_, NetEvent::Disconnected(reason)) => NetStatus::Disconnected(reason),
         };
     }
@@ -395,6 +454,11 @@ mod tests {
             from: PlayerId(1),
             text: "hi".into(),
         });
+        status.apply(NetEvent::PlayerJoined {
+            id: PlayerId(1),
+            name: "bo".into(),
+        });
+        status.apply(NetEvent::PlayerLeft { id: PlayerId(1) });
         assert_eq!(
             status,
             NetStatus::Connected {
@@ -409,6 +473,8 @@ mod tests {
         );
         status.apply(NetEvent::Disconnected("gone".into()));
         assert_eq!(status, NetStatus::Disconnected("gone".into()));
+        status.apply(NetEvent::Untrusted("changed".into()));
+        assert_eq!(status, NetStatus::Failed("changed".into()));
     }
 
     #[test]

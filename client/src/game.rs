@@ -13,9 +13,11 @@
 //!                (or: for _ in 0..game.advance(now) { let t = game.step(b); send(t, b) })
 //! each snapshot: game.on_snapshot(&update)
 //! each ping:     game.on_rtt(rtt);  now and then: game.on_transport(sample, now)
+//! the roster:    game.on_player_joined(id, name), game.on_player_left(id)
 //! to draw:       game.view(), game.net_stats(now)
 //! ```
 
+use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use glam::IVec2;
@@ -23,7 +25,7 @@ use ledge_shared::game::state::{kind, player_flags};
 use ledge_shared::game::{Game, GameConfig};
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
-use ledge_shared::protocol::{decode_sim_config, EntityState, PlayerId, Welcome};
+use ledge_shared::protocol::{decode_sim_config, EntityState, PlayerId, Welcome, MAX_ROSTER};
 
 use crate::clock::SyncClock;
 use crate::error::ClientError;
@@ -49,6 +51,9 @@ pub struct ClientGame {
     level: Level,
     me: PlayerId,
     name: Option<String>,
+    /// The room's players by id, from the server's roster (at most
+    /// [`MAX_ROSTER`]).
+    names: BTreeMap<PlayerId, String>,
     welcome: Option<Welcome>,
     predictor: Predictor,
     clock: SyncClock,
@@ -88,6 +93,7 @@ impl ClientGame {
             player_half: config.player.half,
             me: welcome.player_id,
             name: None,
+            names: BTreeMap::new(),
             welcome: Some(welcome.clone()),
             predictor,
             clock,
@@ -110,6 +116,7 @@ impl ClientGame {
             player_half: GameConfig::default().player.half,
             me,
             name: None,
+            names: BTreeMap::new(),
             welcome: None,
             predictor,
             clock: SyncClock::new(0.0, 60, now),
@@ -130,6 +137,34 @@ impl ClientGame {
     /// Sets our player's name (shown in [`PlayerDraw::name`]).
     pub fn set_name(&mut self, name: &str) {
         self.name = Some(name.to_owned());
+    }
+
+    /// A player is in the room as `name` (from the server's roster):
+    /// remote players are drawn with it ([`PlayerDraw::name`]). Beyond
+    /// [`MAX_ROSTER`] names, new ids are ignored.
+    pub fn on_player_joined(&mut self, id: PlayerId, name: &str) {
+        if self.names.len() < MAX_ROSTER || self.names.contains_key(&id) {
+            self.names.insert(id, name.to_owned());
+        }
+    }
+
+    /// Player `id` left the room.
+    pub fn on_player_left(&mut self, id: PlayerId) {
+        self.names.remove(&id);
+    }
+
+    /// Replaces the known names by `names` (its first [`MAX_ROSTER`]).
+    pub fn set_player_names(&mut self, names: &BTreeMap<PlayerId, String>) {
+        self.names = names
+            .iter()
+            .take(MAX_ROSTER)
+            .map(|(&id, n)| (id, n.clone()))
+            .collect();
+    }
+
+    /// The names known, by player id.
+    pub fn player_names(&self) -> &BTreeMap<PlayerId, String> {
+        &self.names
     }
 
     /// Our player id.
@@ -287,7 +322,10 @@ impl ClientGame {
             };
             PlayerDraw {
                 id: self.me,
-                name: self.name.clone(),
+                name: self
+                    .name
+                    .clone()
+                    .or_else(|| self.names.get(&self.me).cloned()),
                 pos: prev.lerp(cur, alpha) + self.predictor.offset(),
                 size: px2(p.half * 2),
                 vel: px2(p.vel) * rate,
@@ -303,7 +341,7 @@ impl ClientGame {
             .filter(|s| s.id != self.me.0 && game.player(PlayerId(s.id)).is_some())
             .map(|s| PlayerDraw {
                 id: PlayerId(s.id),
-                name: None,
+                name: self.names.get(&PlayerId(s.id)).cloned(),
                 pos: s.pos,
                 size,
                 vel: s.vel * rate,
@@ -370,5 +408,34 @@ impl ClientGame {
             corrections: p.corrections,
             mispredictions: p.mispredictions,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_follow_the_roster_and_stay_bounded() {
+        let level = ledge_shared::level::default_level();
+        let mut game = ClientGame::offline(level, Instant::now()).unwrap();
+        game.on_player_joined(PlayerId(7), "bo");
+        game.on_player_joined(PlayerId(7), "bob");
+        assert_eq!(game.player_names().get(&PlayerId(7)).unwrap(), "bob");
+        for i in 100..100 + MAX_ROSTER as u32 + 10 {
+            game.on_player_joined(PlayerId(i), "x");
+        }
+        assert_eq!(game.player_names().len(), MAX_ROSTER);
+        // A known id is renamed even when full; a new one is not added.
+        game.on_player_joined(PlayerId(7), "bo");
+        assert_eq!(game.player_names().get(&PlayerId(7)).unwrap(), "bo");
+        game.on_player_left(PlayerId(7));
+        assert!(!game.player_names().contains_key(&PlayerId(7)));
+        game.set_player_names(&BTreeMap::from([(PlayerId(1), "me".to_string())]));
+        assert_eq!(game.player_names().len(), 1);
+        // Our own name falls back to the roster's.
+        assert_eq!(game.view().local.unwrap().name.as_deref(), Some("me"));
+        game.set_name("ada");
+        assert_eq!(game.view().local.unwrap().name.as_deref(), Some("ada"));
     }
 }

@@ -146,6 +146,7 @@ impl OnlineGame {
                 match made {
                     Ok(mut game) => {
                         game.set_name(&self.name);
+                        game.set_player_names(&self.net.players());
                         self.game = Some(game);
                     }
                     Err(e) => self.error = Some(e.to_string()),
@@ -173,7 +174,17 @@ impl OnlineGame {
                 }
                 self.notices.push_back(kind.clone());
             }
-            NetEvent::Failed(_) | NetEvent::Disconnected(_) => {}
+            NetEvent::PlayerJoined { id, name } => {
+                if let Some(game) = &mut self.game {
+                    game.on_player_joined(*id, name);
+                }
+            }
+            NetEvent::PlayerLeft { id } => {
+                if let Some(game) = &mut self.game {
+                    game.on_player_left(*id);
+                }
+            }
+            NetEvent::Failed(_) | NetEvent::Untrusted(_) | NetEvent::Disconnected(_) => {}
         }
     }
 

@@ -4,19 +4,22 @@
 //! [`Session`] is driven by its caller (no task of its own): call
 //! [`Session::send_input`] once per tick, and [`Session::recv`] in a loop
 //! (or in a `select!`: it is cancel-safe) to get [`SessionEvent`]s:
-//! decoded snapshots, chat lines, notices, pongs. Snapshots are decoded
-//! against the session's own [`SnapshotHistory`] and every input packet
-//! acknowledges the newest one, so the server's next deltas are against it.
+//! decoded snapshots, chat lines, notices, pongs, players joining and
+//! leaving. Snapshots are decoded against the session's own
+//! [`SnapshotHistory`] and every input packet acknowledges the newest one,
+//! so the server's next deltas are against it. The room's roster (who is
+//! in it, by name) is kept in [`Session::players`], at most
+//! [`MAX_ROSTER`] names.
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::net::SocketAddr;
 use std::time::{Duration, Instant};
 
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
     write_frame, ClientControl, CloseCode, Fingerprint, FrameDecoder, InputPacket, Message,
-    NoticeKind, PlayerId, ServerControl, Snapshot, SnapshotHistory, StateSnapshot, Welcome,
-    MAX_FRAME, MAX_INPUT_HISTORY, PROTOCOL_VERSION,
+    NoticeKind, PlayerId, RosterEntry, ServerControl, Snapshot, SnapshotHistory, StateSnapshot,
+    Welcome, MAX_FRAME, MAX_INPUT_HISTORY, MAX_ROSTER, PROTOCOL_VERSION,
 };
 
 use crate::error::ClientError;
@@ -155,6 +158,7 @@ pub async fn handshake(dialed: Dialed, hello: ClientControl) -> Result<Session, 
             history: SnapshotHistory::new(SNAPSHOT_HISTORY),
             pending: VecDeque::new(),
             pings: VecDeque::new(),
+            players: BTreeMap::new(),
             next_nonce: 0,
             stats: SessionStats::default(),
         }),
@@ -218,6 +222,21 @@ pub enum SessionEvent {
         /// Round-trip time, if the ping was sent by this session recently.
         rtt: Option<Duration>,
     },
+    /// A player is in our room: from the roster sent after the welcome
+    /// (once per player, us included) or because it joined later.
+    PlayerJoined {
+        /// Its id.
+        id: PlayerId,
+        /// Its name.
+        name: String,
+    },
+    /// A player left our room.
+    PlayerLeft {
+        /// Its id.
+        id: PlayerId,
+        /// Its name, if we knew it.
+        name: Option<String>,
+    },
 }
 
 /// Counters of what the session received and sent.
@@ -235,6 +254,8 @@ pub struct SessionStats {
     pub missing_baselines: u64,
     /// Datagrams or snapshots that failed to decode, dropped.
     pub malformed: u64,
+    /// Roster entries ignored because [`MAX_ROSTER`] names were known.
+    pub roster_overflow: u64,
     /// Input packets sent.
     pub inputs_sent: u64,
 }
@@ -296,6 +317,7 @@ pub struct Session {
     history: SnapshotHistory,
     pending: VecDeque<SessionEvent>,
     pings: VecDeque<(u64, Instant)>,
+    players: BTreeMap<PlayerId, String>,
     next_nonce: u64,
     stats: SessionStats,
 }
@@ -315,6 +337,17 @@ impl Session {
     /// The underlying QUIC connection (stats, close reason, raw datagrams).
     pub fn connection(&self) -> &quinn::Connection {
         &self.connection
+    }
+
+    /// Who is in our room, by id (us included, once the roster arrived):
+    /// at most [`MAX_ROSTER`] names.
+    pub fn players(&self) -> &BTreeMap<PlayerId, String> {
+        &self.players
+    }
+
+    /// The name of player `id`, if known.
+    pub fn player_name(&self, id: PlayerId) -> Option<&str> {
+        self.players.get(&id).map(String::as_str)
     }
 
     /// The newest decoded snapshot.
@@ -471,10 +504,53 @@ impl Session {
                     .map(|(_, at)| at.elapsed());
                 self.pending.push_back(SessionEvent::Pong { nonce, rtt });
             }
+            ServerControl::Roster { players } => {
+                // The full list: forget whoever is not in it.
+                let listed: BTreeMap<PlayerId, String> =
+                    players.into_iter().map(|p| (p.id, p.name)).collect();
+                let gone: Vec<PlayerId> = self
+                    .players
+                    .keys()
+                    .filter(|id| !listed.contains_key(id))
+                    .copied()
+                    .collect();
+                for id in gone {
+                    self.player_left(id);
+                }
+                for (id, name) in listed {
+                    self.player_joined(RosterEntry { id, name });
+                }
+            }
+            ServerControl::PlayerJoined(entry) => self.player_joined(entry),
+            ServerControl::PlayerLeft { id } => self.player_left(id),
             ServerControl::Welcome(_) | ServerControl::Reject { .. } => {
                 tracing::warn!("ignoring a second welcome or reject");
             }
         }
+    }
+
+    /// Records a player in the roster (a new name for a known id replaces
+    /// the old one) and reports it; beyond [`MAX_ROSTER`] names new ids are
+    /// ignored and counted.
+    fn player_joined(&mut self, entry: RosterEntry) {
+        let RosterEntry { id, name } = entry;
+        if self.players.get(&id) == Some(&name) {
+            return;
+        }
+        if self.players.len() >= MAX_ROSTER && !self.players.contains_key(&id) {
+            self.stats.roster_overflow += 1;
+            return;
+        }
+        self.players.insert(id, name.clone());
+        self.pending
+            .push_back(SessionEvent::PlayerJoined { id, name });
+    }
+
+    /// Removes a player from the roster and reports it.
+    fn player_left(&mut self, id: PlayerId) {
+        let name = self.players.remove(&id);
+        self.pending
+            .push_back(SessionEvent::PlayerLeft { id, name });
     }
 
     /// Decodes a snapshot against our history and queues it if it is new.

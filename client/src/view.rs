@@ -58,8 +58,9 @@ impl Facing {
 pub struct PlayerDraw {
     /// Its id.
     pub id: PlayerId,
-    /// Its name, when known (ours; the protocol has no roster yet, so
-    /// remote players have `None`).
+    /// Its name, when known: ours, and remote players' from the server's
+    /// roster (`None` until it arrived, or past [`ledge_shared::protocol::MAX_ROSTER`]
+    /// players).
     pub name: Option<String>,
     /// Centre of its box, pixels.
     pub pos: Vec2,

@@ -1,6 +1,7 @@
 //! The real client binary, under Xvfb, joined to a real server, scripted
 //! to run right and stop; its screenshot must show the level and our player
-//! where the server says it is.
+//! where the server says it is, and another player ("bob", who ran to the
+//! left wall) with his name above him.
 //!
 //! Needs `xvfb-run` (Debian: `apt-get install xvfb`; `.ci/run` installs
 //! it). Without it the test fails when `CI=true` and otherwise prints a
@@ -11,9 +12,11 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use ledge_client::{connect, Session};
 use ledge_server::{Server, ServerConfig};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::game::Game;
+use ledge_shared::input::Buttons;
 use ledge_shared::level::default_level;
 use ledge_shared::tilemap::Tile;
 use serde_json::Value;
@@ -23,6 +26,31 @@ const CLIENT_TIMEOUT: Duration = Duration::from_secs(90);
 /// Ticks of play before the screenshot: run right, then come to rest.
 const TICKS: u64 = 150;
 const SCRIPT: &str = "0-14 -> right";
+/// The other player's name.
+const BOB: &str = "bob";
+
+/// Joins as [`BOB`] and holds left for `run` (the server repeats the last
+/// buttons, so he keeps pushing against the level's left wall, away from
+/// our player's spawn).
+async fn bob_runs_left(
+    addr: SocketAddr,
+    fingerprint: ledge_client::Fingerprint,
+    run: Duration,
+) -> Session {
+    let mut bob = connect(addr, "localhost", fingerprint, BOB)
+        .await
+        .expect("bob is welcomed");
+    let start_tick = bob.welcome().server_tick;
+    let rate = f64::from(bob.welcome().timing.tick_rate);
+    let t0 = Instant::now();
+    while t0.elapsed() < run {
+        let tick = start_tick + 2 + (t0.elapsed().as_secs_f64() * rate) as u64;
+        bob.send_input(tick, Buttons(Buttons::LEFT))
+            .expect("input queued");
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
+    bob
+}
 
 fn xvfb_run() -> Option<std::path::PathBuf> {
     let path = std::env::var_os("PATH")?;
@@ -114,19 +142,17 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
         .build()
         .unwrap();
     let certs = tempfile::tempdir().unwrap();
-    let (addr, fingerprint, shutdown, task) = runtime.block_on(async {
+    let (addr, fingerprint, shutdown, task, bob) = runtime.block_on(async {
         let server = Server::bind(ServerConfig {
             bind: SocketAddr::from(([127, 0, 0, 1], 0)),
             cert_dir: certs.path().to_owned(),
             ..ServerConfig::default()
         })
         .expect("server binds");
-        (
-            server.local_addr(),
-            server.fingerprint(),
-            server.shutdown_handle(),
-            tokio::spawn(server.run()),
-        )
+        let (addr, fingerprint) = (server.local_addr(), server.fingerprint());
+        let (shutdown, task) = (server.shutdown_handle(), tokio::spawn(server.run()));
+        let bob = bob_runs_left(addr, fingerprint, Duration::from_millis(1500)).await;
+        (addr, fingerprint, shutdown, task, bob)
     });
 
     // The real client, scripted, in a virtual X server.
@@ -165,6 +191,7 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
         }
         std::thread::sleep(Duration::from_millis(100));
     };
+    runtime.block_on(bob.close());
     shutdown.shutdown();
     runtime.block_on(async {
         let _ = tokio::time::timeout(Duration::from_secs(5), task).await;
@@ -249,10 +276,11 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
         "the scripted run moved us right: x = {px}"
     );
     let (cx, cy) = pair(&player["server_screen"]);
-    assert_eq!(
-        to_screen(px, py),
-        (cx, cy),
-        "server_screen follows the camera"
+    // (The JSON has three decimals: 98.3125 px is printed 98.312.)
+    let (sx, sy) = to_screen(px, py);
+    assert!(
+        (sx - cx).abs() < 0.01 && (sy - cy).abs() < 0.01,
+        "server_screen follows the camera: ({sx}, {sy}) vs ({cx}, {cy})"
     );
     let (dx, dy) = pair(&player["drawn_screen"]);
     assert!(
@@ -296,15 +324,50 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
         "player colour away from the player: {:?}",
         &stray[..stray.len().min(10)]
     );
+    // Bob: drawn with his name (from the server's roster), and the label's
+    // white text is above his head.
+    let remotes = json["remotes"].as_array().expect("remotes listed");
+    let bob: Vec<&Value> = remotes
+        .iter()
+        .filter(|r| r["label"].as_str() == Some(BOB))
+        .collect();
+    assert_eq!(bob.len(), 1, "bob drawn once with his name: {json}");
+    let (bx, by) = pair(&bob[0]["drawn_screen"]);
+    let (bw, bh) = pair(&bob[0]["size_px"]);
+    let (bob_x, bob_y) = ((bx - ox) / zoom, (by - oy) / zoom);
+    assert!(
+        (bob_x - px).abs() > 40.0,
+        "bob ran away from our player: {bob_x} vs {px}"
+    );
+    let head = by - bh * zoom / 2.0;
+    let mut white = 0;
+    for y in (head - 26.0) as i32..(head - 2.0) as i32 {
+        for x in (bx - 24.0) as i32..(bx + 24.0) as i32 {
+            white += img
+                .at(x as f64, y as f64)
+                .is_some_and(|p| p.iter().all(|&c| c >= 250)) as u32;
+        }
+    }
+    assert!(
+        white >= 10,
+        "only {white} white label pixels above bob at ({bx}, {head})"
+    );
+    let body = img.at(bx, by + 2.0).expect("bob on screen");
+    assert!(!close(body, sky), "bob's body is drawn: {body:?}");
+
     // Background around it, where the level is empty (no tile, no entity
-    // near: flags, labels and animations reach a little outside boxes).
+    // or other player near: flags, labels and animations reach a little
+    // outside boxes).
     let game = Game::from_level(&level).unwrap();
     let clear = |x: f64, y: f64| {
+        let away_from_bob =
+            (x - bob_x).abs() > bw / 2.0 + 24.0 || (y - bob_y).abs() > bh / 2.0 + 24.0;
         let tile_empty = tile(
             ((x - o.0) / t).floor() as i32,
             ((y - o.1) / t).floor() as i32,
         ) == Tile::Empty;
         tile_empty
+            && away_from_bob
             && game.entities().all(|e| {
                 let u = UNITS_PER_PX as f64;
                 let (ex, ey) = (e.pos.x as f64 / u, e.pos.y as f64 / u);

@@ -226,7 +226,27 @@ fn server_control() -> impl Strategy<Value = ServerControl> {
         notice.prop_map(|kind| ServerControl::Notice { kind }),
         envelope().prop_map(ServerControl::FullState),
         any::<u64>().prop_map(|nonce| ServerControl::Pong { nonce }),
+        roster(40).prop_map(|players| ServerControl::Roster { players }),
+        (any::<u32>(), text(MAX_NAME_LEN)).prop_map(|(id, name)| ServerControl::PlayerJoined(
+            RosterEntry {
+                id: PlayerId(id),
+                name
+            }
+        )),
+        any::<u32>().prop_map(|id| ServerControl::PlayerLeft { id: PlayerId(id) }),
     ]
+}
+
+/// A valid roster of up to `max_len` players: ids ascending, names valid.
+fn roster(max_len: usize) -> impl Strategy<Value = Vec<RosterEntry>> {
+    proptest::collection::btree_map(any::<u32>(), text(MAX_NAME_LEN), 0..max_len).prop_map(|m| {
+        m.into_iter()
+            .map(|(id, name)| RosterEntry {
+                id: PlayerId(id),
+                name,
+            })
+            .collect()
+    })
 }
 
 fn buttons() -> impl Strategy<Value = Buttons> {
@@ -1088,4 +1108,105 @@ fn the_game_config_round_trips_through_the_welcome_blob() {
     assert!(decode_sim_config::<GameConfig>(&long).is_err());
     assert!(decode_sim_config::<GameConfig>(&bytes[..bytes.len() - 1]).is_err());
     assert!(decode_sim_config::<GameConfig>(&vec![0xff; MAX_SIM_CONFIG_LEN + 1]).is_err());
+}
+
+/// A roster entry named `name` for id `id`.
+fn entry(id: u32, name: &str) -> RosterEntry {
+    RosterEntry {
+        id: PlayerId(id),
+        name: name.into(),
+    }
+}
+
+#[test]
+fn roster_messages_round_trip_after_the_older_variants() {
+    let full = ServerControl::Roster {
+        players: (0..MAX_ROSTER as u32)
+            .map(|i| entry(i * 7, &"n".repeat(MAX_NAME_LEN)))
+            .collect(),
+    };
+    let bytes = full.encode().unwrap();
+    assert!(bytes.len() <= MAX_FRAME, "{}", bytes.len());
+    assert_eq!(ServerControl::decode(&bytes).unwrap(), full);
+    // Appended after Pong (variant 5): the older encodings are unchanged.
+    let small = ServerControl::Roster {
+        players: vec![entry(1, "ana"), entry(300, "bo")],
+    };
+    assert_eq!(
+        small.encode().unwrap(),
+        [6, 2, 1, 3, b'a', b'n', b'a', 0xFB, 0x2C, 0x01, 2, b'b', b'o']
+    );
+    let joined = ServerControl::PlayerJoined(entry(2, "cy"));
+    assert_eq!(joined.encode().unwrap(), [7, 2, 2, b'c', b'y']);
+    let left = ServerControl::PlayerLeft { id: PlayerId(2) };
+    assert_eq!(left.encode().unwrap(), [8, 2]);
+    assert_eq!(ServerControl::Pong { nonce: 1 }.encode().unwrap(), [5, 1]);
+    for m in [
+        small,
+        joined,
+        left,
+        ServerControl::Roster { players: vec![] },
+    ] {
+        assert_eq!(ServerControl::decode(&m.encode().unwrap()).unwrap(), m);
+    }
+    assert!(check_roster(&[entry(1, "a"), entry(2, "b")]).is_ok());
+}
+
+#[test]
+fn bad_rosters_are_refused_both_ways() {
+    let raw = |m: &ServerControl| {
+        bincode::serde::encode_to_vec(m, bincode::config::standard().with_limit::<MAX_FRAME>())
+            .unwrap()
+    };
+    let cases = [
+        (
+            "too many",
+            (0..=MAX_ROSTER as u32).map(|i| entry(i, "x")).collect(),
+        ),
+        ("duplicate id", vec![entry(1, "a"), entry(1, "b")]),
+        ("descending ids", vec![entry(2, "a"), entry(1, "b")]),
+        ("empty name", vec![entry(1, "")]),
+        ("control character", vec![entry(1, "a\u{1b}[2J")]),
+        ("long name", vec![entry(1, &"n".repeat(MAX_NAME_LEN + 1))]),
+    ];
+    for (what, players) in cases {
+        assert!(check_roster(&players).is_err(), "{what}");
+        let m = ServerControl::Roster { players };
+        assert!(m.encode().is_err(), "{what}: the encoder refuses");
+        assert!(
+            ServerControl::decode(&raw(&m)).is_err(),
+            "{what}: the decoder refuses"
+        );
+    }
+    let bad_join = ServerControl::PlayerJoined(entry(3, "a\nb"));
+    assert!(bad_join.encode().is_err());
+    assert!(matches!(
+        ServerControl::decode(&raw(&bad_join)),
+        Err(ProtocolError::InvalidString { .. })
+    ));
+    // A hostile count: 2^60 entries claimed, none present. The decoder
+    // fails on the bytes, having allocated nothing for the claim.
+    let mut bytes = vec![6u8, 0xFD];
+    bytes.extend_from_slice(&(1u64 << 60).to_le_bytes());
+    assert!(ServerControl::decode(&bytes).is_err());
+    // More than MAX_ROSTER entries present: refused while reading, before
+    // the rest is decoded.
+    let too_many = ServerControl::Roster {
+        players: (0..=MAX_ROSTER as u32).map(|i| entry(i, "x")).collect(),
+    };
+    let err = ServerControl::decode(&raw(&too_many)).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains(&format!("more than {MAX_ROSTER} roster entries")),
+        "{err}"
+    );
+    // Truncated anywhere: an error, never a panic.
+    let good = ServerControl::Roster {
+        players: vec![entry(1, "ana"), entry(2, "bo")],
+    }
+    .encode()
+    .unwrap();
+    for end in 0..good.len() {
+        assert!(ServerControl::decode(&good[..end]).is_err(), "{end}");
+    }
 }

@@ -19,6 +19,14 @@ pub const MAX_ID_LEN: usize = 64;
 pub const MAX_REASON_LEN: usize = 256;
 /// Longest opaque simulation-config blob in [`Welcome::sim_config`].
 pub const MAX_SIM_CONFIG_LEN: usize = 4096;
+/// Most players one [`ServerControl::Roster`] lists, and most names a
+/// client remembers: a bound on what a hostile server can make a client
+/// store. A full roster is at most about 10 KiB (checked at compile time).
+pub const MAX_ROSTER: usize = 256;
+
+// Worst-case roster frame: variant (1) + count (3) + per entry id (5) +
+// name length (1) + name (MAX_NAME_LEN).
+const _: () = assert!(1 + 3 + MAX_ROSTER * (5 + 1 + MAX_NAME_LEN) <= MAX_FRAME);
 
 /// Checks a text field: `min..=max` bytes of UTF-8, no control characters
 /// (which covers newlines, escapes and NUL).
@@ -116,6 +124,72 @@ pub struct PlayerId(pub u32);
 impl fmt::Display for PlayerId {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "#{}", self.0)
+    }
+}
+
+/// One player in a room, as [`ServerControl::Roster`] and
+/// [`ServerControl::PlayerJoined`] announce it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RosterEntry {
+    /// The player's id (its entity id in snapshots).
+    pub id: PlayerId,
+    /// Its display name, checked by [`check_name`].
+    pub name: String,
+}
+
+/// Checks a roster: at most [`MAX_ROSTER`] entries, ids strictly ascending
+/// (so no duplicates, one canonical encoding), every name valid.
+pub fn check_roster(players: &[RosterEntry]) -> Result<(), ProtocolError> {
+    if players.len() > MAX_ROSTER {
+        return Err(ProtocolError::too_large(
+            "roster",
+            players.len(),
+            MAX_ROSTER,
+        ));
+    }
+    if players.windows(2).any(|w| w[0].id >= w[1].id) {
+        return Err(ProtocolError::malformed(
+            "roster",
+            "player ids not strictly ascending",
+        ));
+    }
+    players.iter().try_for_each(|p| check_name(&p.name))
+}
+
+/// Serde helper for [`ServerControl::Roster`]: the list grows as entries
+/// arrive (never by the claimed length) and more than [`MAX_ROSTER`]
+/// entries is an error at once, so a hostile count allocates nothing.
+mod roster_list {
+    use serde::de::{Error, SeqAccess, Visitor};
+    use serde::{Deserializer, Serialize, Serializer};
+
+    use super::{RosterEntry, MAX_ROSTER};
+
+    pub fn serialize<S: Serializer>(v: &[RosterEntry], s: S) -> Result<S::Ok, S::Error> {
+        v.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<RosterEntry>, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Vec<RosterEntry>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                write!(f, "at most {MAX_ROSTER} roster entries")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut v = Vec::new();
+                while let Some(entry) = seq.next_element()? {
+                    if v.len() == MAX_ROSTER {
+                        return Err(A::Error::custom(format!(
+                            "more than {MAX_ROSTER} roster entries"
+                        )));
+                    }
+                    v.push(entry);
+                }
+                Ok(v)
+            }
+        }
+        d.deserialize_seq(V)
     }
 }
 
@@ -330,6 +404,24 @@ pub enum ServerControl {
         /// The ping's nonce.
         nonce: u64,
     },
+    /// Everyone in the room (the receiver included), ascending by id, at
+    /// most [`MAX_ROSTER`] ([`check_roster`]). Sent once, right after the
+    /// `Welcome`; [`ServerControl::PlayerJoined`] and
+    /// [`ServerControl::PlayerLeft`] keep it current. Added in protocol
+    /// version 4.
+    Roster {
+        /// The players.
+        #[serde(with = "roster_list")]
+        players: Vec<RosterEntry>,
+    },
+    /// A player joined the room (sent to everyone else in it). Added in
+    /// protocol version 4.
+    PlayerJoined(RosterEntry),
+    /// A player left the room. Added in protocol version 4.
+    PlayerLeft {
+        /// Who left.
+        id: PlayerId,
+    },
 }
 
 impl Message for ServerControl {
@@ -364,7 +456,9 @@ impl Message for ServerControl {
                 NoticeKind::Info { text } => check_text("notice text", text, 0, MAX_REASON_LEN),
             },
             ServerControl::FullState(snapshot) => snapshot.validate(),
-            ServerControl::Pong { .. } => Ok(()),
+            ServerControl::Pong { .. } | ServerControl::PlayerLeft { .. } => Ok(()),
+            ServerControl::Roster { players } => check_roster(players),
+            ServerControl::PlayerJoined(entry) => check_name(&entry.name),
         }
     }
 }

@@ -29,9 +29,10 @@ mod varint;
 
 pub use codec::Message;
 pub use control::{
-    check_name, check_text, check_version, decode_sim_config, encode_sim_config, ClientControl,
-    CloseCode, NetTiming, NoticeKind, PlayerId, RejectReason, ServerControl, Welcome, MAX_CHAT_LEN,
-    MAX_ID_LEN, MAX_NAME_LEN, MAX_REASON_LEN, MAX_SIM_CONFIG_LEN,
+    check_name, check_roster, check_text, check_version, decode_sim_config, encode_sim_config,
+    ClientControl, CloseCode, NetTiming, NoticeKind, PlayerId, RejectReason, RosterEntry,
+    ServerControl, Welcome, MAX_CHAT_LEN, MAX_ID_LEN, MAX_NAME_LEN, MAX_REASON_LEN, MAX_ROSTER,
+    MAX_SIM_CONFIG_LEN,
 };
 pub use datagram::{fits, input_timing, InputPacket, Outgoing, Snapshot};
 pub use error::ProtocolError;
@@ -47,7 +48,9 @@ pub use snapshot::{
 ///
 /// 3: `ClientControl::HelloRoom`; deltas against baseline entities
 /// extrapolated by their velocity ([`snapshot::extrapolate`]).
-pub const PROTOCOL_VERSION: u32 = 3;
+/// 4: the room's roster: `ServerControl::Roster`, `PlayerJoined`,
+/// `PlayerLeft` (players' names).
+pub const PROTOCOL_VERSION: u32 = 4;
 
 /// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
 /// an unrelated QUIC peer. It names the application, not the version:

@@ -1,9 +1,13 @@
 //! `ledge-client`: the macroquad front end.
 //!
 //! * offline (no `--connect`/`--local`): the default level in a local game;
-//! * `--connect HOST:PORT --cert-hash HEX`: joins a server on a background
-//!   network thread (macroquad owns the main thread) and predicts our
-//!   player with the shared simulation;
+//! * `--connect HOST:PORT`: joins a server on a background network thread
+//!   (macroquad owns the main thread) and predicts our player with the
+//!   shared simulation. The server's certificate is pinned with
+//!   `--cert-hash HEX`, or else trusted on first use and remembered in a
+//!   known-hosts file (`--known-hosts PATH`, default
+//!   `$XDG_CONFIG_HOME/ledge/known_hosts`); a changed certificate is refused
+//!   with a message saying what to do, and exit code 3;
 //! * `--local`: starts the real server in-process on `127.0.0.1:0` and
 //!   joins it: one command, a playable game.
 //!
@@ -28,7 +32,7 @@ use std::time::{Duration, Instant};
 use clap::Parser;
 use ledge_client::background::ConnectRequest;
 use ledge_client::view::px2;
-use ledge_client::Fingerprint;
+use ledge_client::{Fingerprint, Trust};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::input::Buttons;
 use macroquad::prelude::*;
@@ -40,6 +44,14 @@ use script::Script;
 
 /// Frames are not drawn faster than this (no vsync under Xvfb).
 const MAX_FPS: f64 = 240.0;
+
+/// How long the window waits for the server's first answer before it
+/// opens (showing "connecting..."): enough for the TLS handshake, so a
+/// refused certificate is reported on the terminal without a window.
+const CONNECT_WAIT: Duration = Duration::from_secs(3);
+
+/// Exit code when the server's certificate is refused.
+const EXIT_UNTRUSTED: i32 = 3;
 
 /// The process exit code, set by the game loop (macroquad's loop owns the
 /// main thread until it ends).
@@ -55,11 +67,23 @@ static EXIT_CODE: AtomicI32 = AtomicI32::new(0);
 #[command(version)]
 struct Cli {
     /// Server to join, as HOST:PORT (without it or --local: play offline).
-    #[arg(long, value_name = "HOST:PORT", requires = "cert_hash")]
+    #[arg(long, value_name = "HOST:PORT")]
     connect: Option<String>,
-    /// SHA-256 fingerprint of the server certificate (the server prints it).
+    /// SHA-256 fingerprint of the server certificate (the server prints
+    /// it): trust only that certificate. Without it, the certificate is
+    /// trusted on first use and remembered in the known-hosts file.
     #[arg(long, value_name = "HEX", requires = "connect")]
     cert_hash: Option<Fingerprint>,
+    /// Known-hosts file for trust on first use (one `HOST:PORT SHA256` line
+    /// per server; created with its folder if missing) [default:
+    /// $XDG_CONFIG_HOME/ledge/known_hosts or ~/.config/ledge/known_hosts].
+    #[arg(
+        long,
+        value_name = "PATH",
+        requires = "connect",
+        conflicts_with = "cert_hash"
+    )]
+    known_hosts: Option<PathBuf>,
     /// Start a server in this process (127.0.0.1, any free port, the
     /// default level) and join it.
     #[arg(long, conflicts_with = "connect")]
@@ -188,22 +212,34 @@ fn main() -> anyhow::Result<()> {
             cert_fingerprint: s.fingerprint,
             player_name: cli.name.clone(),
         };
+        let trust = Trust::Pinned(s.fingerprint);
         server = Some(s);
-        Some(request)
+        Some((request, trust))
     } else {
-        match (cli.connect, cli.cert_hash) {
-            (Some(server), Some(cert_fingerprint)) => Some(ConnectRequest {
+        cli.connect.map(|server| {
+            let trust = Trust::from_args(cli.cert_hash, cli.known_hosts);
+            let request = ConnectRequest {
                 server,
-                cert_fingerprint,
+                // Only used when pinned (`trust` decides).
+                cert_fingerprint: cli.cert_hash.unwrap_or(Fingerprint([0; 32])),
                 player_name: cli.name.clone(),
-            }),
-            _ => None,
-        }
+            };
+            (request, trust)
+        })
     };
-    let play = match request {
-        Some(request) => play::Play::online(request, level, level_file)?,
+    let mut play = match request {
+        Some((request, trust)) => {
+            tracing::info!("connecting to {} ({trust})", request.server);
+            play::Play::online(request, trust, level, level_file)?
+        }
         None => play::Play::offline(level, &cli.name)?,
     };
+    // A refused certificate ends here, on the terminal, before any window.
+    play.wait_for_network(CONNECT_WAIT);
+    if let Some(message) = play.untrusted() {
+        eprintln!("ledge-client: {message}");
+        std::process::exit(EXIT_UNTRUSTED);
+    }
     let setup = Setup {
         play,
         bindings,
@@ -283,6 +319,10 @@ async fn game(mut setup: Setup) {
         if let Some(stats) = &stats {
             graph.rtt(now, stats.rtt_ms);
         }
+        if let Some(message) = setup.play.untrusted() {
+            fail(EXIT_UNTRUSTED, message);
+            break;
+        }
         if setup.exit_after.is_some() {
             if let Some(reason) = setup.play.failure() {
                 fail(2, &reason);
@@ -322,15 +362,24 @@ async fn game(mut setup: Setup) {
         let time = now as f32;
         render::draw_background(&view, time);
         render::draw_tilemap(&level.tilemap, &view);
+        render::draw_polygon_blocks(level, &view);
         render::draw_entities(
             &entities,
             &view,
             me.as_ref().and_then(|m| m.checkpoint),
             time,
         );
-        for p in &remotes {
-            let label = p.name.clone().unwrap_or_else(|| format!("player {}", p.id));
-            render::draw_player(p, &view, render::player_color(p.id, false), &label);
+        // Remote players wear their names (from the server's roster).
+        let labels: Vec<String> = remotes
+            .iter()
+            .map(|p| {
+                p.name
+                    .clone()
+                    .unwrap_or_else(|| format!("player #{}", p.id))
+            })
+            .collect();
+        for (p, label) in remotes.iter().zip(&labels) {
+            render::draw_player(p, &view, render::player_color(p.id, false), label);
         }
         if let Some(p) = &local {
             let label = p.name.as_deref().unwrap_or(&setup.name);
@@ -367,6 +416,16 @@ async fn game(mut setup: Setup) {
                     tile_px: level.tilemap.tile_size() / UNITS_PER_PX,
                     server: setup.play.server_me(),
                     drawn: local.as_ref().map(|p| p.pos),
+                    remotes: remotes
+                        .iter()
+                        .zip(&labels)
+                        .map(|(p, label)| shot::RemoteShot {
+                            id: p.id,
+                            label,
+                            pos: p.pos,
+                            size: p.size,
+                        })
+                        .collect(),
                 };
                 if let Err(e) = shot::save(path, &shot) {
                     fail(1, &format!("saving the screenshot: {e}"));

@@ -7,10 +7,11 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use glam::IVec2;
-use ledge_client::background::{ConnectRequest, NetEvent, NetStatus, NetThread};
+use ledge_client::background::{ConnectRequest, NetEvent, NetOptions, NetStatus, NetThread};
 use ledge_client::game::{ClientGame, MAX_SENDS_PER_UPDATE};
 use ledge_client::levels::level_for;
 use ledge_client::view::{EntityDraw, FrameView, NetStats, PlayerDraw};
+use ledge_client::Trust;
 use ledge_shared::game::PlayerView;
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
@@ -56,6 +57,8 @@ struct Net {
     latest: Option<StateSnapshot>,
     /// Snapshots arrived since the last [`Play::take_arrivals`].
     arrivals: u32,
+    /// Why the server's certificate was refused, if it was.
+    untrusted: Option<String>,
 }
 
 /// What is being played.
@@ -67,6 +70,9 @@ pub struct Play {
     net: Option<Net>,
     failure: Option<String>,
     started: Instant,
+    /// The game was just created: the ticks due at the first update are
+    /// before play starts (the window was opening), run idle.
+    fresh: bool,
 }
 
 impl Play {
@@ -82,19 +88,26 @@ impl Play {
             net: None,
             failure: None,
             started: Instant::now(),
+            fresh: false,
         })
     }
 
-    /// Connects on a background thread; the game starts when welcomed.
-    /// `level_file`: the server's level when it is not the embedded one.
+    /// Connects on a background thread, trusting the server's certificate
+    /// as `trust` says; the game starts when welcomed. `level_file`: the
+    /// server's level when it is not the embedded one.
     pub fn online(
         request: ConnectRequest,
+        trust: Trust,
         level: Level,
         level_file: Option<PathBuf>,
     ) -> anyhow::Result<Play> {
         let name = request.player_name.clone();
         let status = NetStatus::Connecting(request.server.clone());
-        let thread = NetThread::spawn(request)
+        let options = NetOptions {
+            room: None,
+            trust: Some(trust),
+        };
+        let thread = NetThread::spawn_with(request, options)
             .map_err(|e| anyhow::anyhow!("starting the network thread: {e}"))?;
         Ok(Play {
             level,
@@ -106,9 +119,11 @@ impl Play {
                 status,
                 latest: None,
                 arrivals: 0,
+                untrusted: None,
             }),
             failure: None,
             started: Instant::now(),
+            fresh: false,
         })
     }
 
@@ -121,6 +136,14 @@ impl Play {
         let Some(game) = &mut self.game else {
             return 0;
         };
+        if std::mem::take(&mut self.fresh) {
+            // Welcomed before the window opened: the clock ran on since.
+            // Those ticks are nobody's play: idle, and not sent (the
+            // server assumes no buttons until our first input).
+            for _ in 0..game.advance(now) {
+                game.step(Buttons::NONE);
+            }
+        }
         let due = u64::from(game.advance(now)).min(remaining);
         for i in 0..due {
             let b = buttons(i);
@@ -136,44 +159,79 @@ impl Play {
         due
     }
 
-    fn poll(&mut self, now: Instant) {
+    /// Waits up to `timeout` for the network thread's first word (joined,
+    /// refused, failed) and takes it, so a refused certificate is known
+    /// before any window opens. Returns at once offline.
+    pub fn wait_for_network(&mut self, timeout: Duration) {
         let Some(net) = &mut self.net else { return };
-        while let Some(event) = net.thread.try_recv() {
-            match &event {
-                NetEvent::Connected(welcome) => {
-                    // The clock starts from QUIC's round-trip estimate of
-                    // the handshake.
-                    let rtt = net.thread.transport().map_or(RTT_GUESS, |t| t.rtt);
-                    let made = level_for(welcome, self.level_file.as_deref())
-                        .and_then(|level| ClientGame::new(welcome, level, rtt, now));
-                    match made {
-                        Ok(mut game) => {
-                            game.set_name(&self.name);
-                            self.level = game.level().clone();
-                            self.game = Some(game);
-                        }
-                        Err(e) => self.failure = Some(e.to_string()),
-                    }
-                }
-                NetEvent::Rtt(rtt) => {
-                    if let Some(game) = &mut self.game {
-                        game.on_rtt(*rtt);
-                    }
-                }
-                NetEvent::Snapshot(update) => {
-                    net.arrivals += 1;
-                    if let Some(game) = &mut self.game {
-                        game.on_snapshot(update);
-                    }
-                    net.latest = Some(update.state.clone());
-                }
-                _ => {}
-            }
-            net.status.apply(event);
+        if let Some(event) = net.thread.recv_timeout(timeout) {
+            self.handle(event, Instant::now());
         }
+    }
+
+    /// Why the server's certificate was refused (the message says what to
+    /// do), if it was.
+    pub fn untrusted(&self) -> Option<&str> {
+        self.net.as_ref()?.untrusted.as_deref()
+    }
+
+    fn poll(&mut self, now: Instant) {
+        while let Some(event) = self.net.as_ref().and_then(|n| n.thread.try_recv()) {
+            self.handle(event, now);
+        }
+        let Some(net) = &mut self.net else { return };
         if let (Some(t), Some(game)) = (net.thread.transport(), &mut self.game) {
             game.on_transport(t, now);
         }
+    }
+
+    /// Takes one event from the network thread.
+    fn handle(&mut self, event: NetEvent, now: Instant) {
+        let Some(net) = &mut self.net else { return };
+        match &event {
+            NetEvent::Connected(welcome) => {
+                // The clock starts from QUIC's round-trip estimate of
+                // the handshake.
+                let rtt = net.thread.transport().map_or(RTT_GUESS, |t| t.rtt);
+                let made = level_for(welcome, self.level_file.as_deref())
+                    .and_then(|level| ClientGame::new(welcome, level, rtt, now));
+                match made {
+                    Ok(mut game) => {
+                        game.set_name(&self.name);
+                        game.set_player_names(&net.thread.players());
+                        self.level = game.level().clone();
+                        self.game = Some(game);
+                        self.fresh = true;
+                    }
+                    Err(e) => self.failure = Some(e.to_string()),
+                }
+            }
+            NetEvent::Rtt(rtt) => {
+                if let Some(game) = &mut self.game {
+                    game.on_rtt(*rtt);
+                }
+            }
+            NetEvent::Snapshot(update) => {
+                net.arrivals += 1;
+                if let Some(game) = &mut self.game {
+                    game.on_snapshot(update);
+                }
+                net.latest = Some(update.state.clone());
+            }
+            NetEvent::PlayerJoined { id, name } => {
+                if let Some(game) = &mut self.game {
+                    game.on_player_joined(*id, name);
+                }
+            }
+            NetEvent::PlayerLeft { id } => {
+                if let Some(game) = &mut self.game {
+                    game.on_player_left(*id);
+                }
+            }
+            NetEvent::Untrusted(reason) => net.untrusted = Some(reason.clone()),
+            _ => {}
+        }
+        net.status.apply(event);
     }
 
     /// The level played (the server's, once welcomed).

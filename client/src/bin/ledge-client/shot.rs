@@ -19,6 +19,9 @@
 //!     "size_px": [12.0, 16.0],
 //!     "drawn_screen": [156.0, 412.0]   // where it was drawn (predicted)
 //!   },
+//!   "remotes": [                       // other players drawn, with their labels
+//!     {"id": 2, "label": "bob", "drawn_screen": [60.0, 412.0], "size_px": [12.0, 16.0]}
+//!   ],
 //!   "colors": {"sky": [r, g, b], "solid": [...], "grass": [...],
 //!              "local_player": [...], "one_way": [...]}
 //! }
@@ -49,6 +52,20 @@ pub struct Shot<'a> {
     pub server: Option<(u64, u32, IVec2, IVec2)>,
     /// Where our player was drawn (world px, centre).
     pub drawn: Option<Vec2>,
+    /// The other players drawn.
+    pub remotes: Vec<RemoteShot<'a>>,
+}
+
+/// A remote player as drawn.
+pub struct RemoteShot<'a> {
+    /// Its id.
+    pub id: u32,
+    /// The label drawn above it (its name, once known).
+    pub label: &'a str,
+    /// Centre of its box, world px.
+    pub pos: Vec2,
+    /// Size of its box, world px.
+    pub size: Vec2,
 }
 
 /// The JSON path for screenshot `png`: `png` with `.json` appended.
@@ -123,6 +140,24 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
             let _ = writeln!(s, "  \"player\": null,");
         }
     }
+    let remotes: Vec<String> = shot
+        .remotes
+        .iter()
+        .map(|r| {
+            format!(
+                "    {{\"id\": {}, \"label\": \"{}\", \"drawn_screen\": {}, \"size_px\": {}}}",
+                r.id,
+                r.label.replace(['"', '\\'], "_"),
+                pair(v.to_screen(r.pos)),
+                pair(r.size)
+            )
+        })
+        .collect();
+    if remotes.is_empty() {
+        let _ = writeln!(s, "  \"remotes\": [],");
+    } else {
+        let _ = writeln!(s, "  \"remotes\": [\n{}\n  ],", remotes.join(",\n"));
+    }
     let _ = writeln!(
         s,
         "  \"colors\": {{\"sky\": {}, \"solid\": {}, \"grass\": {}, \"local_player\": {}, \"one_way\": {}}}",
@@ -159,6 +194,12 @@ mod tests {
                 IVec2::new(1536, 2048),
             )),
             drawn: Some(Vec2::new(100.0, 50.0)),
+            remotes: vec![RemoteShot {
+                id: 4,
+                label: "bo \"b\"",
+                pos: Vec2::new(10.0, 20.0),
+                size: Vec2::new(12.0, 16.0),
+            }],
         };
         let json = describe(&shot, Path::new("/tmp/a.png"), 960, 540);
         assert!(
@@ -167,6 +208,13 @@ mod tests {
         );
         assert!(json.contains("\"size_px\": [12.000, 16.000]"), "{json}");
         assert!(json.contains("\"png\": \"a.png\""), "{json}");
+        assert!(
+            json.contains(
+                "{\"id\": 4, \"label\": \"bo _b_\", \"drawn_screen\": [10.000, 20.000], \
+                 \"size_px\": [12.000, 16.000]}"
+            ),
+            "{json}"
+        );
         assert_eq!(
             json_path(Path::new("x/s.png")),
             PathBuf::from("x/s.png.json")

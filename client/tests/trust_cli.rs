@@ -1,0 +1,242 @@
+//! The real `ledge-client` binary's trust options against a real server:
+//! `--connect` without `--cert-hash` trusts on first use with a known-hosts
+//! file, and a changed certificate is refused on the terminal (before any
+//! window opens) with the message saying what to do, and exit code 3.
+//!
+//! The refusal needs no display. The first-use test opens a window, so it
+//! runs under `xvfb-run` like the screenshot test (skipped with a notice
+//! when it is missing, failing when `CI=true`).
+#![cfg(feature = "gui")]
+
+use std::net::SocketAddr;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use ledge_client::Fingerprint;
+use ledge_server::{Server, ServerConfig, ShutdownHandle};
+
+/// The client must have exited within this time.
+const CLIENT_TIMEOUT: Duration = Duration::from_secs(60);
+
+/// Exit code of a refused certificate.
+const EXIT_UNTRUSTED: i32 = 3;
+
+/// A real server on loopback, in-process, for one test.
+struct TestServer {
+    addr: SocketAddr,
+    fingerprint: Fingerprint,
+    shutdown: ShutdownHandle,
+    runtime: tokio::runtime::Runtime,
+    task: tokio::task::JoinHandle<Result<(), ledge_server::ServerError>>,
+    _certs: tempfile::TempDir,
+}
+
+impl TestServer {
+    fn start() -> TestServer {
+        let runtime = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(1)
+            .enable_all()
+            .build()
+            .unwrap();
+        let certs = tempfile::tempdir().unwrap();
+        let (addr, fingerprint, shutdown, task) = runtime.block_on(async {
+            let server = Server::bind(ServerConfig {
+                bind: SocketAddr::from(([127, 0, 0, 1], 0)),
+                cert_dir: certs.path().to_owned(),
+                ..ServerConfig::default()
+            })
+            .expect("server binds");
+            (
+                server.local_addr(),
+                server.fingerprint(),
+                server.shutdown_handle(),
+                tokio::spawn(server.run()),
+            )
+        });
+        TestServer {
+            addr,
+            fingerprint,
+            shutdown,
+            runtime,
+            task,
+            _certs: certs,
+        }
+    }
+
+    fn stop(self) {
+        self.shutdown.shutdown();
+        let task = self.task;
+        self.runtime.block_on(async {
+            let _ = tokio::time::timeout(Duration::from_secs(5), task).await;
+        });
+    }
+}
+
+/// Runs `command` to its end (killed after [`CLIENT_TIMEOUT`]).
+fn run(mut command: Command) -> Output {
+    let mut child = command
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the client starts");
+    let deadline = Instant::now() + CLIENT_TIMEOUT;
+    while child.try_wait().unwrap().is_none() {
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let out = child.wait_with_output().unwrap();
+            panic!(
+                "the client did not exit within {CLIENT_TIMEOUT:?}; stderr:\n{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// The client binary, with no configuration directory of the user's.
+fn client(config_home: &Path) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_ledge-client"));
+    command
+        .env("XDG_CONFIG_HOME", config_home)
+        .env("HOME", config_home)
+        .env("RUST_LOG", "warn");
+    command
+}
+
+/// Asserts the client refused the certificate as the known-hosts file at
+/// `path` (line 1) says, and told the player what to do.
+fn assert_refused(out: &Output, server: &TestServer, wrong: Fingerprint, path: &Path) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(EXIT_UNTRUSTED),
+        "a changed certificate exits with {EXIT_UNTRUSTED}; stderr:\n{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for needle in [
+        "CHANGED".to_owned(),
+        server.addr.to_string(),
+        server.fingerprint.to_string(),
+        wrong.to_string(),
+        path.display().to_string(),
+        "remove line 1".to_owned(),
+        format!("--cert-hash {}", server.fingerprint),
+    ] {
+        assert!(
+            stderr.contains(&needle),
+            "{needle:?} missing from:\n{stderr}"
+        );
+    }
+}
+
+#[test]
+fn a_changed_certificate_is_refused_with_what_to_do() {
+    let server = TestServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("known_hosts");
+    let wrong = Fingerprint([0x5a; 32]);
+    let stored = format!("{} {wrong}\n", server.addr);
+    std::fs::write(&path, &stored).unwrap();
+
+    let mut command = client(dir.path());
+    command
+        .args(["--connect", &server.addr.to_string()])
+        .arg("--known-hosts")
+        .arg(&path)
+        .args(["--exit-after-ticks", "30"]);
+    let out = run(command);
+    assert_refused(&out, &server, wrong, &path);
+    assert_eq!(
+        std::fs::read_to_string(&path).unwrap(),
+        stored,
+        "the stored fingerprint is kept"
+    );
+    server.stop();
+}
+
+#[test]
+fn the_default_known_hosts_file_is_under_the_config_directory() {
+    let server = TestServer::start();
+    let home = tempfile::tempdir().unwrap();
+    let path: PathBuf = home.path().join("ledge").join("known_hosts");
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    let wrong = Fingerprint([0xa5; 32]);
+    std::fs::write(&path, format!("{} {wrong}\n", server.addr)).unwrap();
+
+    let mut command = client(home.path());
+    command
+        .args(["--connect", &server.addr.to_string()])
+        .args(["--exit-after-ticks", "30"]);
+    let out = run(command);
+    assert_refused(&out, &server, wrong, &path);
+    server.stop();
+}
+
+#[test]
+fn known_hosts_and_a_pin_are_exclusive_and_need_a_server() {
+    let dir = tempfile::tempdir().unwrap();
+    let pin = Fingerprint([1; 32]).to_string();
+    let both = run({
+        let mut c = client(dir.path());
+        c.args(["--connect", "127.0.0.1:1", "--cert-hash", &pin])
+            .args(["--known-hosts", "kh"]);
+        c
+    });
+    assert_eq!(both.status.code(), Some(2), "a usage error");
+    let stderr = String::from_utf8_lossy(&both.stderr);
+    assert!(stderr.contains("cannot be used with"), "{stderr}");
+    let alone = run({
+        let mut c = client(dir.path());
+        c.args(["--known-hosts", "kh"]);
+        c
+    });
+    assert_eq!(alone.status.code(), Some(2), "a usage error");
+    assert!(String::from_utf8_lossy(&alone.stderr).contains("--connect"));
+}
+
+fn xvfb_run() -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join("xvfb-run"))
+        .find(|p| p.is_file())
+}
+
+#[test]
+fn the_first_connection_stores_the_certificate() {
+    let Some(xvfb) = xvfb_run() else {
+        if std::env::var("CI").as_deref() == Ok("true") {
+            panic!("xvfb-run is not on PATH: install xvfb to run the client in CI");
+        }
+        let notice =
+            "\n*** SKIPPED trust-on-first-use client test: xvfb-run is not on PATH ***\n\n";
+        let _ = std::io::Write::write_all(&mut std::io::stderr(), notice.as_bytes());
+        return;
+    };
+    let server = TestServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    // A folder that does not exist yet: the client creates it.
+    let path = dir.path().join("new").join("known_hosts");
+    let mut command = Command::new(xvfb);
+    command
+        .args(["-a", "-s", "-screen 0 640x480x24"])
+        .arg(env!("CARGO_BIN_EXE_ledge-client"))
+        .args(["--connect", &server.addr.to_string()])
+        .arg("--known-hosts")
+        .arg(&path)
+        .args(["--exit-after-ticks", "30", "--window", "320x240"])
+        .env("XDG_CONFIG_HOME", dir.path())
+        .env("LIBGL_ALWAYS_SOFTWARE", "1")
+        .env("RUST_LOG", "warn");
+    let out = run(command);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "the client failed: {stderr}");
+    let text = std::fs::read_to_string(&path).expect("the known-hosts file was written");
+    assert!(
+        text.contains(&format!("{} {}", server.addr, server.fingerprint)),
+        "{text}"
+    );
+    server.stop();
+}
