@@ -53,7 +53,8 @@ fn client_config(
     let quic = QuicClientConfig::try_from(tls).map_err(|e| ClientError::Config(e.to_string()))?;
     let mut config = quinn::ClientConfig::new(Arc::new(quic));
     let mut transport = quinn::TransportConfig::default();
-    transport
+    // Resume within a round trip after an outage (see `ledge_quic`).
+    ledge_quic::install(&mut transport)
         .keep_alive_interval(Some(KEEP_ALIVE))
         // Inputs repeat the last ticks, so an old queued one is worthless:
         // keep the queue short and let quinn drop the oldest.

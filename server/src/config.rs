@@ -105,6 +105,11 @@ pub struct ServerConfig {
     pub idle_timeout: Duration,
     /// Per-client rate limits.
     pub limits: Limits,
+    /// Record each room's match (inputs, joins and leaves, state hash per
+    /// tick) for its first this many ticks; `None` (the default): off. Set
+    /// programmatically (tests, tools); read with
+    /// [`crate::Server::recorder`]. See [`crate::record`].
+    pub record_ticks: Option<usize>,
 }
 
 impl Default for ServerConfig {
@@ -122,6 +127,7 @@ impl Default for ServerConfig {
             max_catch_up: DEFAULT_MAX_CATCH_UP,
             idle_timeout: DEFAULT_IDLE_TIMEOUT,
             limits: Limits::default(),
+            record_ticks: None,
         }
     }
 }
@@ -151,6 +157,9 @@ impl ServerConfig {
         }
         if self.max_connections == 0 {
             return bad("max_connections must be at least 1");
+        }
+        if self.record_ticks == Some(0) {
+            return bad("record_ticks must be at least 1 when set");
         }
         if self.idle_timeout < Duration::from_millis(100) {
             return bad("idle_timeout must be at least 0.1 s");
@@ -448,5 +457,19 @@ datagrams_per_second = 500.0
         assert_eq!(at(60, 20), 3);
         assert_eq!(at(60, 25), 2);
         assert_eq!(at(60, 1), 60);
+    }
+
+    #[test]
+    fn recording_is_off_by_default_and_needs_a_positive_cap() {
+        assert_eq!(ServerConfig::default().record_ticks, None);
+        let with = |record_ticks| ServerConfig {
+            record_ticks,
+            ..ServerConfig::default()
+        };
+        assert!(matches!(
+            with(Some(0)).validate(),
+            Err(ConfigError::Invalid(_))
+        ));
+        assert!(with(Some(1)).validate().is_ok());
     }
 }

@@ -11,8 +11,10 @@
 //! * inputs arrive as datagrams ([`InputPacket`]) and go to the client's
 //!   [`PlayerInbox`], which the room drains one tick at a time;
 //! * everything the server sends on the stream goes through one writer
-//!   task fed by a bounded queue ([`Outbound`]): the room's chat relays and
-//!   oversized snapshots, pongs, notices.
+//!   task fed by a bounded queue ([`Outbound`]): the room's chat relays,
+//!   roster (queued by the room when the client joins, so written right
+//!   after the `Welcome`, which is written before the writer starts) and
+//!   joins and departures, oversized snapshots, pongs, notices.
 //!
 //! Robustness: each client has token buckets for datagrams and control
 //! messages (over the limit: dropped and counted), a malformed message is

@@ -16,6 +16,7 @@
 //! * [`inputs`]: a client's bounded input buffer;
 //! * [`snapshots`]: a room's snapshot history and per-client encoding;
 //! * [`room`]: the game, its tick loop and snapshot sending;
+//! * [`record`]: optional match recording (inputs, joins, hashes per tick);
 //! * [`connection`]: one client's handshake, control stream and datagrams;
 //! * [`ratelimit`]: token buckets;
 //! * [`metrics`]: Prometheus metrics and their HTTP endpoint;
@@ -31,6 +32,7 @@ pub mod inputs;
 pub mod levels;
 pub mod metrics;
 pub mod ratelimit;
+pub mod record;
 pub mod room;
 pub mod server;
 pub mod snapshots;

@@ -23,7 +23,7 @@ use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
     encode_sim_config, write_frame, InputPacket, NetTiming, Outgoing, PlayerId, RejectReason,
-    ServerControl, Welcome,
+    RosterEntry, ServerControl, Welcome, MAX_ROSTER,
 };
 use prometheus_client::metrics::counter::Counter;
 use prometheus_client::metrics::histogram::Histogram;
@@ -36,6 +36,7 @@ use crate::inputs::{InputBuffer, Received};
 use crate::metrics::{
     Channel, ClientBytes, DropReason, Metrics, RoomLabel, SnapshotKind, SnapshotLabel,
 };
+use crate::record::Recorder;
 use crate::snapshots::RoomSnapshots;
 use crate::tls::DATAGRAM_SEND_BUFFER;
 
@@ -76,6 +77,8 @@ pub struct RoomConfig {
     pub level_id: String,
     /// Level hash sent in `Welcome`.
     pub level_hash: u64,
+    /// Where to record the match (inputs, joins, leaves, hashes), if on.
+    pub record: Option<Recorder>,
 }
 
 /// The room's progress, published after every tick.
@@ -354,7 +357,10 @@ impl Room {
                     None => break,
                 },
                 () = tokio::time::sleep_until(deadline) => {
-                    let due = schedule.poll(Instant::now());
+                    let now = Instant::now();
+                    let late = now.saturating_duration_since(deadline.into_std());
+                    self.metrics.tick_lateness.observe(late.as_secs_f64());
+                    let due = schedule.poll(now);
                     for _ in 0..due.run {
                         self.tick();
                     }
@@ -423,6 +429,9 @@ impl Room {
                 reason: "the game refused the player".into(),
             });
         }
+        if let Some(r) = &self.config.record {
+            r.join(player_id);
+        }
         let tick = self.game.tick();
         let inbox = Arc::new(Mutex::new(PlayerInbox::new(self.config.input_window, tick)));
         info!(room = %self.config.name, %player_id, %name, tick, "player joined");
@@ -439,6 +448,7 @@ impl Room {
         );
         self.players.store(self.members.len(), Ordering::Relaxed);
         self.players_gauge.set(self.members.len() as i64);
+        self.announce_join(player_id);
         Ok(Joined {
             welcome: Welcome {
                 player_id,
@@ -467,8 +477,12 @@ impl Room {
 
     fn remove(&mut self, player_id: PlayerId) {
         if let Some(member) = self.members.remove(&player_id) {
-            self.game.remove_player(player_id);
+            let removed = self.game.remove_player(player_id);
+            if let (true, Some(r)) = (removed, &self.config.record) {
+                r.leave(player_id);
+            }
             info!(room = %self.config.name, %player_id, name = %member.name, "player left");
+            self.broadcast(&ServerControl::PlayerLeft { id: player_id });
         }
         self.players.store(self.members.len(), Ordering::Relaxed);
         self.players_gauge.set(self.members.len() as i64);
@@ -494,11 +508,16 @@ impl Room {
             self.inputs.push((id, m.buttons));
         }
         self.game.step(&self.inputs);
+        if let Some(r) = &self.config.record {
+            r.tick(tick, &self.inputs, || self.game.state_hash());
+        }
         let interval = u64::from(self.config.snapshot_interval.max(1));
         if self.game.tick() % interval == 0 && !self.members.is_empty() {
             self.send_snapshots();
         }
-        self.tick_duration.observe(started.elapsed().as_secs_f64());
+        let took = started.elapsed().as_secs_f64();
+        self.tick_duration.observe(took);
+        self.metrics.tick_duration_fine.observe(took);
     }
 
     fn send_snapshots(&mut self) {
@@ -583,6 +602,43 @@ impl Room {
                         Err(mpsc::error::TrySendError::Closed(_)) => {}
                     }
                 }
+            }
+        }
+    }
+
+    /// Tells the newcomer `id` who is in the room (a `Roster`, queued now
+    /// and so written right after its `Welcome`) and everyone else that it
+    /// joined.
+    fn announce_join(&self, id: PlayerId) {
+        let entry = |(&id, m): (&PlayerId, &Member)| RosterEntry {
+            id,
+            name: m.name.clone(),
+        };
+        let players = self.members.iter().take(MAX_ROSTER).map(entry).collect();
+        let mut frame = Vec::new();
+        if let (Some(m), Ok(())) = (
+            self.members.get(&id),
+            write_frame(&ServerControl::Roster { players }, &mut frame),
+        ) {
+            self.send_control(m, frame);
+        }
+        let Some(joined) = self.members.get_key_value(&id).map(entry) else {
+            return;
+        };
+        let mut frame = Vec::new();
+        if write_frame(&ServerControl::PlayerJoined(joined), &mut frame).is_ok() {
+            for (_, m) in self.members.iter().filter(|(&other, _)| other != id) {
+                self.send_control(m, frame.clone());
+            }
+        }
+    }
+
+    /// Sends `message` to every member's control stream.
+    fn broadcast(&self, message: &ServerControl) {
+        let mut frame = Vec::new();
+        if write_frame(message, &mut frame).is_ok() {
+            for m in self.members.values() {
+                self.send_control(m, frame.clone());
             }
         }
     }

@@ -20,6 +20,7 @@ use crate::connection::{self, Shared, SHUTDOWN_LINGER};
 use crate::fingerprint::Fingerprint;
 use crate::levels::{self, LevelLoadError};
 use crate::metrics::{self, Metrics};
+use crate::record::Recorder;
 use crate::room::{self, RoomConfig};
 use crate::snapshots::DEFAULT_HISTORY;
 use crate::tls::{self, TlsError};
@@ -77,6 +78,8 @@ pub struct Server {
     registry: Arc<Registry>,
     metrics_listener: Option<(tokio::net::TcpListener, SocketAddr)>,
     shutdown: watch::Sender<bool>,
+    /// One per room when `record_ticks` is set, in room order.
+    recorders: Vec<Recorder>,
 }
 
 /// Asks a running server to shut down gracefully. Cloneable; any clone works.
@@ -117,6 +120,15 @@ impl Server {
             None => None,
         };
         let (metrics, registry) = Metrics::new();
+        let recorders = match config.record_ticks {
+            Some(limit) => {
+                let (id, hash) = (levels::level_id(&level), levels::level_hash(&level));
+                (1..=config.rooms)
+                    .map(|i| Recorder::new(&format!("room-{i}"), &id, hash, limit))
+                    .collect()
+            }
+            None => Vec::new(),
+        };
         Ok(Server {
             endpoint,
             local_addr,
@@ -127,6 +139,7 @@ impl Server {
             registry: Arc::new(registry),
             metrics_listener,
             shutdown: watch::Sender::new(false),
+            recorders,
         })
     }
 
@@ -160,6 +173,13 @@ impl Server {
         &self.level
     }
 
+    /// The match record of room `room` (e.g. `room-1`), when recording is
+    /// on (`ServerConfig::record_ticks`); it fills while the server runs and
+    /// stays readable after it stopped.
+    pub fn recorder(&self, room: &str) -> Option<Recorder> {
+        self.recorders.iter().find(|r| r.room() == room).cloned()
+    }
+
     /// A handle that stops [`Server::run`].
     pub fn shutdown_handle(&self) -> ShutdownHandle {
         ShutdownHandle(self.shutdown.clone())
@@ -178,6 +198,7 @@ impl Server {
             registry,
             metrics_listener,
             shutdown,
+            recorders,
             ..
         } = self;
         let mut stop = shutdown.subscribe();
@@ -199,7 +220,11 @@ impl Server {
                 history: DEFAULT_HISTORY,
                 level_id: level_id.clone(),
                 level_hash,
+                record: recorders.get(i as usize - 1).cloned(),
             };
+            if let Some(r) = &room_config.record {
+                r.start(&game);
+            }
             let (handle, task) = room::spawn(game, room_config, metrics.clone());
             rooms.push(handle);
             room_tasks.push(task);

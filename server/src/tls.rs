@@ -54,7 +54,8 @@ pub fn server_config(
     tls.alpn_protocols = vec![ALPN.to_vec()];
     let mut config = quinn::ServerConfig::with_crypto(Arc::new(QuicServerConfig::try_from(tls)?));
     let mut transport = quinn::TransportConfig::default();
-    transport
+    // Resume within a round trip after an outage (see `ledge_quic`).
+    ledge_quic::install(&mut transport)
         .max_idle_timeout(Some(
             quinn::IdleTimeout::try_from(idle_timeout)
                 .map_err(|_| TlsError::IdleTimeout(idle_timeout))?,

@@ -3,26 +3,28 @@
 //! [`TestServer::start`] runs the real server in-process on `127.0.0.1:0`
 //! with a throw-away certificate directory; tests connect to it with the
 //! headless client library exactly as players and bots do. [`UdpRelay`]
-//! sits between a client and the server and can drop everything, to make a
-//! client go silent without closing; [`scrape`] reads the metrics endpoint.
+//! (a thin wrapper over the `ledge-netsim` link conditioner) sits between
+//! clients and the server to impair the traffic, or drop everything to make
+//! a client go silent without closing; [`scrape`] reads the metrics
+//! endpoint.
 //! [`PredictedClient`] drives a predicting client ([`ClientGame`]) in real
 //! time with a scripted input, the way a player or bot would.
 
 use std::collections::BTreeSet;
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use ledge_client::netstats::TransportSample;
 use ledge_client::predict::Reconciled;
 use ledge_client::{connect, ClientGame, Session, SessionEvent, SnapshotUpdate};
+use ledge_netsim::{LinkConfig, Loss, Relay, RelayConfig};
 use ledge_server::metrics::Registry;
+use ledge_server::record::Recorder;
 use ledge_server::{Fingerprint, Server, ServerConfig, ServerError, ShutdownHandle};
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::StateSnapshot;
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
-use tokio::net::UdpSocket;
 use tokio::task::JoinHandle;
 
 /// How long [`TestServer::stop`] may take before it counts as hung.
@@ -41,6 +43,9 @@ pub struct TestServer {
     pub fingerprint: Fingerprint,
     /// The metrics endpoint, when configured.
     pub metrics_addr: Option<SocketAddr>,
+    /// Room `room-1`'s match record, when recording is configured
+    /// ([`ServerConfig::record_ticks`]).
+    pub recorder: Option<Recorder>,
     registry: Arc<Registry>,
     shutdown: ShutdownHandle,
     task: Option<JoinHandle<Result<(), ServerError>>>,
@@ -69,6 +74,7 @@ impl TestServer {
             addr: server.local_addr(),
             fingerprint: server.fingerprint(),
             metrics_addr: server.metrics_addr(),
+            recorder: server.recorder("room-1"),
             registry: server.registry(),
             shutdown: server.shutdown_handle(),
             task: Some(tokio::spawn(server.run())),
@@ -196,8 +202,9 @@ pub fn ids(state: &StateSnapshot) -> BTreeSet<u32> {
     state.entities.iter().map(|e| e.id).collect()
 }
 
-/// How a [`UdpRelay`] impairs the traffic: loss, delay and jitter, each
-/// way (`up`: client to server, `down`: server to client).
+/// How a [`UdpRelay`] impairs the traffic, simply: random loss each way,
+/// and the same delay and jitter both ways. [`UdpRelay::set_links`] takes
+/// the full [`LinkConfig`] (burst loss, duplication, reordering).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Impairment {
     /// Fraction of client-to-server datagrams dropped.
@@ -206,108 +213,88 @@ pub struct Impairment {
     pub loss_down: f64,
     /// Fixed one-way delay, each way.
     pub delay: Duration,
-    /// Extra one-way delay, uniform in `[0, jitter)` per datagram (so
-    /// datagrams may be reordered).
+    /// Extra one-way delay, uniform in `[0, jitter]` per datagram (jitter
+    /// never reorders: see [`LinkConfig`]).
     pub jitter: Duration,
 }
 
-/// A UDP relay on loopback between one client and a server. While
+impl Impairment {
+    /// The link each way: `(up, down)`.
+    pub fn links(&self) -> (LinkConfig, LinkConfig) {
+        let half = self.jitter / 2;
+        let base = LinkConfig::delay(self.delay + half).with_jitter(half);
+        let lossy = |p: f64| {
+            base.with_loss(if p > 0.0 {
+                Loss::Bernoulli { p }
+            } else {
+                Loss::None
+            })
+        };
+        (lossy(self.loss_up), lossy(self.loss_down))
+    }
+}
+
+/// A link conditioner ([`ledge_netsim::Relay`]) on loopback between
+/// clients and a server, perfect until told otherwise. While
 /// [`UdpRelay::blackhole`] is on, it drops every datagram both ways, as a
-/// dead network or a frozen client would; [`UdpRelay::impair`] adds loss,
-/// delay and jitter.
+/// dead network or a frozen client would; [`UdpRelay::impair`] and
+/// [`UdpRelay::set_links`] impair the traffic. Several clients may share
+/// one relay.
 #[derive(Debug)]
 pub struct UdpRelay {
     /// Where clients connect instead of the server.
     pub addr: SocketAddr,
-    drop_all: Arc<AtomicBool>,
-    impairment: Arc<std::sync::Mutex<Impairment>>,
-    task: JoinHandle<()>,
-}
-
-/// A tiny deterministic generator for the relay's loss and jitter.
-fn next_random(state: &mut u64) -> f64 {
-    *state ^= *state << 13;
-    *state ^= *state >> 7;
-    *state ^= *state << 17;
-    (*state >> 11) as f64 / (1u64 << 53) as f64
+    relay: Relay,
 }
 
 impl UdpRelay {
-    /// Starts relaying to `server`.
+    /// Starts relaying to `server`, unimpaired.
     pub async fn start(server: SocketAddr) -> UdpRelay {
-        let front = Arc::new(UdpSocket::bind("127.0.0.1:0").await.unwrap());
-        let back = Arc::new(UdpSocket::bind("127.0.0.1:0").await.unwrap());
-        back.connect(server).await.unwrap();
-        let addr = front.local_addr().unwrap();
-        let drop_all = Arc::new(AtomicBool::new(false));
-        let impairment = Arc::new(std::sync::Mutex::new(Impairment::default()));
-        let dropping = drop_all.clone();
-        let impaired = impairment.clone();
-        let task = tokio::spawn(async move {
-            let mut client: Option<SocketAddr> = None;
-            let (mut up, mut down) = (vec![0u8; 65536], vec![0u8; 65536]);
-            let mut rng = 0x2545_f491_4f6c_dd1du64;
-            loop {
-                let (bytes, upward) = tokio::select! {
-                    r = front.recv_from(&mut up) => {
-                        let Ok((n, from)) = r else { return };
-                        client = Some(from);
-                        (up[..n].to_vec(), true)
-                    }
-                    r = back.recv(&mut down) => {
-                        let Ok(n) = r else { return };
-                        (down[..n].to_vec(), false)
-                    }
-                };
-                if dropping.load(Ordering::Relaxed) {
-                    continue;
-                }
-                let imp = *impaired.lock().unwrap();
-                let loss = if upward { imp.loss_up } else { imp.loss_down };
-                if loss > 0.0 && next_random(&mut rng) < loss {
-                    continue;
-                }
-                let delay = imp.delay + imp.jitter.mul_f64(next_random(&mut rng));
-                let (front, back) = (front.clone(), back.clone());
-                let send = async move {
-                    if upward {
-                        let _ = back.send(&bytes).await;
-                    } else if let Some(to) = client {
-                        let _ = front.send_to(&bytes, to).await;
-                    }
-                };
-                if delay.is_zero() {
-                    send.await;
-                } else {
-                    tokio::spawn(async move {
-                        tokio::time::sleep(delay).await;
-                        send.await;
-                    });
-                }
-            }
-        });
+        Self::with_links(server, LinkConfig::PERFECT, LinkConfig::PERFECT).await
+    }
+
+    /// Starts relaying to `server` with `up` (client to server) and `down`.
+    pub async fn with_links(server: SocketAddr, up: LinkConfig, down: LinkConfig) -> UdpRelay {
+        let config = RelayConfig {
+            up,
+            down,
+            ..RelayConfig::default()
+        };
+        let relay = Relay::start(SocketAddr::from(([127, 0, 0, 1], 0)), server, config)
+            .await
+            .expect("the relay binds to loopback");
         UdpRelay {
-            addr,
-            drop_all,
-            impairment,
-            task,
+            addr: relay.local_addr(),
+            relay,
         }
     }
 
-    /// Drops all traffic from now on.
+    /// Drops all traffic from now on (until [`UdpRelay::restore`]).
     pub fn blackhole(&self) {
-        self.drop_all.store(true, Ordering::Relaxed);
+        self.relay.set_blackout_both(true);
+    }
+
+    /// Ends a [`UdpRelay::blackhole`].
+    pub fn restore(&self) {
+        self.relay.set_blackout_both(false);
     }
 
     /// Impairs the traffic from now on.
     pub fn impair(&self, impairment: Impairment) {
-        *self.impairment.lock().unwrap() = impairment;
+        let (up, down) = impairment.links();
+        self.set_links(up, down);
     }
-}
 
-impl Drop for UdpRelay {
-    fn drop(&mut self) {
-        self.task.abort();
+    /// Replaces both directions' links from now on.
+    pub fn set_links(&self, up: LinkConfig, down: LinkConfig) {
+        self.relay
+            .set_links(up, down)
+            .expect("valid link configurations");
+    }
+
+    /// The relay itself: per-direction control and counters.
+    pub fn relay(&self) -> &Relay {
+        &self.relay
     }
 }
 
@@ -427,3 +414,4 @@ impl PredictedClient {
         }
     }
 }
+pub mod e2e;

@@ -241,6 +241,9 @@ pub async fn run_bot(
             Ok(SessionEvent::Notice(NoticeKind::Kick { reason })) => {
                 break Some(format!("kicked: {reason}"))
             }
+            Ok(SessionEvent::Notice(NoticeKind::Shutdown)) => {
+                break Some("server shut down".into())
+            }
             Ok(_) => {}
             Err(e) => break Some(e.to_string()),
         }
