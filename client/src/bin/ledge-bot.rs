@@ -3,6 +3,7 @@
 //! ```sh
 //! ledge-bot --connect 127.0.0.1:4433 --cert-hash HEX --count 8 --brain runner --seconds 30
 //! ledge-bot --connect 127.0.0.1:4433 --count 4 --brain misbehave --mode flood,stale
+//! ledge-bot --connect 127.0.0.1:4433 --cert-hash HEX --count 256 --brain thin --seconds 60
 //! ```
 //!
 //! Runs N bots in one process on one tokio runtime, each with its own QUIC
@@ -10,6 +11,13 @@
 //! the end: ticks, corrections, RTT, whether the server saw it reach the
 //! goal. Without `--cert-hash` the certificate is trusted on first use
 //! (`--known-hosts`, default in the user's configuration folder).
+//!
+//! `--brain thin` runs thin bots instead (`ledge_client::bot::thin`): the
+//! walker's random walk, one input per tick, every snapshot decoded, but no
+//! prediction. They are for load generation (`ledge-load --client thin`):
+//! a predicting bot re-simulates its whole room, so a small machine cannot
+//! run hundreds of them beside the server, and thin ones give the server
+//! the same work for a fraction of the CPU.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -17,7 +25,8 @@ use std::time::Duration;
 
 use clap::{Parser, ValueEnum};
 use ledge_client::bot::{
-    connect_and_run, misbehave, BotOptions, Brain, Idle, Misbehavior, RandomWalker, Runner,
+    connect_and_run, misbehave, run_thin, BotOptions, Brain, Idle, Misbehavior, RandomWalker,
+    Runner,
 };
 use ledge_client::transport::resolve;
 use ledge_client::trust::{KnownHosts, Trust};
@@ -33,6 +42,9 @@ enum BrainKind {
     Idle,
     /// Random buttons (seeded).
     Walker,
+    /// The walker's buttons without prediction: thin clients for load
+    /// generation (one input per tick, every snapshot decoded).
+    Thin,
     /// Abuses the protocol (see --mode).
     Misbehave,
 }
@@ -109,10 +121,13 @@ async fn run(cli: Cli) -> ExitCode {
     }
     let mut tasks = Vec::new();
     for i in 0..cli.count {
-        let mut brain: Box<dyn Brain> = match cli.brain {
-            BrainKind::Runner => Box::new(Runner::new(default_route())),
-            BrainKind::Idle => Box::new(Idle),
-            BrainKind::Walker => Box::new(RandomWalker::new(cli.seed.wrapping_add(i as u64))),
+        let seed = cli.seed.wrapping_add(i as u64);
+        // No brain: a thin bot, walking without prediction.
+        let brain: Option<Box<dyn Brain>> = match cli.brain {
+            BrainKind::Runner => Some(Box::new(Runner::new(default_route()))),
+            BrainKind::Idle => Some(Box::new(Idle)),
+            BrainKind::Walker => Some(Box::new(RandomWalker::new(seed))),
+            BrainKind::Thin => None,
             BrainKind::Misbehave => unreachable!("handled above"),
         };
         let options = BotOptions {
@@ -125,7 +140,10 @@ async fn run(cli: Cli) -> ExitCode {
         let server = cli.connect.clone();
         let trust = trust.clone();
         tasks.push(tokio::spawn(async move {
-            connect_and_run(&server, &trust, brain.as_mut(), &options).await
+            match brain {
+                Some(mut brain) => connect_and_run(&server, &trust, brain.as_mut(), &options).await,
+                None => run_thin(&server, &trust, &mut RandomWalker::new(seed), &options).await,
+            }
         }));
         // Stagger the joins a little (the first one may store the host key).
         tokio::time::sleep(Duration::from_millis(if i == 0 { 300 } else { 20 })).await;

@@ -66,14 +66,11 @@ impl RandomWalker {
             hold: 0,
         }
     }
-}
 
-impl Brain for RandomWalker {
-    fn name(&self) -> &'static str {
-        "walker"
-    }
-
-    fn buttons(&mut self, _game: &Game, _me: PlayerId) -> Buttons {
+    /// The buttons of the next tick: a direction (or none), maybe jump,
+    /// rarely down, held together for 5 to 44 ticks. Needs no game, so thin
+    /// bots (no prediction) walk the same way.
+    pub fn next_buttons(&mut self) -> Buttons {
         if self.hold == 0 {
             let r = self.rng.next_u64();
             let dir = match r % 3 {
@@ -92,6 +89,16 @@ impl Brain for RandomWalker {
         }
         self.hold -= 1;
         self.current
+    }
+}
+
+impl Brain for RandomWalker {
+    fn name(&self) -> &'static str {
+        "walker"
+    }
+
+    fn buttons(&mut self, _game: &Game, _me: PlayerId) -> Buttons {
+        self.next_buttons()
     }
 }
 
