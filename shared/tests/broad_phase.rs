@@ -351,6 +351,30 @@ fn world_bounds_and_extreme_sizes() {
     }
 }
 
+/// One big box with the smallest id over hundreds of small ones with
+/// shuffled ids: every pair lands in the first bucket of the output sort, in
+/// sweep order, which is far from sorted (the one-thread sort gives up its
+/// insertion sort there and must still be exact).
+#[test]
+fn crowded_first_id_sorts_like_brute_force() {
+    let mut rng = SplitMix64(11);
+    let mut dynamics = vec![(0, Bounds::new(IVec2::ZERO, IVec2::splat(px(600))))];
+    let mut ids: Vec<u32> = (1..=400).collect();
+    for i in (1..ids.len()).rev() {
+        ids.swap(i, rng.range(0, i as i32) as usize);
+    }
+    for (k, &id) in ids.iter().enumerate() {
+        let at = IVec2::new((k % 20) as i32 * 30 + 1, (k / 20) as i32 * 30 + 1);
+        dynamics.push((id, Bounds::from_min_size(px(1) * at, IVec2::splat(px(8)))));
+    }
+    let mut expect = Vec::new();
+    brute_force(&[], &dynamics, &mut expect);
+    assert_eq!(expect.len(), 400, "the big box meets every small one");
+    check_scene(&[], &dynamics);
+    let statics: Vec<_> = dynamics[1..].to_vec();
+    check_scene(&statics, &dynamics[..1]);
+}
+
 #[test]
 fn standard_scene_over_ticks() {
     let mut scene = StandardScene::new(3000, 7);

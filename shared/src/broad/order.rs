@@ -3,9 +3,12 @@
 //! Work items produce pairs in whatever order their sweep meets them; this
 //! module concatenates and sorts them so that the output depends only on the
 //! set of pairs, never on how the work was split or which thread did what.
-//! It is a one-pass bucket sort on the high bits of the first id (buckets of
-//! about 16 pairs) followed by a comparison sort of each bucket, parallel
-//! over buckets when asked; every buffer is reused.
+//! It is a one-pass bucket sort on the high bits of the first id. In parallel
+//! (buckets of a few pairs) a sort of each bucket follows, split over
+//! buckets; on one thread the pairs are scattered straight into the output
+//! (buckets of about a quarter of a pair) and one insertion sort over the
+//! whole output finishes it, falling back to a comparison sort if a crowded
+//! bucket makes it shift too much. Every buffer is reused.
 
 use glam::IVec2;
 
@@ -13,6 +16,14 @@ use glam::IVec2;
 pub(crate) trait Keyed: Copy + Default + Send + Sync {
     /// `(first id, second id)`, the sort key.
     fn ids(&self) -> (u32, u32);
+
+    /// The sort key as one integer, `first << 32 | second`: one compare
+    /// instead of a lexicographic pair of them.
+    #[inline(always)]
+    fn key(&self) -> u64 {
+        let (a, b) = self.ids();
+        ((a as u64) << 32) | b as u64
+    }
 }
 
 impl Keyed for (u32, u32) {
@@ -31,6 +42,10 @@ impl Keyed for (u32, u32, IVec2) {
 
 /// Buckets of the sort (more is faster to sort, slower to count).
 const MAX_BUCKET_BITS: u32 = 16;
+/// Buckets per pair of the one-thread sort: enough that a bucket rarely holds
+/// two pairs, so the insertion sort over the whole output hardly moves
+/// anything.
+const BUCKETS_PER_PAIR_SERIAL: usize = 4;
 /// Buckets filled per leaf task in the parallel fill.
 const LEAF_PAIRS: usize = 4096;
 
@@ -66,14 +81,24 @@ impl<T: Keyed> Buffers<T> {
         if total == 0 {
             return;
         }
-        // Bucket = (first id - id_lo) >> shift: about 2 pairs per bucket on
-        // one buffer, 16 when there are several (each has its counters).
-        let per_bucket = if n == 1 { 2 } else { 16 };
-        let want_bits = (total / per_bucket).max(1).ilog2().min(MAX_BUCKET_BITS);
+        // Bucket = (first id - id_lo) >> shift. In parallel: about 2 pairs
+        // per bucket on one buffer, 16 when there are several (each has its
+        // counters); on one thread about a quarter of a pair.
+        let want_bits = if par {
+            let per_bucket = if n == 1 { 2 } else { 16 };
+            (total / per_bucket).max(1).ilog2()
+        } else {
+            (total * BUCKETS_PER_PAIR_SERIAL).ilog2()
+        }
+        .min(MAX_BUCKET_BITS);
         let span = id_hi.saturating_sub(id_lo);
         let span_bits = 32 - span.leading_zeros();
         let shift = span_bits.saturating_sub(want_bits);
         let nbk = (span >> shift) as usize + 1;
+        if !par {
+            self.finish_serial(n, id_lo, shift, nbk, total, out);
+            return;
+        }
         if self.tmp.len() < n {
             self.tmp.resize_with(n, Vec::new);
         }
@@ -140,18 +165,89 @@ impl<T: Keyed> Buffers<T> {
     }
 }
 
+impl<T: Keyed> Buffers<T> {
+    /// [`Self::finish`] on this thread: one histogram over every buffer, a
+    /// scatter straight into `out` (no intermediate copy), then one bounded
+    /// insertion sort over the whole of `out`.
+    fn finish_serial(
+        &mut self,
+        n: usize,
+        id_lo: u32,
+        shift: u32,
+        nbk: usize,
+        total: usize,
+        out: &mut Vec<T>,
+    ) {
+        let bucket = move |t: &T| ((t.ids().0.wrapping_sub(id_lo)) >> shift) as usize;
+        let starts = &mut self.starts;
+        starts.clear();
+        starts.resize(nbk + 1, 0);
+        for buf in &self.bufs[..n] {
+            for t in buf {
+                starts[bucket(t) + 1] += 1;
+            }
+        }
+        // Running sum in a register (a loop over `starts[b]` would wait on
+        // its own store at every bucket).
+        let mut acc = 0;
+        for c in starts.iter_mut() {
+            acc += *c;
+            *c = acc;
+        }
+        // `counts[b]`: next free slot of bucket `b`.
+        let next = &mut self.counts;
+        next.clear();
+        next.extend_from_slice(&starts[..nbk]);
+        out.resize(total, T::default());
+        for buf in &self.bufs[..n] {
+            for t in buf {
+                let b = bucket(t);
+                out[next[b] as usize] = *t;
+                next[b] += 1;
+            }
+        }
+        // Buckets hold about a quarter of a pair each: one insertion sort
+        // over the whole output only ever moves a pair within its bucket,
+        // and costs no loop over the buckets.
+        sort_nearly_sorted(out);
+    }
+}
+
+/// Sorts `v` by ids, fast when every element is near its place: an
+/// insertion sort, abandoned for a comparison sort once it has shifted
+/// more than a few elements per element (a crowded bucket).
+fn sort_nearly_sorted<T: Keyed>(v: &mut [T]) {
+    let budget = 4 * v.len() + 64;
+    let mut steps = 0;
+    for i in 1..v.len() {
+        let x = v[i];
+        let k = x.key();
+        let mut j = i;
+        while j > 0 && v[j - 1].key() > k {
+            v[j] = v[j - 1];
+            j -= 1;
+        }
+        v[j] = x;
+        steps += i - j;
+        if steps > budget {
+            v.sort_unstable_by_key(Keyed::key);
+            return;
+        }
+    }
+}
+
 /// Sorts a bucket by ids: an insertion sort for the usual handful of pairs.
 #[inline]
 fn sort_small<T: Keyed>(v: &mut [T]) {
     if v.len() > 24 {
-        v.sort_unstable_by_key(Keyed::ids);
+        v.sort_unstable_by_key(Keyed::key);
         return;
     }
     for i in 1..v.len() {
         let x = v[i];
-        let k = x.ids();
+        let k = x.key();
         let mut j = i;
-        while j > 0 && v[j - 1].ids() > k {
+        while j > 0 && v[j - 1].key() > k {
             v[j] = v[j - 1];
             j -= 1;
         }
