@@ -418,9 +418,10 @@ fn a_player_walks_up_a_polygon_ramp_and_stands_on_it() {
         }
         assert!(on_ramp > 10, "{on_ramp} ticks on the ramp");
         assert!(last.pos.y + last.half.y < px(87), "climbed: {last:?}");
-        // Let go: it brakes and stays on the surface, grounded (then slowly
-        // slides down it: the contact is frictionless).
-        for _ in 0..60 {
+        // Let go: it brakes and stays on the surface, grounded, and once
+        // stopped stays put (a walkable face does not let it slide).
+        let mut stopped = None;
+        for t in 0..60 {
             s.step(NONE);
             let p = s.view();
             let corner = p.pos.x + p.half.x;
@@ -428,6 +429,11 @@ fn a_player_walks_up_a_polygon_ramp_and_stands_on_it() {
             assert!(p.grounded, "{p:?}");
             let gap = p.pos.y + p.half.y - ramp_surface(corner);
             assert!(gap.abs() <= 4, "gap {gap}: {p:?}");
+            if t == 20 {
+                stopped = Some(p.pos);
+            } else if let Some(at) = stopped {
+                assert_eq!(p.pos, at, "slid: {p:?}");
+            }
         }
         // Walks back down it at full speed without leaving it, onto the
         // floor.

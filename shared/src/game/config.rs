@@ -79,6 +79,10 @@ impl PlayerShape {
     }
 }
 
+/// Largest [`PlayerConfig::max_walkable_slope`]: 16 rises per run (86
+/// degrees); steeper faces are walls whatever the configuration.
+const MAX_WALKABLE_SLOPE: i32 = 16 * 256;
+
 /// Every player constant (also used by walkers for gravity).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct PlayerConfig {
@@ -118,6 +122,12 @@ pub struct PlayerConfig {
     /// in which it was grounded and walked off (down a slope): at least
     /// `max_run_speed` for 45 degree slopes.
     pub snap_distance: i32,
+    /// Steepest face of a polygon solid the player stands and walks on, as
+    /// a rise per 256 units of run (256: 45 degrees, 64: a 1:4 ramp). On
+    /// such a face it is grounded, does not slide when standing still, and
+    /// is snapped down onto it when walking down; a steeper face is a wall
+    /// (not ground: the player slides off it). Tile slopes do not use it.
+    pub max_walkable_slope: i32,
     /// Upward speed after stomping an enemy (`jump_speed` and a new jump
     /// hold when jump is held).
     pub stomp_bounce_speed: i32,
@@ -148,6 +158,7 @@ impl Default for PlayerConfig {
             jump_buffer_ticks: 6,
             drop_through_ticks: 10,
             snap_distance: 1024,
+            max_walkable_slope: 256,
             stomp_bounce_speed: 1024,
             stomp_tolerance: 1024,
             carry_mode: CarryMode::Add,
@@ -159,7 +170,8 @@ impl Default for PlayerConfig {
 impl PlayerConfig {
     /// Checks every value: sizes positive within the extent bound, speeds and
     /// accelerations in `[0, MAX_SPEED / 4]`, `max_run_speed`, `jump_speed`
-    /// and `max_fall_speed` positive, tick counts at most 254.
+    /// and `max_fall_speed` positive, `max_walkable_slope` in `[0, 4096]`
+    /// (up to 86 degrees), tick counts at most 254.
     pub fn validate(&self) -> Result<(), String> {
         for (what, v) in [("half.x", self.half.x), ("half.y", self.half.y)] {
             if v <= 0 {
@@ -185,6 +197,12 @@ impl PlayerConfig {
             if v < min || v > limit {
                 return Err(format!("player {what} = {v} is not in [{min}, {limit}]"));
             }
+        }
+        let v = self.max_walkable_slope;
+        if !(0..=MAX_WALKABLE_SLOPE).contains(&v) {
+            return Err(format!(
+                "player max_walkable_slope = {v} is not in [0, {MAX_WALKABLE_SLOPE}]"
+            ));
         }
         for (what, v) in [
             ("jump_hold_ticks", self.jump_hold_ticks),

@@ -25,9 +25,9 @@
 //! walkers: walk, gravity
 //! world.step: carry riders, move, detect (colliders + tiles), restitute
 //! walkers: squished -> defeated; turn at walls and ledges
-//! players (id order): squished / hazard -> respawn; ceiling, wall, ground;
-//!   ground snap; platform exit velocity; enemies (stomp or hurt);
-//!   springboards; coins; checkpoints; goal
+//! players (id order): squished / hazard -> respawn; polygon slopes;
+//!   ceiling, wall, ground; ground snap; platform exit velocity;
+//!   enemies (stomp or hurt); springboards; coins; checkpoints; goal
 //! ```
 //! Events come out in that order (join and leave events first). The rules
 //! are described in `docs/PLATFORMER.md`.
@@ -44,6 +44,7 @@
 
 mod config;
 mod path;
+mod polygon_ground;
 mod rules;
 pub mod state;
 
@@ -321,6 +322,8 @@ pub struct Game {
     squished: Vec<u32>,
     in_hazard_tile: Vec<u32>,
     tile_scratch: Vec<crate::tilemap::TileContact>,
+    /// The polygon blocks, for the slope rules (`polygon_ground`).
+    polygons: Vec<polygon_ground::PolygonSolid>,
 }
 
 impl Game {
@@ -364,6 +367,7 @@ impl Game {
             squished: Vec::new(),
             in_hazard_tile: Vec::new(),
             tile_scratch: Vec::new(),
+            polygons: Vec::new(),
         };
         for (i, def) in level.entities.iter().enumerate() {
             let half = def.size / 2;
@@ -420,6 +424,8 @@ impl Game {
                     g.world
                         .add_collider(b, c)
                         .map_err(|x| bad(i, x.to_string()))?;
+                    g.polygons
+                        .push(polygon_ground::PolygonSolid::new(b, def.pos, &poly));
                     e.body = Some(b);
                 }
                 EntityKind::MovingPlatform { motion, one_way } => {

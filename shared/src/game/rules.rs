@@ -4,6 +4,7 @@
 use glam::IVec2;
 
 use super::config::{CarryMode, PlayerConfig};
+use super::polygon_ground::{PolygonSolid, SLOPE_RUN, TOUCH};
 use super::{EntityType, Game, GameEvent, HurtCause, Player, ENTITY_ID_BASE};
 use crate::fixed::MAX_SPEED;
 use crate::input::Buttons;
@@ -318,8 +319,9 @@ impl Game {
         let mut p = self.players[i];
         let id = p.id;
         let body = self.world.body(p.body).expect("player body");
-        let (mut pos, mut vel, sides) = (body.pos(), body.vel(), body.sides());
+        let (mut pos, mut vel, mut sides) = (body.pos(), body.vel(), body.sides());
         let disp = body.displacement();
+        let pushed = body.pushed();
         let carrier = body.carrier();
         let dropping = body.drops_through();
 
@@ -345,6 +347,23 @@ impl Game {
             return;
         }
 
+        // Polygon faces: a walkable one holds the player like a tile slope
+        // (ground, no slide), a steeper one is a wall.
+        if !self.polygons.is_empty() && carrier.is_none() {
+            if let Some(pc) = self.polygon_contacts(p.body, pos, disp, pushed, sides) {
+                sides = pc.sides;
+                if let Some((shift, v)) = pc.unslide {
+                    if self.tiles_clear(pos + shift, cfg.half, disp + shift, dropping) {
+                        self.world
+                            .shift(p.body, shift)
+                            .expect("unslide within bounds");
+                        pos += shift;
+                        vel = v;
+                    }
+                }
+            }
+        }
+
         let s = &mut p.st;
         // A ceiling stops the rise; a wall stops the run.
         if sides.contains(Sides::TOP) {
@@ -361,13 +380,17 @@ impl Game {
         // grounded player on the ground instead of launching it.
         if !grounded && s.grounded && vel.y >= 0 && !dropping && carrier.is_none() {
             let map = self.world.tilemap().expect("a game's world has a tilemap");
-            if let Some(d) = snap_drop(
+            let mut drop = snap_drop(
                 map,
                 pos,
                 cfg.half,
                 cfg.snap_distance,
                 &mut self.tile_scratch,
-            ) {
+            );
+            if !self.polygons.is_empty() {
+                drop = self.polygon_snap(pos, drop);
+            }
+            if let Some(d) = drop {
                 if d != 0 {
                     self.world
                         .shift(p.body, IVec2::new(0, d))
@@ -496,6 +519,168 @@ impl Game {
             .set_velocity(p.body, clamp_speed(vel))
             .expect("clamped player speed");
         self.players[i] = p;
+    }
+}
+
+/// What this tick's polygon contacts change for a player
+/// ([`Game::polygon_contacts`]).
+struct PolygonContacts {
+    /// The body's sides with each polygon contact reread: a walkable face
+    /// the player rests on touched only its bottom; a steeper face (a wall)
+    /// never its bottom.
+    sides: Sides,
+    /// When the player rests on walkable faces and nothing else pushed it
+    /// sideways: the shift that undoes the faces' sideways push (along the
+    /// surface, back out of it), and the velocity a straight-up push would
+    /// have left.
+    unslide: Option<(IVec2, IVec2)>,
+}
+
+impl Game {
+    /// The polygon block of body `b`, if it is one.
+    fn polygon_of(&self, b: BodyId) -> Option<&PolygonSolid> {
+        // Built in level order: ascending body ids.
+        let i = self.polygons.binary_search_by_key(&b, |p| p.body).ok()?;
+        Some(&self.polygons[i])
+    }
+
+    /// Rereads the polygon contacts of player body `body` (now at `pos`,
+    /// moved by `disp`, of which `pushed` by restitution, with `sides`
+    /// touched), or `None` when no polygon pushed it this tick.
+    ///
+    /// The world pushes a box out of a slanted face along the face's normal,
+    /// so a standing player slides down and a walking one is slowed and
+    /// lifted off the surface. On a walkable face the rules make that push
+    /// straight up instead, like a tile slope's: the sideways part is undone
+    /// by moving along the surface and back out of it, and the velocity
+    /// keeps its horizontal part (only a downward part is stopped).
+    fn polygon_contacts(
+        &self,
+        body: BodyId,
+        pos: IVec2,
+        disp: IVec2,
+        pushed: IVec2,
+        sides: Sides,
+    ) -> Option<PolygonContacts> {
+        let cfg = &self.config.player;
+        let (boxes, n) = cfg.shape.boxes(cfg.half);
+        let boxes = &boxes[..n];
+        let slope = cfg.max_walkable_slope;
+        // Each pushed event of this body, with its polygon when it is one
+        // and whether the player rests on a walkable face of it.
+        let contacts = self.world.events().iter().filter_map(|e| match *e {
+            Event::Contact {
+                body: b,
+                other_body,
+                sides,
+                ..
+            } if b == body => {
+                let poly = self.polygon_of(other_body);
+                let walk = poly
+                    .and_then(|p| p.gap(pos, boxes, slope))
+                    .is_some_and(|g| g.touching() && g.walkable);
+                Some((sides, poly, walk))
+            }
+            _ => None,
+        });
+        let (mut any, mut walk_any) = (false, false);
+        let (mut poly_bits, mut other, mut from_poly) = (Sides::NONE, Sides::NONE, Sides::NONE);
+        for (s, poly, walk) in contacts.clone() {
+            if poly.is_none() {
+                other |= s;
+                continue;
+            }
+            any = true;
+            poly_bits |= s;
+            if walk {
+                walk_any = true;
+                from_poly |= Sides::BOTTOM;
+            } else {
+                from_poly |= Sides(s.0 & !Sides::BOTTOM.0);
+            }
+        }
+        if !any {
+            return None;
+        }
+        // Sides no polygon contact explains came from the other contacts
+        // (logged or not).
+        let sides = Sides(sides.0 & !poly_bits.0) | other | from_poly;
+        let mut out = PolygonContacts {
+            sides,
+            unslide: None,
+        };
+        // The motion before any push: the velocity the rules set.
+        let v0 = disp - pushed;
+        let walls = sides.contains(Sides::LEFT) || sides.contains(Sides::RIGHT);
+        if !walk_any || walls || pushed.x == 0 || v0.y < 0 {
+            return Some(out);
+        }
+        // Undo the sideways push, then lift the boxes back out of the
+        // walkable faces they rest on: at most the faces' rise over that
+        // run (plus rounding), so a face the new position would bury the
+        // player in is not one it rests on.
+        let back = IVec2::new(-pushed.x, 0);
+        let mut lift = 0i64;
+        for (_, poly, walk) in contacts {
+            if let (Some(p), true) = (poly, walk) {
+                if let Some(g) = p.gap(pos + back, boxes, slope) {
+                    lift = lift.min(g.gap);
+                }
+            }
+        }
+        let bound = pushed.x.unsigned_abs() as i64 * slope as i64 / SLOPE_RUN as i64 + 2 * TOUCH;
+        if -lift > bound {
+            return Some(out);
+        }
+        out.unslide = Some((back + IVec2::new(0, lift as i32), IVec2::new(v0.x, 0)));
+        Some(out)
+    }
+
+    /// The ground snap with polygon solids: the drop onto the nearest floor
+    /// under the player at `pos`, `tile` (the tile snap's answer) or the
+    /// nearest polygon face at most `snap_distance` below, whichever is
+    /// higher. A polygon face only when it is walkable (walking off onto a
+    /// steeper face falls) and nothing in the tilemap pushes the box there.
+    fn polygon_snap(&mut self, pos: IVec2, tile: Option<i32>) -> Option<i32> {
+        let cfg = self.config.player;
+        let (boxes, n) = cfg.shape.boxes(cfg.half);
+        let max = cfg.snap_distance as i64;
+        let mut near: Option<(i64, bool)> = None;
+        for p in &self.polygons {
+            let Some(g) = p.gap(pos, &boxes[..n], cfg.max_walkable_slope) else {
+                continue;
+            };
+            if g.gap < 0 || g.gap > max {
+                continue;
+            }
+            near = Some(match near {
+                Some((d, w)) if d < g.gap => (d, w),
+                Some((d, w)) if d == g.gap => (d, w || g.walkable),
+                _ => (g.gap, g.walkable),
+            });
+        }
+        let Some((d, walkable)) = near else {
+            return tile;
+        };
+        if tile.is_some_and(|t| t as i64 <= d) {
+            return tile;
+        }
+        let d = d as i32;
+        let shift = IVec2::new(0, d);
+        (walkable && self.tiles_clear(pos + shift, cfg.half, shift, false)).then_some(d)
+    }
+
+    /// Whether no tile pushes a box of half extents `half` at `pos` that
+    /// moved by `moved` (hazards aside).
+    fn tiles_clear(&mut self, pos: IVec2, half: IVec2, moved: IVec2, dropping: bool) -> bool {
+        let map = self.world.tilemap().expect("a game's world has a tilemap");
+        let out = &mut self.tile_scratch;
+        out.clear();
+        let flags = ContactFlags {
+            drop_through: dropping,
+        };
+        map.box_contacts(pos, half, moved, flags, out);
+        out.iter().all(|c| c.is_trigger())
     }
 }
 
