@@ -16,8 +16,6 @@ use ledge_tests::TestServer;
 
 /// Runners in the race.
 const RUNNERS: usize = 8;
-/// Time between two runners' starts.
-const START_EVERY: Duration = Duration::from_secs(1);
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn eight_runner_bots_reach_the_goal_as_the_server_sees_it() {
@@ -26,32 +24,30 @@ async fn eight_runner_bots_reach_the_goal_as_the_server_sees_it() {
     // for each runner's player and its goal flag.
     let mut observer = server.join("observer").await;
     let observer_id = observer.welcome().player_id.0;
-    // The runners start a second apart. Together they foil each other's
-    // plans (the world they share changes under a plan: e.g. a plan that
-    // lands on the trench walker to stomp it fails when another runner
-    // stomped it a few ticks before, which the prediction learns from the
-    // next snapshot only), and a runner that falls into the walker trench
-    // off its route does not find its way out: a limitation of the runner
-    // bot, not of the server.
+    // The runners all start at once: they connect together and race in
+    // the same world, foiling each other's plans (a walker one of them
+    // stomped is still there in the others' predictions until the next
+    // snapshot; a late input makes the server repeat the previous one).
+    // A runner that leaves its route (falls into the walker trench) notices
+    // and takes the route again.
     let (addr, fingerprint) = (server.addr, server.fingerprint);
-    let starter = tokio::spawn(async move {
-        let mut bots = Vec::new();
-        for i in 0..RUNNERS {
-            if i > 0 {
-                tokio::time::sleep(START_EVERY).await;
-            }
-            let name = format!("runner-{i}");
-            let session = ledge_client::connect(addr, "localhost", fingerprint, &name)
-                .await
-                .unwrap_or_else(|e| panic!("{name} is welcomed: {e}"));
-            let options = ledge_client::bot::BotOptions {
-                stop_when_done: true,
-                ..bot_options(&name, Duration::from_secs(25))
-            };
-            bots.push(spawn_bot(session, Runner::new(default_route()), options));
-        }
-        bots
-    });
+    let bots: Vec<_> = (0..RUNNERS)
+        .map(|i| {
+            tokio::spawn(async move {
+                let name = format!("runner-{i}");
+                let session = ledge_client::connect(addr, "localhost", fingerprint, &name)
+                    .await
+                    .unwrap_or_else(|e| panic!("{name} is welcomed: {e}"));
+                let options = ledge_client::bot::BotOptions {
+                    stop_when_done: true,
+                    ..bot_options(&name, Duration::from_secs(25))
+                };
+                spawn_bot(session, Runner::new(default_route()), options)
+                    .await
+                    .expect("the bot task did not panic")
+            })
+        })
+        .collect();
     let goal = default_level()
         .entities
         .iter()
@@ -82,8 +78,8 @@ async fn eight_runner_bots_reach_the_goal_as_the_server_sees_it() {
     .await;
     let took = started.elapsed();
     let mut reports = Vec::new();
-    for bot in starter.await.expect("the runners started") {
-        let (report, runner) = bot.await.expect("the bot task did not panic");
+    for bot in bots {
+        let (report, runner) = bot.await.expect("the runner ran");
         eprintln!("{report}");
         reports.push((report, runner.progress()));
     }

@@ -10,6 +10,23 @@
 //! prediction is right, the plan lands exactly as simulated. When no plan
 //! reaches the waypoint from here, it walks on and tries again a few ticks
 //! later.
+//!
+//! Plans never count on stomping a walker: the walker may be gone on the
+//! server (another player stomped it a few ticks ago, which the prediction
+//! learns from the next snapshot only), and a plan that bounces off it then
+//! drops the runner somewhere else.
+//!
+//! Like a player, the runner notices when it is off its route and
+//! recovers: standing lower than both ends of the route segment it is on
+//! (it fell, e.g. into the walker trench) or not getting closer to its
+//! waypoint for [`STALL_TICKS`] (jumping at a wall), it heads
+//! back to the latest earlier waypoint it can climb to (a floor at most
+//! [`CLIMB_PX`] above its feet), walks all the way there for a running
+//! start, and takes the route again from there. A stall while recovering
+//! steps one more waypoint back; after [`MAX_RETRIES`] recoveries in a row
+//! on the way to the same waypoint it gives that waypoint up. Everything it
+//! decides is a pure function of the games it is shown, so it is
+//! deterministic.
 
 use std::collections::VecDeque;
 
@@ -32,6 +49,18 @@ const LAND_HEIGHT_PX: i32 = 4;
 const HORIZON: u32 = 120;
 /// Ticks between two searches that found nothing.
 const SEARCH_EVERY: u32 = 3;
+/// Standing more than this many pixels lower than both ends of its route
+/// segment, the runner is off its route.
+const BELOW_ROUTE_PX: i32 = 8;
+/// Ticks without getting at least a pixel closer to its waypoint before the
+/// runner counts as stuck (2.5 s).
+pub const STALL_TICKS: u32 = 150;
+/// Highest floor above its feet a recovering runner heads back to, pixels:
+/// what every jump of the route asks (2 tiles), well below a full jump.
+pub const CLIMB_PX: i32 = 32;
+/// Recoveries in a row on the way to one waypoint before the runner gives
+/// it up and heads for the next one.
+pub const MAX_RETRIES: u32 = 2;
 /// Jump hold lengths tried, ticks (0: no jump).
 const HOLDS: [u32; 9] = [0, 3, 6, 9, 12, 16, 20, 25, 30];
 
@@ -66,6 +95,8 @@ pub struct RunnerProgress {
     pub plans: u64,
     /// Times it was hurt or respawned.
     pub respawns: u64,
+    /// Times it noticed it was off its route or stuck, and headed back.
+    pub recoveries: u64,
     /// It reached the goal (the game says it won).
     pub won: bool,
 }
@@ -78,6 +109,19 @@ pub struct Runner {
     plan: VecDeque<Buttons>,
     cooldown: u32,
     blocked: u32,
+    /// Heading back to an earlier waypoint after leaving the route: it must
+    /// be reached exactly (a running start), not just passed.
+    recovering: bool,
+    /// The waypoint `closest` and `stall` are about.
+    watched: usize,
+    /// Closest distance (|dx| + |dy|, units) to waypoint `watched` so far.
+    closest: i32,
+    /// Ticks since `closest` last shrank by a pixel or more.
+    stall: u32,
+    /// The waypoint it was heading for when it last left its route.
+    origin: usize,
+    /// Recoveries in a row on the way to waypoint `origin`.
+    retries: u32,
     progress: RunnerProgress,
 }
 
@@ -90,6 +134,12 @@ impl Runner {
             plan: VecDeque::new(),
             cooldown: 0,
             blocked: 0,
+            recovering: false,
+            watched: usize::MAX,
+            closest: i32::MAX,
+            stall: 0,
+            origin: usize::MAX,
+            retries: 0,
             progress: RunnerProgress::default(),
         }
     }
@@ -107,6 +157,12 @@ impl Runner {
         self.route.get(self.next)
     }
 
+    /// Whether the runner is recovering: heading back to an earlier
+    /// waypoint after it left its route or got stuck.
+    pub fn recovering(&self) -> bool {
+        self.recovering
+    }
+
     fn reached(&self, i: usize, p: &PlayerView) -> bool {
         let w = &self.route[i];
         let foot = foot(p);
@@ -117,6 +173,10 @@ impl Runner {
         let dx = w.foot.x - foot.0;
         if dx.abs() <= REACH_PX * UNITS_PER_PX {
             return true;
+        }
+        if self.recovering {
+            // Recovering: all the way there, for a running start.
+            return false;
         }
         // Passed it (standing at its height beyond it, seen from the
         // previous waypoint).
@@ -139,6 +199,74 @@ impl Runner {
             .unwrap_or(self.route.len());
         self.plan.clear();
         self.cooldown = 0;
+        self.recovering = false;
+    }
+
+    /// Counts the ticks since the runner last got closer to waypoint `i`.
+    fn watch(&mut self, i: usize, p: &PlayerView) {
+        let (fx, fy) = foot(p);
+        let w = self.route[i].foot;
+        let d = (w.x - fx).abs().saturating_add((w.y - fy).abs());
+        if i != self.watched {
+            self.watched = i;
+            self.closest = d;
+            self.stall = 0;
+        } else if d <= self.closest.saturating_sub(UNITS_PER_PX) {
+            self.closest = d;
+            self.stall = 0;
+        } else {
+            self.stall = self.stall.saturating_add(1);
+        }
+    }
+
+    /// Standing lower than both ends of the route segment to waypoint `i`
+    /// (it fell off the route).
+    fn below_route(&self, i: usize, p: &PlayerView) -> bool {
+        let low = match i.checked_sub(1) {
+            Some(h) => self.route[h].foot.y.max(self.route[i].foot.y),
+            None => self.route[i].foot.y,
+        };
+        p.grounded && foot(p).1 > low + BELOW_ROUTE_PX * UNITS_PER_PX
+    }
+
+    /// Off the route or stuck: heads back to the latest waypoint before the
+    /// current one whose floor is at most [`CLIMB_PX`] above the feet (the
+    /// one just before when none is), to take the route again from there.
+    /// After [`MAX_RETRIES`] recoveries in a row on the way to the same
+    /// waypoint, it gives that one up and heads for the next.
+    fn recover(&mut self, p: &PlayerView) {
+        let origin = if self.recovering {
+            self.origin
+        } else {
+            self.next
+        };
+        if origin == self.origin {
+            self.retries += 1;
+        } else {
+            self.origin = origin;
+            self.retries = 1;
+        }
+        self.progress.recoveries += 1;
+        self.plan.clear();
+        self.cooldown = 0;
+        self.blocked = 0;
+        self.stall = 0;
+        if self.retries > MAX_RETRIES && origin + 1 < self.route.len() {
+            self.next = origin + 1;
+            self.recovering = false;
+            self.retries = 0;
+            return;
+        }
+        let Some(before) = self.next.checked_sub(1) else {
+            // Stuck on the way to the first waypoint: try again.
+            return;
+        };
+        let top = foot(p).1 - CLIMB_PX * UNITS_PER_PX;
+        self.next = (0..=before)
+            .rev()
+            .find(|&j| self.route[j].foot.y >= top)
+            .unwrap_or(before);
+        self.recovering = true;
     }
 
     /// Simulates the candidate plans from `game`; returns the best one that
@@ -210,7 +338,11 @@ fn simulate(
                     if *player == me)
                 || matches!(e, GameEvent::Squished(p) if *p == me)
         });
-        if hurt {
+        // A plan must not count on a walker: it may be gone on the server.
+        let stomped = events
+            .iter()
+            .any(|e| matches!(e, GameEvent::Stomped { player, .. } if *player == me));
+        if hurt || stomped {
             return None;
         }
         let p = g.player(me)?;
@@ -250,11 +382,12 @@ impl Brain for Runner {
     fn progress(&self) -> String {
         let p = self.progress();
         format!(
-            "waypoint {}/{}, {} plans, {} respawns",
+            "waypoint {}/{}, {} plans, {} respawns, {} recoveries",
             p.waypoint,
             self.route.len(),
             p.plans,
-            p.respawns
+            p.respawns,
+            p.recoveries
         )
     }
 
@@ -277,9 +410,19 @@ impl Brain for Runner {
         if let Some(b) = self.plan.pop_front() {
             return b;
         }
+        if self.next < self.route.len() {
+            self.watch(self.next, &p);
+        }
         while self.next < self.route.len() && self.reached(self.next, &p) {
             self.next += 1;
             self.cooldown = 0;
+            self.recovering = false;
+        }
+        if self.next < self.route.len() {
+            let fell = !self.recovering && self.below_route(self.next, &p);
+            if fell || (self.stall >= STALL_TICKS && p.grounded) {
+                self.recover(&p);
+            }
         }
         // The goal is the last waypoint: past it, keep walking to the goal.
         let i = self.next.min(self.route.len().saturating_sub(1));
@@ -332,7 +475,37 @@ impl Brain for Runner {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ledge_shared::level::{default_level, default_route};
+    use ledge_shared::level::{default_level, default_route, EntityKind, Level};
+
+    const PX: i32 = UNITS_PER_PX;
+    /// The walker trench of the default level: x from col 36 to col 44,
+    /// floor at the top of row 27, route height (ground) at row 26.
+    const TRENCH: (i32, i32) = (36 * 16 * PX, 44 * 16 * PX);
+    const TRENCH_FLOOR: i32 = 27 * 16 * PX;
+
+    /// Plays `runner` alone on `game` for at most `ticks`; the tick it won.
+    fn play(game: &mut Game, me: PlayerId, runner: &mut Runner, ticks: u32) -> Option<u64> {
+        for _ in 0..ticks {
+            let b = runner.buttons(game, me);
+            if game.step(&[(me, b)]).contains(&GameEvent::Won(me)) {
+                return Some(game.tick());
+            }
+        }
+        None
+    }
+
+    /// The default level without the walker in the trench (as when another
+    /// player stomped it).
+    fn level_without_trench_walker() -> Level {
+        let mut level = default_level();
+        let before = level.entities.len();
+        level.entities.retain(|e| {
+            !(matches!(e.kind, EntityKind::Walker { .. })
+                && (TRENCH.0..TRENCH.1).contains(&e.pos.x))
+        });
+        assert_eq!(level.entities.len(), before - 1, "one walker in the trench");
+        level
+    }
 
     #[test]
     fn a_runner_reaches_the_goal_of_the_default_level_offline() {
@@ -341,28 +514,138 @@ mod tests {
         let me = PlayerId(1);
         game.add_player(me).unwrap();
         let mut runner = Runner::new(default_route());
-        let start = std::time::Instant::now();
-        let mut won_at = None;
-        for _ in 0..60 * 60 {
-            let b = runner.buttons(&game, me);
-            let events = game.step(&[(me, b)]).to_vec();
-            if events.contains(&GameEvent::Won(me)) {
-                won_at = Some(game.tick());
-                break;
-            }
-        }
+        let won_at = play(&mut game, me, &mut runner, 60 * 60);
         let p = game.player(me).unwrap();
         eprintln!(
-            "won at {won_at:?}, {:?}, at ({}, {}) px, {:?}",
+            "won at {won_at:?}, {:?}, at ({}, {}) px",
             runner.progress(),
-            p.pos.x / 256,
-            p.pos.y / 256,
-            start.elapsed()
+            p.pos.x / PX,
+            p.pos.y / PX,
         );
         assert!(
             won_at.is_some(),
             "stuck before waypoint {:?}",
             runner.target()
         );
+        assert_eq!(runner.progress().recoveries, 0, "it never left its route");
+    }
+
+    #[test]
+    fn a_runner_in_the_walker_trench_climbs_out_and_reaches_the_goal() {
+        let route = default_route();
+        // The waypoint on the plateau beyond the trench, and the one on the
+        // ground before the trench.
+        let plateau = route
+            .iter()
+            .position(|w| w.foot.x > TRENCH.1 && w.foot.y < TRENCH_FLOOR - 64 * PX)
+            .expect("a waypoint on the plateau");
+        let low_side = route
+            .iter()
+            .rposition(|w| w.foot.x < TRENCH.0)
+            .expect("a waypoint before the trench");
+        let mut game = Game::from_level(&level_without_trench_walker()).unwrap();
+        let me = PlayerId(1);
+        game.add_player(me).unwrap();
+        // Up to the low side of the trench, then right into it and against
+        // its high wall: where runners got stuck, jumping at the wall.
+        let mut runner = Runner::new(route.clone());
+        let mut ticks = 0;
+        while runner.progress().waypoint <= low_side {
+            let b = runner.buttons(&game, me);
+            game.step(&[(me, b)]);
+            ticks += 1;
+            assert!(
+                ticks < 60 * 60,
+                "reaches the trench: {:?}",
+                runner.progress()
+            );
+        }
+        let at_wall = |p: &PlayerView| p.grounded && p.sides.contains(Sides::RIGHT);
+        while !game.player(me).is_some_and(|p| at_wall(&p)) {
+            game.step(&[(me, Buttons(Buttons::RIGHT))]);
+            ticks += 1;
+            assert!(ticks < 60 * 60, "walks to the wall");
+        }
+        let p = game.player(me).unwrap();
+        assert_eq!(foot(&p).1, TRENCH_FLOOR, "in the trench");
+        assert!(foot(&p).0 > TRENCH.1 - 16 * PX, "at its high wall");
+        // A runner that was heading for the plateau (its plan failed).
+        let mut runner = Runner::new(route.clone());
+        runner.next = plateau;
+        let won_at = play(&mut game, me, &mut runner, 60 * 60);
+        let progress = runner.progress();
+        eprintln!("won at {won_at:?}, {progress:?}");
+        assert!(won_at.is_some(), "stuck: {progress:?}");
+        assert!(progress.recoveries >= 1, "it noticed: {progress:?}");
+        assert_eq!(progress.respawns, 0, "it climbed out: {progress:?}");
+    }
+
+    #[test]
+    fn a_runner_stuck_under_an_unreachable_waypoint_steps_back_then_gives_it_up() {
+        // A waypoint on the bonus shelf, 16 tiles above the ground: no jump
+        // gets there. The runner stalls under it, notices, heads back for a
+        // running start, stalls again, and after MAX_RETRIES recoveries
+        // gives that waypoint up and still reaches the goal.
+        let mut route = default_route();
+        let shelf = Waypoint {
+            foot: glam::IVec2::new(10 * 16 * PX, 10 * 16 * PX),
+            action: RouteAction::Jump,
+        };
+        route.insert(2, shelf);
+        let mut game = Game::from_level(&default_level()).unwrap();
+        let me = PlayerId(1);
+        game.add_player(me).unwrap();
+        let mut runner = Runner::new(route);
+        let mut went_back = false;
+        let mut won_at = None;
+        for _ in 0..60 * 60 {
+            let b = runner.buttons(&game, me);
+            went_back |= runner.recovering() && runner.next == 1;
+            if game.step(&[(me, b)]).contains(&GameEvent::Won(me)) {
+                won_at = Some(game.tick());
+                break;
+            }
+        }
+        let progress = runner.progress();
+        eprintln!("won at {won_at:?}, {progress:?}");
+        assert!(went_back, "it headed back to the waypoint before");
+        assert_eq!(
+            progress.recoveries,
+            u64::from(MAX_RETRIES) + 1,
+            "it gave the shelf up after {MAX_RETRIES} tries: {progress:?}"
+        );
+        let won_at = won_at.expect("it reached the goal");
+        assert!(
+            won_at > u64::from(STALL_TICKS * (MAX_RETRIES + 1)),
+            "it stalled {} times first",
+            MAX_RETRIES + 1
+        );
+    }
+
+    #[test]
+    fn plans_never_count_on_stomping_a_walker() {
+        // The runner crosses the whole level, the trench walker included,
+        // without ever bouncing off a walker.
+        let level = default_level();
+        let mut game = Game::from_level(&level).unwrap();
+        let me = PlayerId(1);
+        game.add_player(me).unwrap();
+        let mut runner = Runner::new(default_route());
+        let mut stomps = 0;
+        let mut won = false;
+        for _ in 0..60 * 60 {
+            let b = runner.buttons(&game, me);
+            let events = game.step(&[(me, b)]);
+            stomps += events
+                .iter()
+                .filter(|e| matches!(e, GameEvent::Stomped { player, .. } if *player == me))
+                .count();
+            if events.contains(&GameEvent::Won(me)) {
+                won = true;
+                break;
+            }
+        }
+        assert!(won, "{:?}", runner.progress());
+        assert_eq!(stomps, 0);
     }
 }
