@@ -162,7 +162,7 @@ impl Tilemap {
     /// The collision faces of tile `(c, r)`: its full faces not hidden by
     /// the neighbour's full face on the same side.
     #[inline]
-    fn exposed(&self, c: i64, r: i64, kind: Tile) -> u8 {
+    pub(super) fn exposed(&self, c: i64, r: i64, kind: Tile) -> u8 {
         let mut f = kind.full_faces();
         if f & TOP != 0 && self.at(c, r - 1).full_faces() & BOTTOM != 0 {
             f &= !TOP;

@@ -3,7 +3,8 @@
 //!
 //! * [`Tile`]: empty, solid, one-way, [`Slope`], hazard (one byte each);
 //! * [`Tilemap`]: the grid placed in the world (`grid.rs`), box contacts
-//!   (`contacts.rs`), the floor under a foot (`ground.rs`).
+//!   (`contacts.rs`), contacts of every other shape kind (`shapes.rs`), the
+//!   floor under a foot (`ground.rs`).
 //!
 //! Coordinates are integer units (y grows down, up is `-y`); tile `(c, r)`
 //! covers `origin + [c, c + 1) * T` by `origin + [r, r + 1) * T`. Every answer
@@ -57,6 +58,21 @@
 //! * **Hazard.** Never pushes; an overlapped hazard is reported in the same
 //!   output as a trigger contact with zero MTV ([`TileContact::is_trigger`]).
 //!
+//! # Other shapes ([`Tilemap::shape_contacts`])
+//! Circles, segments, points, oriented boxes and polygons are tested
+//! exactly against each overlapped tile's region ([`Tilemap::tile_region`]:
+//! a solid tile's box, a slope's polygon under its surface line, a one-way
+//! tile's top segment) with the pair contact functions. Culling: a solid
+//! tile's push with a part through a covered face is dropped when a slope's
+//! full side covers it (the slope holds the shape), else replaced by the
+//! shortest push straight out through an exposed face; a slope's push
+//! through its covered bottom or high side (or level through a covered low
+//! side) is dropped. One-way tiles push a shape that was on or above the
+//! line at the start of the tick, moving down and not dropping through;
+//! hazards give triggers. No foot rule: a shape rests on a slope along the
+//! surface normal. Known limit: a level segment (or a point) lying exactly on
+//! a tile line only touches the tiles on both sides and can slip along it.
+//!
 //! Slope surfaces: see [`Slope::height`] (`x/2` is `floor(x/2)`; ramps are
 //! continuous). Known limit: the rising-right surfaces top out at
 //! `h(T - 1) = T - 1`, one unit below the next tile's top; stepping onto a
@@ -67,11 +83,13 @@ mod contacts;
 mod error;
 mod grid;
 mod ground;
+mod shapes;
 mod slope;
 mod tile;
 
 pub use contacts::{ContactFlags, TileContact};
 pub use error::TilemapError;
 pub use grid::Tilemap;
+pub use shapes::{TileRegion, TileShape};
 pub use slope::Slope;
 pub use tile::Tile;

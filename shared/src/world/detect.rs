@@ -28,16 +28,18 @@
 //! shape kind (of the lower id for equal kinds), exactly as the brute-force
 //! loops orient them, so restitution sees identical input.
 //!
-//! Then [`detect_tiles`] asks the world's tilemap
-//! ([`Tilemap::box_contacts`]) about every solid box collider of an enabled
-//! dynamic body: tile contacts are records against one static end,
-//! [`BodyId::TILEMAP`] (no per-tile collider exists), appended in collider
-//! order.
+//! Then [`detect_tiles`] asks the world's tilemap about every solid
+//! collider of an enabled dynamic body: boxes through
+//! [`Tilemap::box_contacts`], other kinds through
+//! [`Tilemap::shape_contacts`]. Tile contacts are records against one
+//! static end, [`BodyId::TILEMAP`] (no per-tile collider exists), appended
+//! in collider order; the end's `index` says which query made the record
+//! ([`tile_mtv`] re-checks through it).
 
 use crate::broad::{Bounds, BroadPhase};
 use crate::query::{Contact, Proximity};
-use crate::shape::{Aabb, Circle, ConvexPolygon, Obb, Point, Segment};
-use crate::tilemap::{ContactFlags, Tile, TileContact, Tilemap};
+use crate::shape::{Aabb, Circle, ConvexPolygon, Obb, Point, Segment, ShapeKind};
+use crate::tilemap::{ContactFlags, Tile, TileContact, TileShape, Tilemap};
 use glam::IVec2;
 
 use super::body::{Body, BodyId, BodyKind};
@@ -573,9 +575,20 @@ pub(crate) fn redetect(
     // all asked again).
     if let Some(map) = tiles {
         st.fresh.clear();
-        for &i in &layout.tile_boxes {
-            let c = &cols.aabbs.items[i as usize];
-            if moved[c.body as usize] {
+        // Boxes and other shapes, merged by collider id.
+        let shapes = &layout.tile_shapes;
+        let mut j = 0;
+        for &i in layout.tile_boxes.iter().chain(core::iter::once(&u32::MAX)) {
+            let c = cols.aabbs.items.get(i as usize);
+            let id = c.map_or(u32::MAX, |c| c.id);
+            while j < shapes.len() && shapes[j].0 < id {
+                let sh = shapes[j];
+                if moved[slots[sh.0 as usize].body as usize] {
+                    tile_shape_of(map, cols, sh, bodies, scratch, &mut st.fresh);
+                }
+                j += 1;
+            }
+            if let Some(c) = c.filter(|c| moved[c.body as usize]) {
                 tile_box(map, i as usize, c, bodies, scratch, &mut st.fresh);
             }
         }
@@ -677,34 +690,283 @@ pub(crate) fn tile_flags(b: &Body) -> ContactFlags {
     }
 }
 
-/// Appends to `out` one record per tile contact of every solid box collider
+/// Appends to `out` one record per tile contact of every solid collider
 /// (mask with [`TILEMAP_LAYER`]) of an enabled dynamic body, in collider
 /// order then row-major tile order: a solid record for a tile that pushes, a
-/// trigger record (zero MTV) for an overlapped hazard. `scratch` is reused.
+/// trigger record (zero MTV) for an overlapped hazard. Boxes ask
+/// [`Tilemap::box_contacts`] (the platformer rules), other shapes
+/// [`Tilemap::shape_contacts`] (exact contacts with each tile's region).
+/// `scratch` is reused.
 ///
-/// With `boxes` (the specialised pipeline's list of those colliders' indices,
-/// in set order) only they are visited; without, every box is checked.
+/// With `layout` (the specialised pipeline's lists of those colliders: the
+/// boxes' set indices and, separately, the other shapes) only they are
+/// visited; without, every collider is checked.
 pub(crate) fn detect_tiles(
     map: &Tilemap,
     cols: &Colliders,
     bodies: &[Body],
-    boxes: Option<&[u32]>,
+    layout: Option<&Layout>,
     scratch: &mut Vec<TileContact>,
     out: &mut Vec<ContactRecord>,
 ) {
     let set = &cols.aabbs.items;
-    match boxes {
-        Some(list) => {
-            for &i in list {
-                tile_box(map, i as usize, &set[i as usize], bodies, scratch, out);
+    match layout {
+        Some(l) => {
+            let shapes = &l.tile_shapes;
+            let mut j = 0;
+            for &i in &l.tile_boxes {
+                let c = &set[i as usize];
+                while j < shapes.len() && shapes[j].0 < c.id {
+                    tile_shape_of(map, cols, shapes[j], bodies, scratch, out);
+                    j += 1;
+                }
+                tile_box(map, i as usize, c, bodies, scratch, out);
+            }
+            for &sh in &shapes[j..] {
+                tile_shape_of(map, cols, sh, bodies, scratch, out);
             }
         }
         None => {
+            let mut cur = ShapeCursor::default();
+            let mut next = cur.next(cols);
             for (i, c) in set.iter().enumerate() {
-                if c.dynamic && c.solid && c.mask & TILEMAP_LAYER != 0 {
-                    tile_box(map, i, c, bodies, scratch, out);
+                if !(c.dynamic && c.solid && c.mask & TILEMAP_LAYER != 0) {
+                    continue;
                 }
+                while let Some(sh) = next.filter(|sh| sh.0 < c.id) {
+                    tile_shape_of(map, cols, sh, bodies, scratch, out);
+                    next = cur.next(cols);
+                }
+                tile_box(map, i, c, bodies, scratch, out);
             }
+            while let Some(sh) = next {
+                tile_shape_of(map, cols, sh, bodies, scratch, out);
+                next = cur.next(cols);
+            }
+        }
+    }
+}
+
+/// A non-box collider the tilemap is asked about: `(collider id, kind,
+/// index in its kind's set)`.
+pub(crate) type TileShapeRef = (u32, ShapeKind, u32);
+
+/// Whether a collider is asked about tiles: solid, of a dynamic body, mask
+/// with [`TILEMAP_LAYER`].
+#[inline]
+pub(crate) fn touches_tiles<S>(c: &ColliderData<S>) -> bool {
+    c.dynamic && c.solid && c.mask & TILEMAP_LAYER != 0
+}
+
+/// Walks the non-box colliders that touch tiles in collider id order (a
+/// merge of the five sets, each in id order): the brute-force form of
+/// [`Layout::tile_shapes`].
+#[derive(Default)]
+pub(crate) struct ShapeCursor {
+    at: [usize; 5],
+}
+
+impl ShapeCursor {
+    /// The next such collider, if any.
+    pub(crate) fn next(&mut self, cols: &Colliders) -> Option<TileShapeRef> {
+        fn head<S: Stored>(cols: &Colliders, at: &mut usize) -> Option<u32> {
+            let items = &S::set(cols).items;
+            while *at < items.len() && !touches_tiles(&items[*at]) {
+                *at += 1;
+            }
+            items.get(*at).map(|c| c.id)
+        }
+        let heads = [
+            (head::<Point>(cols, &mut self.at[0]), ShapeKind::Point),
+            (head::<Segment>(cols, &mut self.at[1]), ShapeKind::Segment),
+            (head::<Circle>(cols, &mut self.at[2]), ShapeKind::Circle),
+            (head::<Obb>(cols, &mut self.at[3]), ShapeKind::Obb),
+            (
+                head::<ConvexPolygon>(cols, &mut self.at[4]),
+                ShapeKind::Polygon,
+            ),
+        ];
+        let (k, (id, kind)) = heads
+            .iter()
+            .enumerate()
+            .filter_map(|(k, &(id, kind))| id.map(|id| (k, (id, kind))))
+            .min_by_key(|&(_, (id, _))| id)?;
+        let index = self.at[k] as u32;
+        self.at[k] += 1;
+        Some((id, kind, index))
+    }
+}
+
+/// The tile contacts of non-box collider `sh`.
+#[inline]
+pub(crate) fn tile_shape_of(
+    map: &Tilemap,
+    cols: &Colliders,
+    sh: TileShapeRef,
+    bodies: &[Body],
+    scratch: &mut Vec<TileContact>,
+    out: &mut Vec<ContactRecord>,
+) {
+    fn one<S: Stored + TileShape>(
+        map: &Tilemap,
+        cols: &Colliders,
+        i: u32,
+        bodies: &[Body],
+        scratch: &mut Vec<TileContact>,
+        out: &mut Vec<ContactRecord>,
+    ) {
+        let c = &S::set(cols).items[i as usize];
+        tile_shape(map, i as usize, c, bodies, scratch, out);
+    }
+    let (_, kind, i) = sh;
+    match kind {
+        ShapeKind::Point => one::<Point>(map, cols, i, bodies, scratch, out),
+        ShapeKind::Segment => one::<Segment>(map, cols, i, bodies, scratch, out),
+        ShapeKind::Circle => one::<Circle>(map, cols, i, bodies, scratch, out),
+        ShapeKind::Aabb => tile_box(
+            map,
+            i as usize,
+            &cols.aabbs.items[i as usize],
+            bodies,
+            scratch,
+            out,
+        ),
+        ShapeKind::Obb => one::<Obb>(map, cols, i, bodies, scratch, out),
+        ShapeKind::Polygon => one::<ConvexPolygon>(map, cols, i, bodies, scratch, out),
+    }
+}
+
+/// [`End::index`] of the tilemap end of a tile record: which tile query
+/// made it (0: a box, [`Tilemap::box_contacts`]; `1 + kind`: another shape
+/// kind, [`Tilemap::shape_contacts`]), so a re-check asks the same one.
+#[inline]
+fn tile_query_code(kind: ShapeKind) -> u32 {
+    if kind == ShapeKind::Aabb {
+        0
+    } else {
+        1 + kind as u32
+    }
+}
+
+/// The tile contact buffer's capacity once a non-box shape is asked.
+const SHAPE_SCRATCH: usize = 64;
+
+/// The tile contacts of non-box collider `c` (index `i` in its set).
+fn tile_shape<S: Stored + TileShape>(
+    map: &Tilemap,
+    i: usize,
+    c: &ColliderData<S>,
+    bodies: &[Body],
+    scratch: &mut Vec<TileContact>,
+    out: &mut Vec<ContactRecord>,
+) {
+    let t = map.tile_size() as i64;
+    let origin = map.origin().as_i64vec2();
+    let b = &bodies[c.body as usize];
+    if !b.enabled {
+        return;
+    }
+    scratch.clear();
+    // A shape may overlap more tiles than any box so far: grow once to a
+    // size that covers shapes a few tiles wide, not tick by tick.
+    if scratch.capacity() < SHAPE_SCRATCH {
+        scratch.reserve(SHAPE_SCRATCH);
+    }
+    map.shape_contacts(
+        &c.shape,
+        b.pos + c.offset,
+        b.pos - b.start,
+        tile_flags(b),
+        scratch,
+    );
+    let centre = b.pos + (c.lo + c.hi) / 2;
+    let (lo, hi) = ((b.pos + c.lo).as_i64vec2(), (b.pos + c.hi).as_i64vec2());
+    for tc in scratch.iter() {
+        if !tile_push_ok(map, tc.tile, tc.kind, centre, tc.mtv) {
+            continue;
+        }
+        let tlo = origin + tc.tile.as_i64vec2() * t;
+        let thi = tlo + t;
+        let ix = (hi.x.min(thi.x) - lo.x.max(tlo.x)).max(0) as u64;
+        let iy = (hi.y.min(thi.y) - lo.y.max(tlo.y)).max(0) as u64;
+        let solid = tc.kind != Tile::Hazard;
+        out.push(ContactRecord {
+            a: end_of(i, c),
+            b: End {
+                body: BodyId::TILEMAP.0,
+                collider: BodyId::TILEMAP.0,
+                index: tile_query_code(S::KIND),
+                tag: TILEMAP_TAG,
+                one_way: None,
+                solid,
+            },
+            mtv: tc.mtv,
+            kind: if solid {
+                ContactKind::Solid
+            } else {
+                ContactKind::Trigger
+            },
+            pos_a: b.pos,
+            pos_b: IVec2::ZERO,
+            area: ix.saturating_mul(iy),
+            recheck: no_recheck,
+            tile: tc.tile,
+        });
+    }
+}
+
+/// The MTV of tile record `c` with its body `a` where it is now: the tile
+/// query that made the record, asked again about that tile
+/// ([`Tilemap::tile_contact`] or [`Tilemap::shape_tile_contact`]), through
+/// [`tile_push_ok`]. Restitution's re-check of a stale tile contact.
+#[inline]
+pub(crate) fn tile_mtv(
+    map: &Tilemap,
+    cols: &Colliders,
+    c: &ContactRecord,
+    a: &Body,
+) -> Option<IVec2> {
+    fn shape<S: Stored + TileShape>(
+        map: &Tilemap,
+        cols: &Colliders,
+        c: &ContactRecord,
+        a: &Body,
+    ) -> Option<IVec2> {
+        let d = &S::set(cols).items[c.a.index as usize];
+        let centre = a.pos + (d.lo + d.hi) / 2;
+        map.shape_tile_contact(
+            c.tile,
+            &d.shape,
+            a.pos + d.offset,
+            a.pos - a.start,
+            tile_flags(a),
+        )
+        .filter(|t| tile_push_ok(map, t.tile, t.kind, centre, t.mtv))
+        .map(|t| t.mtv)
+    }
+    const POINT: u32 = 1 + ShapeKind::Point as u32;
+    const SEGMENT: u32 = 1 + ShapeKind::Segment as u32;
+    const CIRCLE: u32 = 1 + ShapeKind::Circle as u32;
+    const OBB: u32 = 1 + ShapeKind::Obb as u32;
+    const POLYGON: u32 = 1 + ShapeKind::Polygon as u32;
+    match c.b.index {
+        POINT => shape::<Point>(map, cols, c, a),
+        SEGMENT => shape::<Segment>(map, cols, c, a),
+        CIRCLE => shape::<Circle>(map, cols, c, a),
+        OBB => shape::<Obb>(map, cols, c, a),
+        POLYGON => shape::<ConvexPolygon>(map, cols, c, a),
+        _ => {
+            let d = &cols.aabbs.items[c.a.index as usize];
+            let centre = a.pos + d.offset;
+            map.tile_contact(
+                c.tile,
+                centre,
+                d.shape.half(),
+                a.pos - a.start,
+                tile_flags(a),
+            )
+            .filter(|t| tile_push_ok(map, t.tile, t.kind, centre, t.mtv))
+            .map(|t| t.mtv)
         }
     }
 }

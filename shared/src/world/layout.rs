@@ -13,7 +13,7 @@ use glam::IVec2;
 use super::body::{Body, BodyKind};
 use super::collider::{Colliders, OneWay};
 use super::config::Pipeline;
-use super::detect::TILEMAP_LAYER;
+use super::detect::{TileShapeRef, TILEMAP_LAYER};
 
 /// What a scene uses: shape kinds, tilemap features, one-way colliders,
 /// triggers, moving platforms and riders. [`super::World::features`]
@@ -114,6 +114,10 @@ pub(crate) struct Layout {
     /// AABB-set indices of the boxes the tilemap is asked about (solid, of a
     /// dynamic body, mask with [`TILEMAP_LAYER`]), in set order.
     pub tile_boxes: Vec<u32>,
+    /// The other colliders the tilemap is asked about (same filters; any
+    /// kind but a box, [`Tilemap::shape_contacts`]), in collider id order:
+    /// empty in box-only scenes, which then pay nothing for them.
+    pub tile_shapes: Vec<TileShapeRef>,
     /// Detect through the broad phase's AABB fast path.
     pub aabb_fast: bool,
     /// Detect by testing moving colliders against all, no broad phase.
@@ -175,6 +179,17 @@ impl Layout {
                 self.tile_boxes.push(i as u32);
             }
         }
+        self.tile_shapes.clear();
+        for (id, s) in slots.iter().enumerate() {
+            if s.index != GONE
+                && s.kind != ShapeKind::Aabb
+                && s.solid
+                && s.dynamic
+                && s.mask & TILEMAP_LAYER != 0
+            {
+                self.tile_shapes.push((id as u32, s.kind, s.index));
+            }
+        }
         self.features = f;
         let special = pipeline == Pipeline::Specialised;
         self.aabb_fast = special && f.aabb_only();
@@ -198,7 +213,8 @@ impl Layout {
         let live = self.moving.len() + self.statics.len();
         self.small = special && self.moving.len().saturating_mul(live) <= SMALL_PAIRS;
         self.carry = !special || (!self.riders.is_empty() && !self.carriers.is_empty());
-        self.tiles = map.is_some() && (!special || (f.tilemap && !self.tile_boxes.is_empty()));
+        let askers = !self.tile_boxes.is_empty() || !self.tile_shapes.is_empty();
+        self.tiles = map.is_some() && (!special || (f.tilemap && askers));
         self.triggers = !special || f.triggers || f.hazard_tiles;
         self.incremental = special && !self.small;
     }

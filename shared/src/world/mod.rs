@@ -10,8 +10,10 @@
 //! ```
 //!
 //! * **Tilemap** ([`World::set_tilemap`]): detection asks the tilemap about
-//!   every solid box collider of an enabled dynamic body
-//!   ([`crate::tilemap::Tilemap::box_contacts`]); each tile contact becomes a
+//!   every solid collider of an enabled dynamic body, boxes by the tile
+//!   rules ([`crate::tilemap::Tilemap::box_contacts`]), other shapes against
+//!   each tile's own region ([`crate::tilemap::Tilemap::shape_contacts`]);
+//!   each tile contact becomes a
 //!   record against one static end, [`BodyId::TILEMAP`] (solid, or trigger
 //!   for a hazard tile), re-checked through
 //!   [`crate::tilemap::Tilemap::tile_contact`]. Restitution treats it like any
@@ -55,7 +57,7 @@
 //!   only what they imply: direct pair tests without the broad phase for a
 //!   tiny scene, the AABB fast path for a scene of boxes, no rider search
 //!   without riders and kinematic boxes (and then only riders against
-//!   platforms), tile queries only for the boxes that can touch tiles, no
+//!   platforms), tile queries only for the colliders that can touch tiles, no
 //!   trigger logging without triggers, and re-detection after a
 //!   restitution pass only around the bodies the pass moved. Same results,
 //!   bit for bit, as [`Pipeline::General`].
@@ -486,6 +488,8 @@ impl World {
         let want = (self.dynamic_colliders * self.colliders.len()).min(RESERVE_CAP);
         self.contacts
             .reserve(want.saturating_sub(self.contacts.len()));
+        let logged = self.logs.triggers.len();
+        self.logs.triggers.reserve(want.saturating_sub(logged));
         Ok(ColliderId(id))
     }
 
@@ -824,8 +828,7 @@ impl World {
             return;
         }
         if let Some(map) = &self.tilemap {
-            let boxes = (self.config.pipeline == Pipeline::Specialised)
-                .then_some(self.layout.tile_boxes.as_slice());
+            let boxes = (self.config.pipeline == Pipeline::Specialised).then_some(&self.layout);
             detect::detect_tiles(
                 map,
                 &self.colliders,

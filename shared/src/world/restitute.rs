@@ -69,7 +69,6 @@ use glam::{I64Vec2, IVec2};
 use super::body::{Body, BodyKind, Sides};
 use super::collider::{Colliders, OneWay};
 use super::contact::{ContactKind, ContactRecord, End, OrderKey};
-use super::detect::{tile_flags, tile_push_ok};
 use super::event::{Hit, TriggerHit};
 use super::layout::{Slot, GONE};
 
@@ -385,19 +384,7 @@ pub(crate) fn current_mtv(c: &ContactRecord, bodies: &[Body], scene: Scene<'_>) 
         if a.pos == c.pos_a {
             return Some(c.mtv);
         }
-        let d = &scene.cols.aabbs.items[c.a.index as usize];
-        let map = scene.tiles?;
-        let centre = a.pos + d.offset;
-        return map
-            .tile_contact(
-                c.tile,
-                centre,
-                d.shape.half(),
-                a.pos - a.start,
-                tile_flags(a),
-            )
-            .filter(|t| tile_push_ok(map, t.tile, t.kind, centre, t.mtv))
-            .map(|t| t.mtv);
+        return super::detect::tile_mtv(scene.tiles?, scene.cols, c, a);
     }
     let pa = a.pos;
     let pb = bodies[c.b.body as usize].pos;

@@ -5,8 +5,8 @@
 //!
 //! Which bodies are swept is [`SweepMode`]'s choice (marked ones, or also
 //! fast ones); what a hit does is the body's [`SweepResponse`]. The exact
-//! sweeps are [`crate::query::sweep`]'s; this module finds the candidates
-//! and applies the outcome:
+//! sweeps are [`crate::query::sweep`](mod@crate::query::sweep)'s; this
+//! module finds the candidates and applies the outcome:
 //!
 //! * **Candidates.** Static colliders come from an index of their own (a
 //!   [`BroadPhase`] static set, built at the first sweep after the statics
@@ -17,12 +17,14 @@
 //!   lies before the next piece. Kinematic colliders (few) are all tested,
 //!   at their positions after this substep's move. Candidates must be
 //!   solid, on another enabled body, and agree on layers both ways.
-//! * **Tilemap.** A box collider is swept with [`sweep_tiles`] (the tile
-//!   rules: culled edges, one-way tiles from above, slopes); any other
-//!   collider by its bounding box. The discrete pass only ever tests box
-//!   colliders against tiles, so a swept circle, segment or polygon stops
-//!   at a tile wall (by its box) where a slow one would pass: the sweep is
-//!   the safe side of that limit.
+//! * **Tilemap.** A box collider is swept with [`sweep_tiles`] (the box
+//!   rules: culled edges, one-way tiles from above, the foot on slopes);
+//!   any other collider (circle, segment, point, oriented box, polygon)
+//!   exactly with [`sweep_shape_tiles`]: the pair sweep against each tile's
+//!   region near the path (a solid tile's box, a slope's polygon, a one-way
+//!   tile's top line, only from above while moving down), hits through
+//!   culled internal faces ignored, the same rules as the discrete pass's
+//!   [`Tilemap::shape_contacts`].
 //! * **One-way colliders** stop a body only when the hit normal has a
 //!   positive component along the collider's normal (the body came from
 //!   its solid side) and the body is not dropping through.
@@ -45,9 +47,11 @@
 
 use crate::broad::{Bounds, BroadPhase};
 use crate::query::ray::Toi;
-use crate::query::sweep::{reflect, slide, sweep_tiles, Sweep, SweepHit};
+use crate::query::sweep::{
+    reflect, slide, sweep_shape_tiles, sweep_tiles, Sweep, SweepHit, TileHit,
+};
 use crate::shape::{Aabb, Circle, ConvexPolygon, Obb, Point, Segment, ShapeKind};
-use crate::tilemap::Tilemap;
+use crate::tilemap::{ContactFlags, Tilemap};
 use glam::{I64Vec2, IVec2};
 
 use super::body::{Body, BodyId, BodyKind, Sides, SweepResponse};
@@ -404,7 +408,9 @@ fn against(
     })
 }
 
-/// The tile hit of collider `a` (a box, else its bounding box).
+/// The tile hit of collider `a`: a box by the box rules ([`sweep_tiles`]),
+/// any other shape exactly against each tile's region
+/// ([`sweep_shape_tiles`]).
 fn tiles(
     map: &Tilemap,
     cols: &Colliders,
@@ -414,18 +420,33 @@ fn tiles(
     offset: IVec2,
     d: I64Vec2,
 ) -> Option<Best> {
-    let (shape, centre) = if a.kind == ShapeKind::Aabb {
-        (cols.aabbs.items[a.index as usize].shape, offset)
-    } else {
-        // The bounding box around the body, centred on a whole unit.
-        let c = a.lo + (a.hi - a.lo) / 2;
-        let half = (a.hi - c).max(IVec2::ONE);
-        (Aabb::new(half).ok()?, c)
-    };
-    let th = sweep_tiles(map, &shape, body.pos + centre, d, tile_flags(body))?;
+    fn shaped<S>(
+        map: &Tilemap,
+        cols: &Colliders,
+        i: u32,
+        start: IVec2,
+        d: I64Vec2,
+        f: ContactFlags,
+    ) -> Option<TileHit>
+    where
+        S: Stored + Sweep<Aabb> + Sweep<ConvexPolygon> + Sweep<Segment>,
+    {
+        sweep_shape_tiles(map, &S::set(cols).items[i as usize].shape, start, d, f)
+    }
+    let start = body.pos + offset;
+    let f = tile_flags(body);
+    let i = a.index;
+    let th = match a.kind {
+        ShapeKind::Aabb => sweep_tiles(map, &cols.aabbs.items[i as usize].shape, start, d, f),
+        ShapeKind::Point => shaped::<Point>(map, cols, i, start, d, f),
+        ShapeKind::Segment => shaped::<Segment>(map, cols, i, start, d, f),
+        ShapeKind::Circle => shaped::<Circle>(map, cols, i, start, d, f),
+        ShapeKind::Obb => shaped::<Obb>(map, cols, i, start, d, f),
+        ShapeKind::Polygon => shaped::<ConvexPolygon>(map, cols, i, start, d, f),
+    }?;
     Some(Best {
         hit: th.hit,
-        offset: centre,
+        offset,
         collider: cid,
         other_body: BodyId::TILEMAP.0,
         other_collider: ColliderId::TILEMAP.0,

@@ -106,7 +106,7 @@ mod poly;
 mod round;
 mod tilemap;
 
-pub use tilemap::{sweep_tiles, TileHit};
+pub use tilemap::{sweep_shape_tiles, sweep_tiles, TileHit};
 
 use crate::fixed::div_away;
 use crate::query::ray::Toi;

@@ -69,8 +69,9 @@
 use super::{
     better_normal, check_d, check_end, offset, primitive, round_outer, toi_floor, Sweep, SweepHit,
 };
-use crate::shape::Aabb;
-use crate::tilemap::{ContactFlags, Slope, Tile, Tilemap};
+use crate::query::ray::Toi;
+use crate::shape::{Aabb, ConvexPolygon, Segment, Shape};
+use crate::tilemap::{ContactFlags, Slope, Tile, TileRegion, Tilemap};
 use core::cmp::Ordering;
 use glam::{I64Vec2, IVec2};
 
@@ -132,6 +133,100 @@ pub fn sweep_tiles(
         tile: IVec2::new(best.tile.0 as i32, best.tile.1 as i32),
         kind: best.kind,
     })
+}
+
+/// Largest side, in tiles, of one piece of the path [`sweep_shape_tiles`]
+/// tests at a time.
+const PIECE_TILES: i64 = 1;
+
+/// The first tile that stops `shape` (any kind; its origin at `start`)
+/// moving by `d`: the exact sweep ([`Sweep`]) against the region of each
+/// tile near the path ([`Tilemap::tile_region`]: a solid tile's box, a
+/// slope's polygon, a one-way tile's top line), keeping a hit only when its
+/// normal leaves through exposed faces (the same internal edge culling as
+/// [`Tilemap::shape_contacts`]). One-way tiles stop only a shape moving
+/// down that started with its bottom on or above their line, and not
+/// dropping through; hazards never. Tiles the shape starts inside are left
+/// to the contact pass.
+///
+/// The path is cut into pieces about a tile long along its longer axis,
+/// visited in order; each piece tests the tiles its swept bounding box
+/// covers (row-major), and the walk stops once the best hit lies before the
+/// next piece: the cost follows the tiles crossed, not the map's size. The
+/// earliest hit wins; ties go to the smaller `(row, column)`.
+///
+/// For boxes [`sweep_tiles`] applies the box rules (the foot on slopes).
+pub fn sweep_shape_tiles<S>(
+    map: &Tilemap,
+    shape: &S,
+    start: IVec2,
+    d: I64Vec2,
+    flags: ContactFlags,
+) -> Option<TileHit>
+where
+    S: Shape + Sweep<Aabb> + Sweep<ConvexPolygon> + Sweep<Segment>,
+{
+    check_d(d);
+    check_end(start, d);
+    let t = map.tile_size() as i64;
+    let (lo, hi) = shape.local_bounds();
+    let (lo, hi) = (lo.as_i64vec2(), hi.as_i64vec2());
+    let s0 = start.as_i64vec2();
+    let long = d.x.abs().max(d.y.abs());
+    let m = (long / (t * PIECE_TILES) + 1).max(1);
+    let bottom0 = s0.y + hi.y;
+    let mut best: Option<TileHit> = None;
+    let (w, h) = (map.width() as i64, map.height() as i64);
+    for j in 0..m {
+        if let Some(b) = &best {
+            // Hits in later pieces come after `j / m`.
+            if b.hit.toi < Toi::new(j as u64, m as u64).expect("j < m") {
+                break;
+            }
+        }
+        let p0 = s0 + d * j / m;
+        let p1 = s0 + d * (j + 1) / m;
+        let (qlo, qhi) = (p0.min(p1) + lo, p0.max(p1) + hi);
+        let c0 = map.col_of(qlo.x - 1).max(0);
+        let c1 = map.col_of(qhi.x + 1).min(w - 1);
+        let r0 = map.row_of(qlo.y - 1).max(0);
+        let r1 = map.row_of(qhi.y + 1).min(h - 1);
+        for r in r0..=r1 {
+            for c in c0..=c1 {
+                let tile = IVec2::new(c as i32, r as i32);
+                let kind = map.tile(tile);
+                let hit = match (kind, map.tile_region(tile, kind)) {
+                    (Tile::Solid, Some(TileRegion::Square { shape: b, centre })) => {
+                        shape.sweep(start, d, &b, centre)
+                    }
+                    (Tile::Slope(_), Some(TileRegion::Slope { shape: p, centre })) => {
+                        shape.sweep(start, d, &p, centre)
+                    }
+                    (Tile::OneWay, Some(TileRegion::Top { shape: top, origin })) => {
+                        let tt = origin.y as i64;
+                        if flags.drop_through || d.y <= 0 || bottom0 > tt {
+                            continue;
+                        }
+                        shape
+                            .sweep(start, d, &top, origin)
+                            .filter(|h| h.normal.y < 0)
+                    }
+                    _ => continue,
+                };
+                let Some(hit) = hit else { continue };
+                if hit.started_inside() || !map.push_ok(tile, kind, hit.normal) {
+                    continue;
+                }
+                let earlier = best.as_ref().is_none_or(|b| {
+                    (hit.toi, r, c) < (b.hit.toi, b.tile.y as i64, b.tile.x as i64)
+                });
+                if earlier {
+                    best = Some(TileHit { hit, tile, kind });
+                }
+            }
+        }
+    }
+    best
 }
 
 /// A box against the tilemap with default flags (see [`sweep_tiles`]); the
