@@ -860,8 +860,6 @@ fn tile_shape<S: Stored + TileShape>(
     scratch: &mut Vec<TileContact>,
     out: &mut Vec<ContactRecord>,
 ) {
-    let t = map.tile_size() as i64;
-    let origin = map.origin().as_i64vec2();
     let b = &bodies[c.body as usize];
     if !b.enabled {
         return;
@@ -881,38 +879,17 @@ fn tile_shape<S: Stored + TileShape>(
     );
     let centre = b.pos + (c.lo + c.hi) / 2;
     let (lo, hi) = ((b.pos + c.lo).as_i64vec2(), (b.pos + c.hi).as_i64vec2());
-    for tc in scratch.iter() {
-        if !tile_push_ok(map, tc.tile, tc.kind, centre, tc.mtv) {
-            continue;
-        }
-        let tlo = origin + tc.tile.as_i64vec2() * t;
-        let thi = tlo + t;
-        let ix = (hi.x.min(thi.x) - lo.x.max(tlo.x)).max(0) as u64;
-        let iy = (hi.y.min(thi.y) - lo.y.max(tlo.y)).max(0) as u64;
-        let solid = tc.kind != Tile::Hazard;
-        out.push(ContactRecord {
-            a: end_of(i, c),
-            b: End {
-                body: BodyId::TILEMAP.0,
-                collider: BodyId::TILEMAP.0,
-                index: tile_query_code(S::KIND),
-                tag: TILEMAP_TAG,
-                one_way: None,
-                solid,
-            },
-            mtv: tc.mtv,
-            kind: if solid {
-                ContactKind::Solid
-            } else {
-                ContactKind::Trigger
-            },
-            pos_a: b.pos,
-            pos_b: IVec2::ZERO,
-            area: ix.saturating_mul(iy),
-            recheck: no_recheck,
-            tile: tc.tile,
-        });
-    }
+    let own = end_of(i, c);
+    push_tile_records(
+        map,
+        own,
+        tile_query_code(S::KIND),
+        b.pos,
+        centre,
+        (lo, hi),
+        scratch,
+        out,
+    );
 }
 
 /// The MTV of tile record `c` with its body `a` where it is now: the tile
@@ -981,8 +958,6 @@ fn tile_box(
     scratch: &mut Vec<TileContact>,
     out: &mut Vec<ContactRecord>,
 ) {
-    let t = map.tile_size() as i64;
-    let origin = map.origin().as_i64vec2();
     let b = &bodies[c.body as usize];
     if !b.enabled {
         return;
@@ -997,7 +972,29 @@ fn tile_box(
         scratch,
     );
     let (lo, hi) = ((b.pos + c.lo).as_i64vec2(), (b.pos + c.hi).as_i64vec2());
-    for tc in scratch.iter() {
+    let own = end_of(i, c);
+    push_tile_records(map, own, 0, b.pos, centre, (lo, hi), scratch, out);
+}
+
+/// Appends one record per tile contact in `found` of the collider whose end
+/// is `own` (body at `pos`, collider centre `centre`, bounds `lo..hi`),
+/// skipping pushes [`tile_push_ok`] refuses; `index` says which tile query
+/// made them (0: the box query), for the re-check.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn push_tile_records(
+    map: &Tilemap,
+    own: End,
+    index: u32,
+    pos: IVec2,
+    centre: IVec2,
+    (lo, hi): (glam::I64Vec2, glam::I64Vec2),
+    found: &[TileContact],
+    out: &mut Vec<ContactRecord>,
+) {
+    let t = map.tile_size() as i64;
+    let origin = map.origin().as_i64vec2();
+    for tc in found {
         if !tile_push_ok(map, tc.tile, tc.kind, centre, tc.mtv) {
             continue;
         }
@@ -1007,11 +1004,11 @@ fn tile_box(
         let iy = (hi.y.min(thi.y) - lo.y.max(tlo.y)).max(0) as u64;
         let solid = tc.kind != Tile::Hazard;
         out.push(ContactRecord {
-            a: end_of(i, c),
+            a: own,
             b: End {
                 body: BodyId::TILEMAP.0,
                 collider: BodyId::TILEMAP.0,
-                index: 0,
+                index,
                 tag: TILEMAP_TAG,
                 one_way: None,
                 solid,
@@ -1022,7 +1019,7 @@ fn tile_box(
             } else {
                 ContactKind::Trigger
             },
-            pos_a: b.pos,
+            pos_a: pos,
             pos_b: IVec2::ZERO,
             area: ix.saturating_mul(iy),
             recheck: no_recheck,
