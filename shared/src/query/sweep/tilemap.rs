@@ -402,24 +402,24 @@ impl<'a> Sweeper<'a> {
 
     /// Columns the closed box spans at `tau` (unclamped).
     fn col_span(&self, tau: Frac) -> (i64, i64) {
-        let (t, dx) = (self.t as i128, self.d.x as i128);
-        let lnum = self.l0 as i128 * tau.d + dx * tau.n - self.ox as i128 * tau.d;
-        let rnum = self.r0 as i128 * tau.d + dx * tau.n - self.ox as i128 * tau.d;
-        let den = t * tau.d;
-        // col_left(c) + T >= l  and  col_left(c) <= r.
-        let lo = -(-lnum).div_euclid(den) - 1;
-        let hi = rnum.div_euclid(den);
-        (lo as i64, hi as i64)
+        self.span(self.l0, self.r0, self.d.x, self.ox, tau)
     }
 
     /// Rows the closed box spans at `tau` (unclamped).
     fn row_span(&self, tau: Frac) -> (i64, i64) {
-        let (t, dy) = (self.t as i128, self.d.y as i128);
-        let tnum = self.t0 as i128 * tau.d + dy * tau.n - self.oy as i128 * tau.d;
-        let bnum = self.b0 as i128 * tau.d + dy * tau.n - self.oy as i128 * tau.d;
+        self.span(self.t0, self.b0, self.d.y, self.oy, tau)
+    }
+
+    /// Cells along one axis that the closed interval `lo0..=hi0`, moved by
+    /// `d * tau`, spans on a grid of cells `t` wide starting at `origin`:
+    /// the cells `k` with `origin + k t + t >= lo` and `origin + k t <= hi`.
+    fn span(&self, lo0: i64, hi0: i64, d: i64, origin: i64, tau: Frac) -> (i64, i64) {
+        let (t, d) = (self.t as i128, d as i128);
+        let lnum = lo0 as i128 * tau.d + d * tau.n - origin as i128 * tau.d;
+        let hnum = hi0 as i128 * tau.d + d * tau.n - origin as i128 * tau.d;
         let den = t * tau.d;
-        let lo = -(-tnum).div_euclid(den) - 1;
-        let hi = bnum.div_euclid(den);
+        let lo = -(-lnum).div_euclid(den) - 1;
+        let hi = hnum.div_euclid(den);
         (lo as i64, hi as i64)
     }
 
