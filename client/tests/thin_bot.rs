@@ -3,11 +3,12 @@
 //! sends an input per tick, receives snapshots, leaves cleanly, and prints
 //! the report line `ledge-load` reads.
 
-use std::net::SocketAddr;
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+mod common;
 
-use ledge_server::{Server, ServerConfig};
+use std::process::Command;
+use std::time::Duration;
+
+use common::{run_to_end, TestServer};
 
 /// `ledge-bot` must have exited within this time.
 const BOT_TIMEOUT: Duration = Duration::from_secs(60);
@@ -26,47 +27,15 @@ fn field(line: &str, name: &str) -> u64 {
 
 #[test]
 fn thin_bots_play_and_report() {
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(1)
-        .enable_all()
-        .build()
-        .unwrap();
-    let certs = tempfile::tempdir().unwrap();
-    let (addr, fingerprint, shutdown, task) = runtime.block_on(async {
-        let server = Server::bind(ServerConfig {
-            bind: SocketAddr::from(([127, 0, 0, 1], 0)),
-            cert_dir: certs.path().to_owned(),
-            ..ServerConfig::default()
-        })
-        .expect("server binds");
-        (
-            server.local_addr(),
-            server.fingerprint(),
-            server.shutdown_handle(),
-            tokio::spawn(server.run()),
-        )
-    });
-
-    let mut child = Command::new(env!("CARGO_BIN_EXE_ledge-bot"))
-        .args(["--connect", &addr.to_string()])
-        .args(["--cert-hash", &fingerprint.to_string()])
+    let server = TestServer::start();
+    let mut command = Command::new(env!("CARGO_BIN_EXE_ledge-bot"));
+    command
+        .args(["--connect", &server.addr.to_string()])
+        .args(["--cert-hash", &server.fingerprint.to_string()])
         .args(["--brain", "thin", "--count", "3", "--seconds", "2"])
         .args(["--name", "p1"])
-        .env("RUST_LOG", "warn")
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("ledge-bot starts");
-    let deadline = Instant::now() + BOT_TIMEOUT;
-    while child.try_wait().unwrap().is_none() {
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            panic!("ledge-bot did not exit within {BOT_TIMEOUT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let out = child.wait_with_output().unwrap();
+        .env("RUST_LOG", "warn");
+    let out = run_to_end(command, BOT_TIMEOUT);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{}\n{stdout}\n{stderr}", out.status);
@@ -85,8 +54,5 @@ fn thin_bots_play_and_report() {
         assert!(words[3].starts_with('#'), "{line}");
     }
 
-    shutdown.shutdown();
-    runtime.block_on(async {
-        let _ = tokio::time::timeout(Duration::from_secs(5), task).await;
-    });
+    server.stop();
 }

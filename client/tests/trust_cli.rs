@@ -8,13 +8,14 @@
 //! when it is missing, failing when `CI=true`).
 #![cfg(feature = "gui")]
 
-use std::net::SocketAddr;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+mod common;
 
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::Duration;
+
+use common::{run_to_end, TestServer};
 use ledge_client::Fingerprint;
-use ledge_server::{Server, ServerConfig, ShutdownHandle};
 
 /// The client must have exited within this time.
 const CLIENT_TIMEOUT: Duration = Duration::from_secs(60);
@@ -22,78 +23,9 @@ const CLIENT_TIMEOUT: Duration = Duration::from_secs(60);
 /// Exit code of a refused certificate.
 const EXIT_UNTRUSTED: i32 = 3;
 
-/// A real server on loopback, in-process, for one test.
-struct TestServer {
-    addr: SocketAddr,
-    fingerprint: Fingerprint,
-    shutdown: ShutdownHandle,
-    runtime: tokio::runtime::Runtime,
-    task: tokio::task::JoinHandle<Result<(), ledge_server::ServerError>>,
-    _certs: tempfile::TempDir,
-}
-
-impl TestServer {
-    fn start() -> TestServer {
-        let runtime = tokio::runtime::Builder::new_multi_thread()
-            .worker_threads(1)
-            .enable_all()
-            .build()
-            .unwrap();
-        let certs = tempfile::tempdir().unwrap();
-        let (addr, fingerprint, shutdown, task) = runtime.block_on(async {
-            let server = Server::bind(ServerConfig {
-                bind: SocketAddr::from(([127, 0, 0, 1], 0)),
-                cert_dir: certs.path().to_owned(),
-                ..ServerConfig::default()
-            })
-            .expect("server binds");
-            (
-                server.local_addr(),
-                server.fingerprint(),
-                server.shutdown_handle(),
-                tokio::spawn(server.run()),
-            )
-        });
-        TestServer {
-            addr,
-            fingerprint,
-            shutdown,
-            runtime,
-            task,
-            _certs: certs,
-        }
-    }
-
-    fn stop(self) {
-        self.shutdown.shutdown();
-        let task = self.task;
-        self.runtime.block_on(async {
-            let _ = tokio::time::timeout(Duration::from_secs(5), task).await;
-        });
-    }
-}
-
 /// Runs `command` to its end (killed after [`CLIENT_TIMEOUT`]).
-fn run(mut command: Command) -> Output {
-    let mut child = command
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the client starts");
-    let deadline = Instant::now() + CLIENT_TIMEOUT;
-    while child.try_wait().unwrap().is_none() {
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            let out = child.wait_with_output().unwrap();
-            panic!(
-                "the client did not exit within {CLIENT_TIMEOUT:?}; stderr:\n{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    child.wait_with_output().unwrap()
+fn run(command: Command) -> Output {
+    run_to_end(command, CLIENT_TIMEOUT)
 }
 
 /// The client binary, with no configuration directory of the user's.
