@@ -823,14 +823,7 @@ impl<'a> Sweeper<'a> {
     /// the right).
     fn surface(&self, c: i64, r: i64, s: Slope) -> Option<Cand> {
         let t = self.t;
-        let (a, k) = match s {
-            Slope::Right45 => (2, 0),
-            Slope::Left45 => (-2, 2 * t),
-            Slope::RightLow22 => (1, -1),
-            Slope::RightHigh22 => (1, t - 1),
-            Slope::LeftHigh22 => (-1, 2 * t),
-            Slope::LeftLow22 => (-1, t),
-        };
+        let (a, k) = slope_line(s, t);
         let tl = self.map.col_left(c);
         let tr = tl + t;
         let tb = self.map.row_top(r) + t;
@@ -971,6 +964,21 @@ fn slab(lo0: i64, hi0: i64, v: i64, a: i64, b: i64) -> Option<(Option<Frac>, Opt
     }
 }
 
+/// The surface line of slope `s` on tiles `t` wide: `(a, k)` with
+/// `2 h(X) = a X + k` the doubled height over the column offset `X`
+/// (lowered by a half unit for the 22.5 degree ramps rising to the right),
+/// so that below the line is below the surface at integer points.
+fn slope_line(s: Slope, t: i64) -> (i64, i64) {
+    match s {
+        Slope::Right45 => (2, 0),
+        Slope::Left45 => (-2, 2 * t),
+        Slope::RightLow22 => (1, -1),
+        Slope::RightHigh22 => (1, t - 1),
+        Slope::LeftHigh22 => (-1, 2 * t),
+        Slope::LeftLow22 => (-1, t),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -991,14 +999,7 @@ mod tests {
         // unit): "below the line" is "below the surface" at integer points.
         let t = 64i64;
         for s in Slope::ALL {
-            let (a, k) = match s {
-                Slope::Right45 => (2, 0),
-                Slope::Left45 => (-2, 2 * t),
-                Slope::RightLow22 => (1, -1),
-                Slope::RightHigh22 => (1, t - 1),
-                Slope::LeftHigh22 => (-1, 2 * t),
-                Slope::LeftLow22 => (-1, t),
-            };
+            let (a, k) = slope_line(s, t);
             for x in 0..t {
                 let h2 = 2 * s.height(x as i32, t as i32) as i64;
                 let line = a * x + k;
