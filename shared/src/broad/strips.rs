@@ -86,6 +86,12 @@ impl Levels {
         ((y + (1i64 << 31)) >> self.shift[l]) as u32
     }
 
+    /// [`Self::strip`] of a coordinate already in the `i32` range.
+    #[inline(always)]
+    fn strip_i32(&self, l: usize, y: i32) -> u32 {
+        ((((y as u32) ^ (1 << 31)) as u64) >> self.shift[l]) as u32
+    }
+
     /// Strip height of level `l` in units.
     #[inline]
     pub fn height(&self, l: usize) -> i64 {
@@ -100,7 +106,7 @@ impl Levels {
         let h = b.max.y as i64 - b.min.y as i64;
         let l = self.level_of(w.max(h));
         ((l as u64) << 60)
-            | ((self.strip(l, b.min.y as i64) as u64) << 32)
+            | ((self.strip_i32(l, b.min.y) as u64) << 32)
             | ((b.min.x as u32) ^ (1 << 31)) as u64
     }
 }
@@ -143,6 +149,12 @@ struct Entry {
 }
 
 impl Entry {
+    /// Width in units (saturated).
+    #[inline(always)]
+    fn width(&self) -> u32 {
+        (self.maxx as i64 - self.minx as i64).clamp(0, u32::MAX as i64) as u32
+    }
+
     #[inline(always)]
     fn new(key: u64, idx: u32, id: u32, b: &Bounds) -> Self {
         Self {
@@ -165,8 +177,9 @@ struct Chunk {
     rows: Range<usize>,
     /// Boxes that kept their strip, in sorted order.
     stay: Vec<Entry>,
-    /// Distinct strip keys of `stay`, in order.
-    stay_rows: Vec<u32>,
+    /// Distinct strip keys of `stay`, in order, each with the end of its
+    /// boxes in `stay`.
+    stay_rows: Vec<(u32, u32)>,
     /// Boxes that changed strip.
     movers: Vec<Entry>,
     /// Insertion-sort steps taken.
@@ -212,7 +225,7 @@ impl Chunk {
                 }
             }
             if self.stay.len() > before {
-                self.stay_rows.push(r.key);
+                self.stay_rows.push((r.key, self.stay.len() as u32));
             }
         }
     }
@@ -228,51 +241,116 @@ impl Chunk {
                 continue;
             }
             last = rk;
-            while k < self.stay_rows.len() && self.stay_rows[k] < rk {
+            while k < self.stay_rows.len() && self.stay_rows[k].0 < rk {
                 k += 1;
             }
-            if self.stay_rows.get(k) != Some(&rk) {
+            if self.stay_rows.get(k).map(|r| r.0) != Some(rk) {
                 distinct += 1;
             }
         }
         self.size = self.stay.len() + mv.len() + distinct;
     }
 
-    /// Merges the kept boxes and this chunk's movers into `out`, one
-    /// sentinel after each strip.
-    fn layout(&mut self, movers: &[Entry], out: Slices<'_>) {
+    /// Merges the kept boxes and this chunk's movers into `out`, strip by
+    /// strip, one sentinel after each.
+    fn layout(&mut self, movers: &[Entry], mut out: Slices<'_>) {
         self.out_rows.clear();
-        let mut o = Out {
-            s: out,
-            at: 0,
-            base: self.base,
-            rows: &mut self.out_rows,
-            row: Row {
-                key: u32::MAX,
-                ..Row::default()
-            },
+        let (st, mv) = (&self.stay, &movers[self.mv.clone()]);
+        let (mut r, mut i, mut j, mut at) = (0, 0, 0, 0);
+        let mut acc = Acc::default();
+        loop {
+            let sk = self.stay_rows.get(r).map(|x| x.0);
+            let mk = mv.get(j).map(|m| row_key(m.key));
+            let rk = match (sk, mk) {
+                (Some(a), Some(b)) => a.min(b),
+                (Some(k), None) | (None, Some(k)) => k,
+                (None, None) => break,
+            };
+            let i1 = if sk == Some(rk) {
+                r += 1;
+                self.stay_rows[r - 1].1 as usize
+            } else {
+                i
+            };
+            let mut j1 = j;
+            while j1 < mv.len() && row_key(mv[j1].key) == rk {
+                j1 += 1;
+            }
+            acc.max_w = 0;
+            let end = put(&mut out, at, &st[i..i1], &mv[j..j1], &mut acc);
+            out.set_sentinel(end);
+            self.out_rows.push(Row {
+                key: rk,
+                start: (self.base + at) as u32,
+                end: (self.base + end) as u32,
+                max_w: acc.max_w,
+            });
+            (i, j, at) = (i1, j1, end + 1);
+        }
+        debug_assert_eq!(at, self.size);
+        self.id_lo = acc.id_lo;
+        self.id_hi = acc.id_hi;
+    }
+}
+
+/// Running figures of a layout: the widest box of the current strip and the
+/// id range.
+#[derive(Debug, Clone, Copy)]
+struct Acc {
+    max_w: u32,
+    id_lo: u32,
+    id_hi: u32,
+}
+
+impl Default for Acc {
+    fn default() -> Self {
+        Self {
+            max_w: 0,
             id_lo: u32::MAX,
             id_hi: 0,
-        };
-        let (st, mv) = (&self.stay, &movers[self.mv.clone()]);
-        let (mut i, mut j) = (0, 0);
-        while i < st.len() {
-            if j < mv.len() && mv[j].key < st[i].key {
-                o.push(&mv[j]);
-                j += 1;
-            } else {
-                o.push(&st[i]);
-                i += 1;
-            }
         }
-        for m in &mv[j..] {
-            o.push(m);
-        }
-        o.close_row();
-        debug_assert_eq!(o.at, self.size);
-        self.id_lo = o.id_lo;
-        self.id_hi = o.id_hi;
     }
+}
+
+/// Writes the merge of the sorted runs `stay` and `new` (kept boxes first
+/// on equal keys) into `out` from entry `at` on; returns the next free
+/// entry. The kept boxes go in runs, column by column.
+#[inline(always)]
+fn put(out: &mut Slices<'_>, at: usize, stay: &[Entry], new: &[Entry], acc: &mut Acc) -> usize {
+    let (mut at, mut i) = (at, 0);
+    for m in new {
+        let mut k = i;
+        while k < stay.len() && stay[k].key <= m.key {
+            k += 1;
+        }
+        at = put_run(out, at, &stay[i..k], acc);
+        at = put_run(out, at, core::slice::from_ref(m), acc);
+        i = k;
+    }
+    put_run(out, at, &stay[i..], acc)
+}
+
+/// Writes `run` into `out` from entry `at` on, column by column; returns
+/// the next free entry.
+#[inline(always)]
+fn put_run(out: &mut Slices<'_>, at: usize, run: &[Entry], acc: &mut Acc) -> usize {
+    let end = at + run.len();
+    let cols = out.minx[at..end]
+        .iter_mut()
+        .zip(&mut out.maxx[at..end])
+        .zip(&mut out.miny[at..end])
+        .zip(&mut out.maxy[at..end])
+        .zip(&mut out.id[at..end])
+        .zip(&mut out.idx[at..end]);
+    let mut a = *acc;
+    for (e, (((((minx, maxx), miny), maxy), id), idx)) in run.iter().zip(cols) {
+        (*minx, *maxx, *miny, *maxy, *id, *idx) = (e.minx, e.maxx, e.miny, e.maxy, e.id, e.idx);
+        a.max_w = a.max_w.max(e.width());
+        a.id_lo = a.id_lo.min(e.id);
+        a.id_hi = a.id_hi.max(e.id);
+    }
+    *acc = a;
+    end
 }
 
 /// One set of boxes (the static or the dynamic ones) in strip order.
@@ -387,9 +465,13 @@ impl Strips {
             c.stay_rows.clear();
             for &(key, i) in &self.full {
                 let (id, b) = &items[i as usize];
+                if c.stay_rows.last().map(|r| r.0) != Some(row_key(key)) {
+                    c.stay_rows.push((row_key(key), 0));
+                }
                 c.stay.push(Entry::new(key, i, *id, b));
-                if c.stay_rows.last() != Some(&row_key(key)) {
-                    c.stay_rows.push(row_key(key));
+                let n = c.stay.len() as u32;
+                if let Some(last) = c.stay_rows.last_mut() {
+                    last.1 = n;
                 }
             }
             c.rows = 0..0;
@@ -479,13 +561,16 @@ impl Strips {
         };
         lay_chunks(&mut self.chunks, &self.movers, out, par);
         // Padding sentinels.
+        let mut pad = Slices {
+            minx: &mut self.minx,
+            maxx: &mut self.maxx,
+            miny: &mut self.miny,
+            maxy: &mut self.maxy,
+            id: &mut self.id,
+            idx: &mut self.idx,
+        };
         for k in used..need {
-            self.minx[k] = SENTINEL;
-            self.maxx[k] = SENTINEL;
-            self.miny[k] = 0;
-            self.maxy[k] = 0;
-            self.id[k] = u32::MAX;
-            self.idx[k] = u32::MAX;
+            pad.set_sentinel(k);
         }
         self.used = used;
         self.rows.clear();
@@ -532,6 +617,17 @@ struct Slices<'a> {
 }
 
 impl<'a> Slices<'a> {
+    /// Makes entry `k` a sentinel.
+    #[inline(always)]
+    fn set_sentinel(&mut self, k: usize) {
+        self.minx[k] = SENTINEL;
+        self.maxx[k] = SENTINEL;
+        self.miny[k] = 0;
+        self.maxy[k] = 0;
+        self.id[k] = u32::MAX;
+        self.idx[k] = u32::MAX;
+    }
+
     fn split_at(self, k: usize) -> (Slices<'a>, Slices<'a>) {
         let (a0, b0) = self.minx.split_at_mut(k);
         let (a1, b1) = self.maxx.split_at_mut(k);
@@ -579,60 +675,4 @@ fn lay_chunks(chunks: &mut [Chunk], movers: &[Entry], out: Slices<'_>, par: bool
         || lay_chunks(left, movers, lo, par),
         || lay_chunks(right, movers, hi, par),
     );
-}
-
-/// One chunk's output, written from entry `at` of its slices on.
-struct Out<'a, 'r> {
-    s: Slices<'a>,
-    at: usize,
-    base: usize,
-    rows: &'r mut Vec<Row>,
-    row: Row,
-    id_lo: u32,
-    id_hi: u32,
-}
-
-impl Out<'_, '_> {
-    #[inline(always)]
-    fn push(&mut self, e: &Entry) {
-        let rk = row_key(e.key);
-        if rk != self.row.key {
-            self.close_row();
-            self.row = Row {
-                key: rk,
-                start: (self.base + self.at) as u32,
-                end: 0,
-                max_w: 0,
-            };
-        }
-        let w = (e.maxx as i64 - e.minx as i64).clamp(0, u32::MAX as i64) as u32;
-        self.row.max_w = self.row.max_w.max(w);
-        let k = self.at;
-        self.s.minx[k] = e.minx;
-        self.s.maxx[k] = e.maxx;
-        self.s.miny[k] = e.miny;
-        self.s.maxy[k] = e.maxy;
-        self.s.id[k] = e.id;
-        self.s.idx[k] = e.idx;
-        self.at = k + 1;
-        self.id_lo = self.id_lo.min(e.id);
-        self.id_hi = self.id_hi.max(e.id);
-    }
-
-    /// Ends the current strip (if any) with its sentinel.
-    fn close_row(&mut self) {
-        if self.row.key != u32::MAX {
-            self.row.end = (self.base + self.at) as u32;
-            self.rows.push(self.row);
-            let k = self.at;
-            self.s.minx[k] = SENTINEL;
-            self.s.maxx[k] = SENTINEL;
-            self.s.miny[k] = 0;
-            self.s.maxy[k] = 0;
-            self.s.id[k] = u32::MAX;
-            self.s.idx[k] = u32::MAX;
-            self.at = k + 1;
-            self.row.key = u32::MAX;
-        }
-    }
 }

@@ -3,14 +3,16 @@
 //! in the hot loop.
 //!
 //! The scans test [`BLOCK`] entries at a time without branching (each test
-//! is a few compares folded into a bit mask, which the compiler vectorises)
-//! and stop at the first entry that starts too far right; strips end with a
+//! is a few 4-lane vector compares, written with `wide` so that they stay
+//! vector code whatever the optimiser decides, folded into a bit mask) and
+//! stop at the first entry that starts too far right; strips end with a
 //! sentinel that always stops a scan. The few hits are then walked bit by
 //! bit. Bodies move little, so most boxes have no or one candidate and a
 //! branchy scan would mispredict on almost every box.
 
 use super::strips::{row_level, Levels, Row, Strips, BLOCK, SENTINEL};
 use core::ops::Range;
+use wide::i32x4;
 
 /// Receives every pair of boxes whose interiors overlap (strictly, on both
 /// axes): entry `i` of `a` and entry `j` of `b`.
@@ -19,32 +21,23 @@ pub(crate) trait Sink {
     fn hit(&mut self, a: &Strips, i: usize, b: &Strips, j: usize);
 }
 
-/// A block of `BLOCK` values starting at `k`.
+/// The block of `BLOCK` values starting at `k`, as one vector.
 #[inline(always)]
-fn block(v: &[i32], k: usize) -> &[i32; BLOCK] {
-    v[k..k + BLOCK].try_into().unwrap()
+fn block(v: &[i32], k: usize) -> i32x4 {
+    let b: [i32; BLOCK] = v[k..k + BLOCK].try_into().unwrap();
+    i32x4::new(b)
 }
 
 /// Bit `t` set when `v[k + t] < x`.
 #[inline(always)]
 fn lanes_lt(v: &[i32], k: usize, x: i32) -> u32 {
-    let b = block(v, k);
-    let mut m = 0;
-    for (t, &e) in b.iter().enumerate() {
-        m |= ((e < x) as u32) << t;
-    }
-    m
+    block(v, k).simd_lt(i32x4::splat(x)).to_bitmask()
 }
 
 /// Bit `t` set when `v[k + t] <= x`.
 #[inline(always)]
 fn lanes_le(v: &[i32], k: usize, x: i32) -> u32 {
-    let b = block(v, k);
-    let mut m = 0;
-    for (t, &e) in b.iter().enumerate() {
-        m |= ((e <= x) as u32) << t;
-    }
-    m
+    !block(v, k).simd_gt(i32x4::splat(x)).to_bitmask() & low(BLOCK as u32)
 }
 
 /// Bit `t` set when entry `k + t` of `s` ends right of `x0` and overlaps
@@ -52,11 +45,8 @@ fn lanes_le(v: &[i32], k: usize, x: i32) -> u32 {
 #[inline(always)]
 fn lanes_rest(s: &Strips, k: usize, x0: i32, y0: i32, y1: i32) -> u32 {
     let (mx, ny, my) = (block(&s.maxx, k), block(&s.miny, k), block(&s.maxy, k));
-    let mut m = 0;
-    for t in 0..BLOCK {
-        m |= (((mx[t] > x0) & (ny[t] < y1) & (my[t] > y0)) as u32) << t;
-    }
-    m
+    (mx.simd_gt(i32x4::splat(x0)) & my.simd_gt(i32x4::splat(y0)) & i32x4::splat(y1).simd_gt(ny))
+        .to_bitmask()
 }
 
 /// The low `n` bits.
