@@ -7,13 +7,14 @@
 //! cargo run --release --manifest-path bench/Cargo.toml -- --threads 1,2
 //! ```
 //!
-//! Options: `--n 1000,10000,50000,100000`, `--threads 1,2` (parallel runs,
-//! one pool per count), `--ticks 20` (timed ticks per N), `--warmup 10`,
-//! `--rounds 3` (every method runs once per round, medians over all rounds),
-//! `--no-rapier`, `--strip-shift 14`, `--breakdown` (update vs pair search),
-//! `--brute-full 10000` (largest N timed in full; above it brute force is
-//! estimated from a sample of rows), `--only-fast` / `--only-par K` (quick
-//! profiling runs of our one-thread path / rayon on K threads).
+//! Options (`--help` lists them): `--n 1000,10000,50000,100000`,
+//! `--threads 1,2` (parallel runs, one pool per count), `--ticks 20` (timed
+//! ticks per N), `--warmup 10`, `--rounds 3` (every method runs once per
+//! round, medians over all rounds), `--no-rapier`, `--strip-shift 14`,
+//! `--breakdown` (update vs pair search), `--brute-full 10000` (largest N
+//! timed in full; above it brute force is estimated from a sample of rows),
+//! `--only-fast` / `--only-par K` (quick runs of our one-thread path / of it
+//! against rayon on K threads in alternating passes).
 //!
 //! Each method runs in its own pass over a fresh copy of the scene (same
 //! seed, so the very same boxes every tick), so that none of them finds
@@ -23,6 +24,7 @@
 //! count, and a pair counts when a contact point has negative distance); a
 //! mismatch aborts the run.
 
+use clap::Parser;
 use glam::IVec2;
 use ledge_shared::broad::standard::{StandardScene, SEED};
 use ledge_shared::broad::{aabb_mtv, Bounds, BroadPhase, BroadPhaseConfig};
@@ -33,59 +35,134 @@ use std::time::Instant;
 
 type Contacts = Vec<(u32, u32, IVec2)>;
 
+/// Times the standard broad-phase scene through ledge's broad phase, brute
+/// force, rapier2d's collision pipeline and a plain copy of the boxes, in
+/// one run; prints a Markdown table.
+#[derive(Parser, Debug)]
+#[command(name = "ledge-bench")]
 struct Args {
+    /// Body counts to run.
+    #[arg(long = "n", value_delimiter = ',', default_values_t = [1_000, 10_000, 50_000, 100_000])]
     ns: Vec<usize>,
+    /// Thread counts of the parallel runs (one rayon pool per count).
+    #[arg(long, value_delimiter = ',', default_values_t = [1, 2])]
     threads: Vec<usize>,
+    /// Timed ticks per N and round.
+    #[arg(long, default_value_t = 20)]
     ticks: usize,
+    /// Untimed ticks before them.
+    #[arg(long, default_value_t = 10)]
     warmup: usize,
+    /// Leave rapier2d out.
+    #[arg(long = "no-rapier", action = clap::ArgAction::SetFalse)]
     rapier: bool,
+    /// `log2` of the finest strip height in units.
+    #[arg(long, default_value_t = BroadPhaseConfig::default().strip_shift)]
     strip_shift: u32,
+    /// Also time the update and the pair search apart.
+    #[arg(long)]
     breakdown: bool,
+    /// Largest N whose brute force is timed in full (above it: estimated
+    /// from a sample of rows).
+    #[arg(long, default_value_t = 10_000)]
     brute_full: usize,
+    /// Only our one-thread path: median and fastest tick.
+    #[arg(long)]
     only_fast: bool,
+    /// Only our one-thread path against rayon on this many threads, in
+    /// alternating passes (`--rounds` of each).
+    #[arg(long)]
     only_par: Option<usize>,
-    rounds: usize,
+    /// Rounds: every method runs once per round, medians over all rounds.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..))]
+    rounds: u64,
 }
 
-fn parse_list(s: &str) -> Vec<usize> {
-    s.split(',')
-        .map(|x| x.trim().replace('_', "").parse().expect("a number"))
-        .collect()
-}
-
-fn args() -> Args {
-    let mut a = Args {
-        ns: vec![1_000, 10_000, 50_000, 100_000],
-        threads: vec![1, 2],
-        ticks: 20,
-        warmup: 10,
-        rapier: true,
-        strip_shift: BroadPhaseConfig::default().strip_shift,
-        breakdown: false,
-        brute_full: 10_000,
-        only_fast: false,
-        only_par: None,
-        rounds: 3,
-    };
-    let mut it = std::env::args().skip(1);
-    while let Some(k) = it.next() {
-        let mut v = || it.next().expect("a value after the option");
-        match k.as_str() {
-            "--n" => a.ns = parse_list(&v()),
-            "--threads" => a.threads = parse_list(&v()),
-            "--ticks" => a.ticks = v().parse().unwrap(),
-            "--warmup" => a.warmup = v().parse().unwrap(),
-            "--no-rapier" => a.rapier = false,
-            "--strip-shift" => a.strip_shift = v().parse().unwrap(),
-            "--breakdown" => a.breakdown = true,
-            "--brute-full" => a.brute_full = v().parse().unwrap(),
-            "--only-fast" => a.only_fast = true,
-            "--rounds" => a.rounds = v().parse::<usize>().unwrap().max(1),
-            "--only-par" => a.only_par = Some(v().parse().unwrap()),
-            _ => panic!("unknown option {k}"),
-        }
+/// `--only-par K`: our one-thread path and rayon on `k` threads in
+/// alternating passes over the scene, `a.rounds` of each, so that a burst of
+/// load on the machine hits both alike; prints the medians over all passes,
+/// the ratio of each round and the update/search split. `reference` is a
+/// one-thread trace whose output every pass must match.
+fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Trace) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(k)
+        .build()
+        .expect("a thread pool");
+    // Per timed tick: (update, search) of each side.
+    let (mut one, mut many) = (Vec::new(), Vec::new());
+    let (mut rounds, mut both) = (Vec::new(), Vec::new());
+    for _ in 0..a.rounds {
+        // The machine's own ceiling: `k` independent one-thread runs at
+        // once. Were the cores independent, each tick would take as long as
+        // alone and the ceiling would be `k`; shared caches, memory
+        // bandwidth or a hyperthread sibling make it less.
+        let serial = |_| {
+            let mut bp = BroadPhase::new(cfg);
+            trace(n, a, |s, out| {
+                time(|| {
+                    bp.update_dynamic(&s.boxes);
+                    bp.contacts_aabb(out);
+                })
+            })
+            .ns
+        };
+        std::thread::scope(|sc| {
+            let hs: Vec<_> = (0..k).map(|t| sc.spawn(move || serial(t))).collect();
+            for h in hs {
+                both.extend(h.join().expect("a calibration thread"));
+            }
+        });
+        let mut parts = Vec::new();
+        let mut bp = BroadPhase::new(cfg);
+        let mut t1 = trace(n, a, |s, out| {
+            let u = time(|| bp.update_dynamic(&s.boxes));
+            let c = time(|| bp.contacts_aabb(out));
+            parts.push((u, c));
+            u + c
+        });
+        check("one thread", n, reference, &t1, true);
+        one.extend_from_slice(&parts[a.warmup..]);
+        parts.clear();
+        let mut bp = BroadPhase::new(cfg);
+        let mut tk = trace(n, a, |s, out| {
+            pool.install(|| {
+                let u = time(|| bp.update_dynamic_par(&s.boxes));
+                let c = time(|| bp.contacts_aabb_par(out));
+                parts.push((u, c));
+                u + c
+            })
+        });
+        check("rayon", n, reference, &tk, true);
+        many.extend_from_slice(&parts[a.warmup..]);
+        rounds.push(t1.median() / tk.median());
     }
-    a
+    let med = |v: &[(f64, f64)], f: fn(&(f64, f64)) -> f64| {
+        median(&mut v.iter().map(f).collect::<Vec<_>>())
+    };
+    let (t1, tk) = (med(&one, |p| p.0 + p.1), med(&many, |p| p.0 + p.1));
+    let per_round: Vec<String> = rounds.iter().map(|r| format!("{r:.2}x")).collect();
+    println!(
+        "N={n}: serial {}, rayon {k} threads {} ({:.2}x; rounds {})",
+        fmt_ns(t1),
+        fmt_ns(tk),
+        t1 / tk,
+        per_round.join(", ")
+    );
+    println!(
+        "update: serial {} par {}; search: serial {} par {}",
+        fmt_ns(med(&one, |p| p.0)),
+        fmt_ns(med(&many, |p| p.0)),
+        fmt_ns(med(&one, |p| p.1)),
+        fmt_ns(med(&many, |p| p.1)),
+    );
+    let alongside = median(&mut both);
+    println!(
+        "machine ceiling: {k} independent one-thread runs at once take {} per tick each, \
+         so {k} threads can give at most {:.2}x on this work (ours: {:.2}x)",
+        fmt_ns(alongside),
+        k as f64 * t1 / alongside,
+        t1 / tk
+    );
 }
 
 // ---------------------------------------------------------------- rapier2d
@@ -288,6 +365,10 @@ struct Row {
     general: f64,
     par: Vec<(usize, f64)>,
     rapier: Option<f64>,
+    /// rapier2d / ours, median of each round.
+    rapier_rounds: Vec<f64>,
+    /// rapier2d / ours, fastest tick of each.
+    rapier_fastest: Option<f64>,
     brute: f64,
     brute_estimated: bool,
     copy: f64,
@@ -376,46 +457,7 @@ fn run(n: usize, a: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Row {
         })
     });
     if let Some(k) = a.only_par {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(k)
-            .build()
-            .unwrap();
-        let mut bp = BroadPhase::new(cfg);
-        let mut t = trace(n, a, |s, out| {
-            pool.install(|| {
-                time(|| {
-                    bp.update_dynamic_par(&s.boxes);
-                    bp.contacts_aabb_par(out);
-                })
-            })
-        });
-        check("rayon", n, &fast, &t, true);
-        println!(
-            "N={n}: serial {}, rayon {k} threads {}",
-            fmt_ns(fast.median()),
-            fmt_ns(t.median())
-        );
-        let mut bp = BroadPhase::new(cfg);
-        let mut u = Vec::new();
-        let mut t = trace(n, a, |s, out| {
-            pool.install(|| {
-                u.push(time(|| bp.update_dynamic_par(&s.boxes)));
-                time(|| bp.contacts_aabb_par(out))
-            })
-        });
-        let mut bp = BroadPhase::new(cfg);
-        let mut u1 = Vec::new();
-        let mut t1 = trace(n, a, |s, out| {
-            u1.push(time(|| bp.update_dynamic(&s.boxes)));
-            time(|| bp.contacts_aabb(out))
-        });
-        println!(
-            "update: serial {} par {}; search: serial {} par {}",
-            fmt_ns(median(&mut u1[a.warmup..])),
-            fmt_ns(median(&mut u[a.warmup..])),
-            fmt_ns(t1.median()),
-            fmt_ns(t.median())
-        );
+        only_par(n, a, cfg, k, &fast);
         std::process::exit(0);
     }
     if a.only_fast {
@@ -447,16 +489,20 @@ fn run(n: usize, a: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Row {
     let mut rap_t = Trace::default();
     let mut copy = Trace::default();
     let (mut upd, mut srch) = (Vec::new(), Vec::new());
+    let mut rapier_rounds = Vec::new();
     for round in 0..a.rounds {
-        if round > 0 {
-            let t = trace(n, a, |s, out| {
+        let ours_round = if round > 0 {
+            let mut t = trace(n, a, |s, out| {
                 time(|| {
                     bp.update_dynamic(&s.boxes);
                     bp.contacts_aabb(out);
                 })
             });
-            fast.ns.extend(t.ns);
-        }
+            fast.ns.extend_from_slice(&t.ns);
+            t.median()
+        } else {
+            median(&mut fast.ns.clone())
+        };
         let t = trace(n, a, |s, out| {
             time(|| {
                 bp_gen.update_dynamic(&s.boxes);
@@ -496,6 +542,7 @@ fn run(n: usize, a: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Row {
                 ns
             });
             check("rapier2d's pair set", n, &fast, &t, false);
+            rapier_rounds.push(median(&mut t.ns.clone()) / ours_round);
             rap_t.ns.extend(t.ns);
         }
         let t = trace(n, a, |s, out| {
@@ -512,6 +559,8 @@ fn run(n: usize, a: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Row {
         .map(|((k, _), t)| (*k, t.median()))
         .collect();
     let rapier_ns = a.rapier.then(|| rap_t.median());
+    let fastest = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    let rapier_fastest = a.rapier.then(|| fastest(&rap_t.ns) / fastest(&fast.ns));
     let (update, search) = if a.breakdown {
         (median(&mut upd), median(&mut srch))
     } else {
@@ -543,6 +592,8 @@ fn run(n: usize, a: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Row {
         general: general.median(),
         par,
         rapier: rapier_ns,
+        rapier_rounds,
+        rapier_fastest,
         brute: brute.median(),
         brute_estimated: !full_brute,
         copy: copy.median(),
@@ -552,7 +603,7 @@ fn run(n: usize, a: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Row {
 }
 
 fn main() {
-    let a = args();
+    let a = Args::parse();
     let pools: Vec<(usize, rayon::ThreadPool)> = a
         .threads
         .iter()
@@ -610,6 +661,20 @@ fn main() {
             r.fast / r.copy
         );
         println!("{line}");
+    }
+    if a.rapier {
+        println!("\nrapier2d / ours, one thread: median of each round, and fastest tick against fastest tick\n");
+        println!("| N | per round | fastest ticks |");
+        println!("|---:|---|---:|");
+        for r in &rows {
+            let rounds: Vec<String> = r.rapier_rounds.iter().map(|x| format!("{x:.1}x")).collect();
+            println!(
+                "| {} | {} | {:.1}x |",
+                r.n,
+                rounds.join(", "),
+                r.rapier_fastest.unwrap_or(f64::NAN)
+            );
+        }
     }
     println!();
     println!(

@@ -171,7 +171,12 @@ impl Entry {
 
 /// One slice of the old strips, updated on its own (in parallel with the
 /// others when asked).
+///
+/// Aligned to two cache lines: chunks sit side by side and different
+/// threads write their counters and vector lengths at once, which must not
+/// share a line.
 #[derive(Debug, Default, Clone)]
+#[repr(align(128))]
 struct Chunk {
     /// Old row-table indices covered.
     rows: Range<usize>,
