@@ -9,7 +9,7 @@
 //! [`crate::online::OnlineGame`]) and feeds it:
 //!
 //! ```text
-//! every frame:   game.update(now, buttons, |tick, b| send the input)
+//! every frame:   game.update(now, max_ticks, |i| buttons, |tick, b| send the input)
 //!                (or: for _ in 0..game.advance(now) { let t = game.step(b); send(t, b) })
 //! each snapshot: game.on_snapshot(&update)
 //! each ping:     game.on_rtt(rtt);  now and then: game.on_transport(sample, now)
@@ -243,20 +243,24 @@ impl ClientGame {
         self.predictor.step(buttons)
     }
 
-    /// [`ClientGame::advance`], then the due ticks with `buttons`, handing
-    /// each input to `send` (at most [`MAX_SENDS_PER_UPDATE`], the newest).
-    /// Returns the ticks run.
+    /// [`ClientGame::advance`], then at most `max_ticks` of the due ticks,
+    /// the i-th of this call with `buttons(i)`, handing each input to `send`
+    /// (only the newest [`MAX_SENDS_PER_UPDATE`] of a long frame: each
+    /// packet repeats the ticks before it anyway). Returns the ticks run;
+    /// the rest stay due.
     pub fn update(
         &mut self,
         now: Instant,
-        buttons: Buttons,
+        max_ticks: u64,
+        mut buttons: impl FnMut(u64) -> Buttons,
         mut send: impl FnMut(u64, Buttons),
-    ) -> u32 {
-        let due = self.advance(now);
+    ) -> u64 {
+        let due = u64::from(self.advance(now)).min(max_ticks);
         for i in 0..due {
-            let tick = self.step(buttons);
-            if due - i <= MAX_SENDS_PER_UPDATE && !self.offline {
-                send(tick, buttons);
+            let b = buttons(i);
+            let tick = self.step(b);
+            if due - i <= u64::from(MAX_SENDS_PER_UPDATE) && !self.offline {
+                send(tick, b);
             }
         }
         due

@@ -21,16 +21,16 @@
 //! # Ok::<(), std::io::Error>(())
 //! ```
 //!
-//! Nothing here blocks: events are drained with `try_recv`, inputs queued
-//! with `try_send`.
+//! Nothing here blocks (but [`OnlineGame::wait`]): events are drained with
+//! `try_recv`, inputs queued with `try_send`.
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
-use ledge_shared::protocol::{Fingerprint, NoticeKind, PlayerId};
+use ledge_shared::protocol::{Fingerprint, NoticeKind, PlayerId, StateSnapshot};
 
 use crate::background::{ConnectRequest, NetEvent, NetOptions, NetStatus, NetThread};
 use crate::game::ClientGame;
@@ -82,6 +82,15 @@ pub struct OnlineGame {
     /// A problem with the game itself (wrong level): shown, not fatal to
     /// the connection.
     error: Option<String>,
+    /// Why the server's certificate was refused, if it was.
+    untrusted: Option<String>,
+    /// The newest authoritative state.
+    latest: Option<StateSnapshot>,
+    /// Snapshots arrived since the last [`OnlineGame::take_arrivals`].
+    arrivals: u32,
+    /// The game was just created: the ticks due at its first update are
+    /// nobody's play (e.g. a window was opening after [`OnlineGame::wait`]).
+    fresh: bool,
 }
 
 impl OnlineGame {
@@ -111,36 +120,78 @@ impl OnlineGame {
             chat: VecDeque::new(),
             notices: VecDeque::new(),
             error: None,
+            untrusted: None,
+            latest: None,
+            arrivals: 0,
+            fresh: false,
         })
     }
 
     /// Call once per frame: takes the network's events, runs the due ticks
     /// with `buttons` and queues our inputs.
     pub fn update(&mut self, now: Instant, buttons: Buttons) {
+        self.update_ticks(now, u64::MAX, |_| buttons);
+    }
+
+    /// [`OnlineGame::update`] for a fixed-step loop: runs at most
+    /// `max_ticks` of the due ticks, the i-th of this call with
+    /// `buttons(i)`; returns the ticks run. Those due at the game's first
+    /// update (the clock ran on since the welcome) are run idle and not
+    /// sent: the server assumes no buttons until our first input.
+    pub fn update_ticks(
+        &mut self,
+        now: Instant,
+        max_ticks: u64,
+        buttons: impl FnMut(u64) -> Buttons,
+    ) -> u64 {
         while let Some(event) = self.net.try_recv() {
-            self.handle(&event, now);
-            self.status.apply(event);
+            self.take(event, now);
         }
+        let Some(game) = &mut self.game else {
+            return 0;
+        };
         if let Some(t) = self.net.transport() {
-            if let Some(game) = &mut self.game {
-                game.on_transport(t, now);
+            game.on_transport(t, now);
+        }
+        if std::mem::take(&mut self.fresh) {
+            for _ in 0..game.advance(now) {
+                game.step(Buttons::NONE);
             }
         }
-        if let Some(game) = &mut self.game {
-            let net = &self.net;
-            game.update(now, buttons, |tick, b| {
-                net.send_input(tick, b);
-            });
+        let net = &self.net;
+        game.update(now, max_ticks, buttons, |tick, b| {
+            net.send_input(tick, b);
+        })
+    }
+
+    /// Waits up to `timeout` for the network thread's first word (joined,
+    /// refused, failed) and takes it, so that a refused certificate is
+    /// known before, say, a window opens.
+    pub fn wait(&mut self, timeout: Duration) {
+        if let Some(event) = self.net.recv_timeout(timeout) {
+            self.take(event, Instant::now());
+        }
+    }
+
+    /// Takes one event from the network thread.
+    fn take(&mut self, event: NetEvent, now: Instant) {
+        self.handle(&event, now);
+        match event {
+            // Kept without a copy (the status has no use for it).
+            NetEvent::Snapshot(update) => self.latest = Some(update.state),
+            event => self.status.apply(event),
         }
     }
 
     fn handle(&mut self, event: &NetEvent, now: Instant) {
         match event {
             NetEvent::Connected(welcome) => {
+                // The clock starts from QUIC's round-trip estimate of the
+                // handshake (or a guess).
                 let rtt = self
                     .net
                     .transport()
-                    .map_or(std::time::Duration::from_millis(50), |t| t.rtt);
+                    .map_or(Duration::from_millis(50), |t| t.rtt);
                 let made = level_for(welcome, self.level_file.as_deref())
                     .and_then(|level| ClientGame::new(welcome, level, rtt, now));
                 match made {
@@ -148,11 +199,13 @@ impl OnlineGame {
                         game.set_name(&self.name);
                         game.set_player_names(&self.net.players());
                         self.game = Some(game);
+                        self.fresh = true;
                     }
                     Err(e) => self.error = Some(e.to_string()),
                 }
             }
             NetEvent::Snapshot(update) => {
+                self.arrivals = self.arrivals.saturating_add(1);
                 if let Some(game) = &mut self.game {
                     game.on_snapshot(update);
                 }
@@ -184,7 +237,8 @@ impl OnlineGame {
                     game.on_player_left(*id);
                 }
             }
-            NetEvent::Failed(_) | NetEvent::Untrusted(_) | NetEvent::Disconnected(_) => {}
+            NetEvent::Untrusted(reason) => self.untrusted = Some(reason.clone()),
+            NetEvent::Failed(_) | NetEvent::Disconnected(_) => {}
         }
     }
 
@@ -221,6 +275,22 @@ impl OnlineGame {
         self.error.as_deref()
     }
 
+    /// Why the server's certificate was refused (the message says what to
+    /// do), if it was.
+    pub fn untrusted(&self) -> Option<&str> {
+        self.untrusted.as_deref()
+    }
+
+    /// The newest authoritative state (where the server says things are).
+    pub fn server_state(&self) -> Option<&StateSnapshot> {
+        self.latest.as_ref()
+    }
+
+    /// Snapshots arrived since the last call (for an arrivals graph).
+    pub fn take_arrivals(&mut self) -> u32 {
+        std::mem::take(&mut self.arrivals)
+    }
+
     /// The last chat lines, oldest first.
     pub fn chat_lines(&self) -> impl Iterator<Item = &(PlayerId, String)> {
         self.chat.iter()
@@ -239,5 +309,95 @@ impl OnlineGame {
     /// The network thread (queues, counters).
     pub fn net(&self) -> &NetThread {
         &self.net
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::net::SocketAddr;
+
+    use ledge_server::{Server, ServerConfig};
+
+    use super::*;
+
+    const WITHIN: Duration = Duration::from_secs(20);
+
+    /// Runs `check` against a real server on loopback (its own runtime).
+    fn with_server(check: impl FnOnce(SocketAddr, Fingerprint)) {
+        let runtime = tokio::runtime::Runtime::new().unwrap();
+        let certs = tempfile::tempdir().unwrap();
+        let server = runtime.block_on(async {
+            Server::bind(ServerConfig {
+                bind: SocketAddr::from(([127, 0, 0, 1], 0)),
+                cert_dir: certs.path().to_owned(),
+                ..ServerConfig::default()
+            })
+            .unwrap()
+        });
+        let (addr, pin, shutdown) = (
+            server.local_addr(),
+            server.fingerprint(),
+            server.shutdown_handle(),
+        );
+        let task = runtime.spawn(server.run());
+        check(addr, pin);
+        shutdown.shutdown();
+        let _ = runtime.block_on(async { tokio::time::timeout(WITHIN, task).await });
+    }
+
+    fn connect(addr: SocketAddr, pin: Fingerprint) -> OnlineGame {
+        let request = OnlineRequest::new(&addr.to_string(), Trust::Pinned(pin), "ada");
+        OnlineGame::connect(request).unwrap()
+    }
+
+    #[test]
+    fn a_wrong_certificate_is_untrusted_once_waited_for() {
+        with_server(|addr, _| {
+            let mut online = connect(addr, Fingerprint([7; 32]));
+            online.wait(WITHIN);
+            assert!(online.untrusted().is_some(), "{}", online.status());
+            assert!(matches!(online.status(), NetStatus::Failed(_)));
+            assert!(online.game().is_none());
+            assert_eq!(online.update_ticks(Instant::now(), 5, |_| Buttons::NONE), 0);
+        });
+    }
+
+    #[test]
+    fn a_fixed_step_loop_idles_the_wait_runs_capped_ticks_and_sees_the_server() {
+        with_server(|addr, pin| {
+            let mut online = connect(addr, pin);
+            online.wait(WITHIN);
+            assert!(online.game().is_some(), "{}", online.status());
+            assert!(online.untrusted().is_none());
+            // The clock runs on while, say, a window opens: those ticks
+            // are run idle at the first update, not counted as played.
+            std::thread::sleep(Duration::from_millis(200));
+            let start = online.game().unwrap().next_tick();
+            assert_eq!(online.update_ticks(Instant::now(), 1, |_| Buttons::NONE), 0);
+            assert!(online.game().unwrap().next_tick() >= start + 6);
+
+            let deadline = Instant::now() + WITHIN;
+            let (mut arrivals, mut played) = (0, 0);
+            loop {
+                let mut asked = 0;
+                let ran = online.update_ticks(Instant::now(), 1, |i| {
+                    assert_eq!(i, asked);
+                    asked += 1;
+                    Buttons::NONE
+                });
+                assert!(ran <= 1 && ran == asked, "ran {ran}, asked {asked}");
+                played += ran;
+                arrivals += online.take_arrivals();
+                let me = online.game().unwrap().me().0;
+                let seen = online.server_state().and_then(|s| s.get(me)).is_some();
+                if seen && arrivals > 1 && played > 5 {
+                    break;
+                }
+                assert!(Instant::now() < deadline, "{}", online.status());
+                std::thread::sleep(Duration::from_millis(20));
+            }
+            assert_eq!(online.take_arrivals(), 0);
+            assert!(online.game().unwrap().synced());
+        });
     }
 }

@@ -30,9 +30,8 @@ use std::sync::atomic::{AtomicI32, Ordering};
 use std::time::{Duration, Instant};
 
 use clap::Parser;
-use ledge_client::background::ConnectRequest;
 use ledge_client::view::px2;
-use ledge_client::{Fingerprint, Trust};
+use ledge_client::{Fingerprint, OnlineRequest, Trust};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::input::Buttons;
 use macroquad::prelude::*;
@@ -203,34 +202,26 @@ fn main() -> anyhow::Result<()> {
             .map_err(|e| anyhow::anyhow!("loading the level: {e}"))?,
         _ => ledge_shared::level::default_level(),
     };
-    let level_file = cli.level.clone().filter(|_| !cli.local);
     let mut server = None;
     let request = if cli.local {
         let s = local::LocalServer::start()?;
-        let request = ConnectRequest {
-            server: s.addr.to_string(),
-            cert_fingerprint: s.fingerprint,
-            player_name: cli.name.clone(),
-        };
         let trust = Trust::Pinned(s.fingerprint);
+        let request = OnlineRequest::new(&s.addr.to_string(), trust, &cli.name);
         server = Some(s);
-        Some((request, trust))
+        Some(request)
     } else {
         cli.connect.map(|server| {
             let trust = Trust::from_args(cli.cert_hash, cli.known_hosts);
-            let request = ConnectRequest {
-                server,
-                // Only used when pinned (`trust` decides).
-                cert_fingerprint: cli.cert_hash.unwrap_or(Fingerprint([0; 32])),
-                player_name: cli.name.clone(),
-            };
-            (request, trust)
+            OnlineRequest {
+                level: cli.level.clone(),
+                ..OnlineRequest::new(&server, trust, &cli.name)
+            }
         })
     };
     let mut play = match request {
-        Some((request, trust)) => {
-            tracing::info!("connecting to {} ({trust})", request.server);
-            play::Play::online(request, trust, level, level_file)?
+        Some(request) => {
+            tracing::info!("connecting to {} ({})", request.server, request.trust);
+            play::Play::online(request, level)?
         }
         None => play::Play::offline(level, &cli.name)?,
     };
