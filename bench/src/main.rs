@@ -88,9 +88,17 @@ fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Tra
         .num_threads(k)
         .build()
         .expect("a thread pool");
+    let pool1 = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a thread pool");
     // Per timed tick: (update, search) of each side.
     let (mut one, mut many) = (Vec::new(), Vec::new());
     let (mut rounds, mut both) = (Vec::new(), Vec::new());
+    // The one-thread path on a worker thread (the scene is moved on this
+    // one, as a game moves its bodies before detecting), and the rayon path
+    // on one worker.
+    let (mut away, mut par1) = (Vec::new(), Vec::new());
     for _ in 0..a.rounds {
         // The machine's own ceiling: `k` independent one-thread runs at
         // once. Were the cores independent, each tick would take as long as
@@ -124,8 +132,10 @@ fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Tra
         one.extend_from_slice(&parts[a.warmup..]);
         parts.clear();
         let mut bp = BroadPhase::new(cfg);
-        let mut tk = trace(n, a, |s, out| {
-            pool.install(|| {
+        // The whole loop in the pool, as a game loop run by the pool: the
+        // bodies are moved on one of the workers.
+        let mut tk = pool.install(|| {
+            trace(n, a, |s, out| {
                 let u = time(|| bp.update_dynamic_par(&s.boxes));
                 let c = time(|| bp.contacts_aabb_par(out));
                 parts.push((u, c));
@@ -135,6 +145,28 @@ fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Tra
         check("rayon", n, reference, &tk, true);
         many.extend_from_slice(&parts[a.warmup..]);
         rounds.push(t1.median() / tk.median());
+        let mut bp = BroadPhase::new(cfg);
+        let t = trace(n, a, |s, out| {
+            pool1.install(|| {
+                time(|| {
+                    bp.update_dynamic(&s.boxes);
+                    bp.contacts_aabb(out);
+                })
+            })
+        });
+        check("one thread on a worker", n, reference, &t, true);
+        away.extend(t.ns);
+        let mut bp = BroadPhase::new(cfg);
+        let t = trace(n, a, |s, out| {
+            pool1.install(|| {
+                time(|| {
+                    bp.update_dynamic_par(&s.boxes);
+                    bp.contacts_aabb_par(out);
+                })
+            })
+        });
+        check("rayon on one thread", n, reference, &t, true);
+        par1.extend(t.ns);
     }
     let med = |v: &[(f64, f64)], f: fn(&(f64, f64)) -> f64| {
         median(&mut v.iter().map(f).collect::<Vec<_>>())
@@ -154,6 +186,14 @@ fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Tra
         fmt_ns(med(&many, |p| p.0)),
         fmt_ns(med(&one, |p| p.1)),
         fmt_ns(med(&many, |p| p.1)),
+    );
+    let (away, par1) = (median(&mut away), median(&mut par1));
+    println!(
+        "the one-thread path on a worker thread (input written by another): {}; \
+         the rayon path on one worker: {} ({k} threads against it: {:.2}x)",
+        fmt_ns(away),
+        fmt_ns(par1),
+        par1 / tk
     );
     let alongside = median(&mut both);
     println!(
