@@ -194,16 +194,14 @@ impl<T: Keyed> Buffers<T> {
             acc += *c;
             *c = acc;
         }
-        // `counts[b]`: next free slot of bucket `b`.
-        let next = &mut self.counts;
-        next.clear();
-        next.extend_from_slice(&starts[..nbk]);
+        // `starts[b]` is now where bucket `b` starts; it becomes the next
+        // free slot of the bucket as the pairs go in.
         out.resize(total, T::default());
         for buf in &self.bufs[..n] {
             for t in buf {
                 let b = bucket(t);
-                out[next[b] as usize] = *t;
-                next[b] += 1;
+                out[starts[b] as usize] = *t;
+                starts[b] += 1;
             }
         }
         // Buckets hold about a quarter of a pair each: one insertion sort
@@ -217,20 +215,31 @@ impl<T: Keyed> Buffers<T> {
 /// insertion sort, abandoned for a comparison sort once it has shifted
 /// more than a few elements per element (a crowded bucket).
 fn sort_nearly_sorted<T: Keyed>(v: &mut [T]) {
-    let budget = 4 * v.len() + 64;
+    sort_nearly_sorted_by_key(v, 4, Keyed::key);
+}
+
+/// Sorts `v` by `key` with an insertion sort, linear when every element is
+/// near its place, falling back to a comparison sort past `shifts` shifts
+/// per element.
+pub(crate) fn sort_nearly_sorted_by_key<T: Copy, K: Ord>(
+    v: &mut [T],
+    shifts: usize,
+    key: impl Fn(&T) -> K,
+) {
+    let budget = shifts * v.len() + 64;
     let mut steps = 0;
     for i in 1..v.len() {
         let x = v[i];
-        let k = x.key();
+        let k = key(&x);
         let mut j = i;
-        while j > 0 && v[j - 1].key() > k {
+        while j > 0 && key(&v[j - 1]) > k {
             v[j] = v[j - 1];
             j -= 1;
         }
         v[j] = x;
         steps += i - j;
         if steps > budget {
-            v.sort_unstable_by_key(Keyed::key);
+            v.sort_unstable_by_key(key);
             return;
         }
     }

@@ -504,7 +504,10 @@ impl Strips {
             use rayon::prelude::*;
             self.movers.par_sort_unstable_by_key(|m| m.key);
         } else {
-            self.movers.sort_unstable_by_key(|m| m.key);
+            // In the order of the strips they left, each for the strip
+            // before or after: every mover is within a few strips' movers
+            // of its place.
+            super::order::sort_nearly_sorted_by_key(&mut self.movers, 16, |m| m.key);
         }
         self.count = n;
         self.layout(par);
