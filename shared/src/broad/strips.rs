@@ -501,13 +501,11 @@ impl Strips {
             }
             c.rows = 0..0;
             self.chunks.truncate(1);
-        } else if par {
-            use rayon::prelude::*;
-            self.movers.par_sort_unstable_by_key(|m| m.key);
         } else {
-            // In the order of the strips they left, each for the strip
-            // before or after: every mover is within a few strips' movers
-            // of its place.
+            // In the order of the strips they left (chunks in order), each
+            // for the strip before or after: every mover is within a few
+            // strips' movers of its place. (A parallel sort of the few
+            // thousand movers of N = 100,000 took 66 µs.)
             super::order::sort_nearly_sorted_by_key(&mut self.movers, 16, |m| m.key);
         }
         self.count = n;
