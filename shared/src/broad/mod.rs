@@ -25,16 +25,16 @@
 //!   only the cost does.
 //! * **Determinism**: the output is sorted by `(first id, second id)` with
 //!   `first < second` (a bucket sort on the first id, then one bounded
-//!   insertion sort),
-//!   so it depends only on the input, never on thread count or scheduling.
+//!   insertion sort), so it depends only on the input, never on thread
+//!   count or scheduling.
 //!   The MTV in a contact moves the *first* (smaller id) body.
 //! * **No allocation per tick** in steady state: every buffer is kept and
 //!   reused.
 //! * **Parallel** (`*_par` methods): strips are cut into batches of about
 //!   equal box counts, run with rayon's work stealing into one buffer per
 //!   batch, then sorted into the canonical order (on one thread: cheap next
-//!   to the search); the dynamic update is cut the same way. The plain methods never touch
-//!   rayon. They use the *current* rayon pool, so a
+//!   to the search); the dynamic update is cut the same way. The plain
+//!   methods never touch rayon. They use the *current* rayon pool, so a
 //!   caller picks the thread count with
 //!   `rayon::ThreadPoolBuilder::new().num_threads(n).build()?.install(..)`.
 //!
