@@ -14,27 +14,11 @@ use ledge_shared::world::{
 };
 use proptest::prelude::*;
 
-/// Tile size: 16 px.
-const T: i32 = 4096;
+mod platformer_kit;
+use platformer_kit::{map, T};
+
 /// Gravity per tick, in units per tick.
 const G: i32 = 40;
-
-fn map(rows: &[&str]) -> Tilemap {
-    let w = rows[0].len() as u32;
-    let tiles = rows
-        .iter()
-        .flat_map(|r| {
-            r.chars().map(|ch| match ch {
-                '#' => Tile::Solid,
-                '=' => Tile::OneWay,
-                '/' => Tile::Slope(Slope::Right45),
-                '\\' => Tile::Slope(Slope::Left45),
-                _ => Tile::Empty,
-            })
-        })
-        .collect();
-    Tilemap::new(IVec2::ZERO, T, w, rows.len() as u32, tiles).unwrap()
-}
 
 /// The four non-box kinds the issue names, about one tile wide.
 fn shapes() -> Vec<(&'static str, AnyShape)> {
