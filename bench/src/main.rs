@@ -81,7 +81,9 @@ struct Args {
 /// `--only-par K`: our one-thread path and rayon on `k` threads in
 /// alternating passes over the scene, `a.rounds` of each, so that a burst of
 /// load on the machine hits both alike; prints the medians over all passes,
-/// the ratio of each round and the update/search split. `reference` is a
+/// the ratio of each round and the update/search split. Then both again on
+/// *paired ticks* (each tick runs both paths, in turn), which a burst of load
+/// lasting longer than a tick cannot favour either way. `reference` is a
 /// one-thread trace whose output every pass must match.
 fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Trace) {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -99,6 +101,8 @@ fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Tra
     // one, as a game moves its bodies before detecting), and the rayon path
     // on one worker.
     let (mut away, mut par1) = (Vec::new(), Vec::new());
+    // Paired ticks: (one thread, k threads) on the same tick.
+    let mut paired = Vec::new();
     for _ in 0..a.rounds {
         // The machine's own ceiling: `k` independent one-thread runs at
         // once. Were the cores independent, each tick would take as long as
@@ -145,6 +149,41 @@ fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Tra
         check("rayon", n, reference, &tk, true);
         many.extend_from_slice(&parts[a.warmup..]);
         rounds.push(t1.median() / tk.median());
+        // Paired ticks: both paths on the same tick, one after the other
+        // (which goes first alternates), on the worker that moved the
+        // boxes; a burst of load lasting longer than a tick hits both.
+        let (mut b1, mut bk) = (BroadPhase::new(cfg), BroadPhase::new(cfg));
+        let mut out_k = Contacts::new();
+        let mut tick = 0usize;
+        let t = pool.install(|| {
+            trace(n, a, |s, out| {
+                tick += 1;
+                let mut one = |out: &mut Contacts| {
+                    time(|| {
+                        b1.update_dynamic(&s.boxes);
+                        b1.contacts_aabb(out);
+                    })
+                };
+                let mut many = || {
+                    time(|| {
+                        bk.update_dynamic_par(&s.boxes);
+                        bk.contacts_aabb_par(&mut out_k);
+                    })
+                };
+                let (x, y) = if tick.is_multiple_of(2) {
+                    (one(out), many())
+                } else {
+                    let y = many();
+                    (one(out), y)
+                };
+                assert!(*out == out_k, "rayon differs from one thread at N={n}");
+                if tick > a.warmup {
+                    paired.push((x, y));
+                }
+                x
+            })
+        });
+        check("paired one thread", n, reference, &t, true);
         let mut bp = BroadPhase::new(cfg);
         let t = trace(n, a, |s, out| {
             pool1.install(|| {
@@ -186,6 +225,15 @@ fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Tra
         fmt_ns(med(&many, |p| p.0)),
         fmt_ns(med(&one, |p| p.1)),
         fmt_ns(med(&many, |p| p.1)),
+    );
+    let (p1, pk) = (med(&paired, |p| p.0), med(&paired, |p| p.1));
+    println!(
+        "paired ticks (both paths on every tick, in turn): serial {}, rayon {k} threads {} \
+         ({:.2}x; median of the per-tick ratios {:.2}x)",
+        fmt_ns(p1),
+        fmt_ns(pk),
+        p1 / pk,
+        med(&paired, |p| p.0 / p.1)
     );
     let (away, par1) = (median(&mut away), median(&mut par1));
     println!(

@@ -217,11 +217,13 @@ proptest! {
 
     #[test]
     fn ids_in_any_order(dynamics in boxes(80), seed in any::<u64>()) {
-        // Sparse, shuffled ids: the order is by id, not by input position.
+        // Sparse, shuffled ids over the whole `u32` range: the order is by
+        // id, not by input position, and the parallel sort's id parts span
+        // every id.
         let mut rng = SplitMix64(seed);
         let d: Vec<_> = dynamics
             .iter()
-            .map(|&b| ((rng.next_u64() >> 40) as u32, b))
+            .map(|&b| ((rng.next_u64() >> 32) as u32, b))
             .collect();
         let mut ids: Vec<_> = d.iter().map(|e| e.0).collect();
         ids.sort_unstable();

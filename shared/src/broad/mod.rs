@@ -51,7 +51,7 @@ mod strips;
 mod sweep;
 
 use glam::IVec2;
-use order::{Buffers, Keyed};
+use order::{Buffers, Keyed, Parts};
 use strips::{Levels, Strips};
 use sweep::Sink;
 
@@ -157,6 +157,10 @@ impl Default for BroadPhaseConfig {
         }
     }
 }
+
+/// Id-range parts per thread of the parallel output sort: a few, so that
+/// work stealing evens out parts of unequal sizes.
+const PARTS_PER_THREAD: usize = 4;
 
 /// What one batch of work covers.
 #[derive(Debug, Clone, Copy)]
@@ -340,20 +344,30 @@ impl BroadPhase {
         }
         let work = &self.work;
         let bufs = <Self as HasBuffers<T>>::buffers(&mut self.pairs, &mut self.contacts);
-        bufs.prepare(n);
-        let job = |(w, buf): (&Work, &mut Vec<T>)| {
-            let mut sink = Emit { out: buf, kernel };
+        let parts = if par {
+            PARTS_PER_THREAD * rayon::current_num_threads()
+        } else {
+            1
+        };
+        let (item_bufs, split) = bufs.prepare(n, parts, id_lo, id_hi);
+        let job = |(w, out): (&Work, &mut [Vec<T>])| {
+            let mut sink = Emit {
+                out: Parts::new(out, split),
+                kernel,
+            };
             run_work(lv, dy, st, *w, &mut sink);
         };
         if par {
             use rayon::prelude::*;
             work.par_iter()
-                .zip(bufs.bufs[..n].par_iter_mut())
+                .zip(item_bufs.par_chunks_mut(split.parts))
                 .for_each(job);
         } else {
-            work.iter().zip(bufs.bufs[..n].iter_mut()).for_each(job);
+            work.iter()
+                .zip(item_bufs.chunks_mut(split.parts))
+                .for_each(job);
         }
-        bufs.finish(n, id_lo, id_hi, out);
+        bufs.finish(out, par);
     }
 
     /// Cuts the work into batches: one of each kind on one thread; batches of
@@ -444,19 +458,19 @@ impl HasBuffers<(u32, u32, IVec2)> for BroadPhase {
 /// What an overlapping pair becomes.
 trait Kernel<T>: Sync {
     /// Pushes the output for entry `i` of `a` and entry `j` of `b`, if any.
-    fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Vec<T>);
+    fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Parts<'_, T>);
 }
 
 /// A sink writing one kernel's output into one buffer.
 struct Emit<'a, T, K> {
-    out: &'a mut Vec<T>,
+    out: Parts<'a, T>,
     kernel: &'a K,
 }
 
-impl<T, K: Kernel<T>> Sink for Emit<'_, T, K> {
+impl<T: Keyed, K: Kernel<T>> Sink for Emit<'_, T, K> {
     #[inline(always)]
     fn hit(&mut self, a: &Strips, i: usize, b: &Strips, j: usize) {
-        self.kernel.pair(a, i, b, j, self.out);
+        self.kernel.pair(a, i, b, j, &mut self.out);
     }
 }
 
@@ -465,7 +479,7 @@ struct PairKernel;
 
 impl Kernel<(u32, u32)> for PairKernel {
     #[inline(always)]
-    fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Vec<(u32, u32)>) {
+    fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Parts<'_, (u32, u32)>) {
         let (x, y) = (a.id[i], b.id[j]);
         out.push(if x < y { (x, y) } else { (y, x) });
     }
@@ -476,7 +490,14 @@ struct AabbKernel;
 
 impl Kernel<(u32, u32, IVec2)> for AabbKernel {
     #[inline(always)]
-    fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Vec<(u32, u32, IVec2)>) {
+    fn pair(
+        &self,
+        a: &Strips,
+        i: usize,
+        b: &Strips,
+        j: usize,
+        out: &mut Parts<'_, (u32, u32, IVec2)>,
+    ) {
         let ba = (a.minx[i], a.maxx[i], a.miny[i], a.maxy[i]);
         let bb = (b.minx[j], b.maxx[j], b.miny[j], b.maxy[j]);
         let (x, y) = (a.id[i], b.id[j]);
@@ -496,7 +517,14 @@ where
     F: Fn(u32, u32) -> Option<IVec2> + Sync,
 {
     #[inline(always)]
-    fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Vec<(u32, u32, IVec2)>) {
+    fn pair(
+        &self,
+        a: &Strips,
+        i: usize,
+        b: &Strips,
+        j: usize,
+        out: &mut Parts<'_, (u32, u32, IVec2)>,
+    ) {
         let (x, y) = (a.id[i], b.id[j]);
         let (x, y) = if x < y { (x, y) } else { (y, x) };
         if let Some(m) = (self.0)(x, y) {
