@@ -235,6 +235,15 @@ fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Tra
         p1 / pk,
         med(&paired, |p| p.0 / p.1)
     );
+    // Fastest ticks: noise on this kind of machine only ever adds time.
+    let fastest = |v: &[(f64, f64)]| v.iter().map(|p| p.0 + p.1).fold(f64::INFINITY, f64::min);
+    let (f1, fk) = (fastest(&one), fastest(&many));
+    println!(
+        "fastest ticks: serial {}, rayon {k} threads {} ({:.2}x)",
+        fmt_ns(f1),
+        fmt_ns(fk),
+        f1 / fk
+    );
     let (away, par1) = (median(&mut away), median(&mut par1));
     println!(
         "the one-thread path on a worker thread (input written by another): {}; \
