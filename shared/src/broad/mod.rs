@@ -31,9 +31,11 @@
 //! * **No allocation per tick** in steady state: every buffer is kept and
 //!   reused.
 //! * **Parallel** (`*_par` methods): strips are cut into batches of about
-//!   equal box counts, run with rayon's work stealing into one buffer per
-//!   batch, then sorted into the canonical order (on one thread: cheap next
-//!   to the search); the dynamic update is cut the same way. The plain
+//!   equal box counts, run with rayon's work stealing; a batch files each
+//!   pair under its first id's range (a few ranges per thread), and the
+//!   ranges are then sorted into the canonical order in parallel, each into
+//!   its own slice of the output. The dynamic update is cut into chunks the
+//!   same way (each chunk also sorts its own movers). The plain
 //!   methods never touch rayon. They use the *current* rayon pool, so a
 //!   caller picks the thread count with
 //!   `rayon::ThreadPoolBuilder::new().num_threads(n).build()?.install(..)`.
