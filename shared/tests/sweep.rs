@@ -27,6 +27,9 @@ use ledge_shared::tilemap::{ContactFlags, Slope, Tile, TileContact, Tilemap};
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseResult;
 
+mod platformer_kit;
+use platformer_kit::map_at;
+
 // ------------------------------------------------------------------ helpers
 
 fn v(x: i32, y: i32) -> IVec2 {
@@ -875,30 +878,7 @@ proptest! {
 
 const T: i32 = 16;
 
-fn map_of(origin: IVec2, t: i32, rows: &[&str]) -> Tilemap {
-    let h = rows.len() as u32;
-    let wd = rows[0].len() as u32;
-    let tiles = rows
-        .iter()
-        .flat_map(|r| {
-            r.chars().map(|c| match c {
-                '#' => Tile::Solid,
-                '-' => Tile::OneWay,
-                '^' => Tile::Hazard,
-                '/' => Tile::Slope(Slope::Right45),
-                '\\' => Tile::Slope(Slope::Left45),
-                'a' => Tile::Slope(Slope::RightLow22),
-                'b' => Tile::Slope(Slope::RightHigh22),
-                'c' => Tile::Slope(Slope::LeftHigh22),
-                'd' => Tile::Slope(Slope::LeftLow22),
-                _ => Tile::Empty,
-            })
-        })
-        .collect();
-    Tilemap::new(origin, t, wd, h, tiles).unwrap()
-}
-
-/// The map as text (the `map_of` characters), for failure messages.
+/// The map as text (the `map_at` characters), for failure messages.
 fn render(m: &Tilemap) -> String {
     let mut out = format!("origin {} size {}:", m.origin(), m.tile_size());
     for (i, t) in m.tiles().iter().enumerate() {
@@ -937,7 +917,7 @@ fn pushes(
 
 #[test]
 fn tile_floor_wall_and_seams() {
-    let m = map_of(
+    let m = map_at(
         v(-1000, 300),
         256,
         &["........", "......#.", "......#.", "########"],
@@ -981,7 +961,7 @@ fn tile_floor_wall_and_seams() {
 
 #[test]
 fn tile_one_way_platforms() {
-    let m = map_of(v(0, 0), T, &["......", "..--..", "......", "......"]);
+    let m = map_at(v(0, 0), T, &["......", "..--..", "......", "......"]);
     let b = Aabb::new(v(5, 4)).unwrap();
     let top = T;
     let flags = ContactFlags::default();
@@ -1008,7 +988,7 @@ fn tile_one_way_platforms() {
 #[test]
 fn tile_slopes_and_plateaus() {
     // Floor, a 45-degree ramp up to a plateau, and a 22.5-degree ramp down.
-    let m = map_of(
+    let m = map_at(
         v(0, 0),
         T,
         &["..........", "..../##cd.", "...//####.", "##########"],
@@ -1065,7 +1045,7 @@ fn tile_slopes_and_plateaus() {
 #[test]
 fn tile_boxes_resting_on_ramps_never_fall_through() {
     // Both 22.5-degree ramps and both 45-degree slopes, on solid ground.
-    let m = map_of(v(-5, 3), T, &["..........", ".ab/..\\cd.", "##########"]);
+    let m = map_at(v(-5, 3), T, &["..........", ".ab/..\\cd.", "##########"]);
     let flags = ContactFlags::default();
     for half in [v(1, 1), v(3, 5), v(8, 2)] {
         let b = Aabb::new(half).unwrap();
@@ -1097,7 +1077,7 @@ fn tile_boxes_resting_on_ramps_never_fall_through() {
 
 #[test]
 fn tile_hazards_are_ignored() {
-    let m = map_of(v(0, 0), T, &["....", "^^^^", "...."]);
+    let m = map_at(v(0, 0), T, &["....", "^^^^", "...."]);
     let b = Aabb::new(v(4, 4)).unwrap();
     assert_eq!(
         sweep_tiles(&m, &b, v(20, 0), w(0, 60), ContactFlags::default()),
@@ -1248,7 +1228,7 @@ proptest! {
         let half = v(half.0, half.1);
         let b = Aabb::new(half).unwrap();
         let row: String = std::iter::repeat_n(kind, 4).collect();
-        let m = map_of(v(ox, 0), 256, &["....", &row, "...."]);
+        let m = map_at(v(ox, 0), 256, &["....", &row, "...."]);
         let flags = ContactFlags::default();
         if down || kind == '-' {
             // Falling from the top of the world to the bottom.
@@ -1266,7 +1246,7 @@ proptest! {
             prop_assert_eq!(h.hit.stop.y - half.y, 512);
         }
         // Sideways through a wall column.
-        let m = map_of(v(ox, 0), 256, &[".#..", ".#..", ".#.."]);
+        let m = map_at(v(ox, 0), 256, &[".#..", ".#..", ".#.."]);
         let start = v(-MAX_COORD + (1 << 16), 300);
         let h = sweep_tiles(&m, &b, start, w(2 * MAX_COORD as i64 - (1 << 17), 0), flags).expect("stopped by the wall");
         prop_assert_eq!((h.hit.normal, h.hit.stop.x + half.x), (w(-1, 0), ox + 256));

@@ -12,6 +12,9 @@ use ledge_shared::fixed::{px, MAX_COORD};
 use ledge_shared::tilemap::{ContactFlags, Slope, Tile, TileContact, Tilemap, TilemapError};
 use std::cmp::Reverse;
 
+mod platformer_kit;
+use platformer_kit::map_at;
+
 /// 16 px tiles.
 const T: i32 = px(16);
 
@@ -27,27 +30,9 @@ const ORIGINS: [IVec2; 2] = [
     IVec2::new(MAX_COORD - 40 * T - 5, -MAX_COORD + 3),
 ];
 
-fn tile(ch: char) -> Tile {
-    match ch {
-        '.' => Tile::Empty,
-        '#' => Tile::Solid,
-        '-' => Tile::OneWay,
-        '^' => Tile::Hazard,
-        '/' => Tile::Slope(Slope::Right45),
-        '\\' => Tile::Slope(Slope::Left45),
-        'a' => Tile::Slope(Slope::RightLow22),
-        'b' => Tile::Slope(Slope::RightHigh22),
-        'c' => Tile::Slope(Slope::LeftHigh22),
-        'd' => Tile::Slope(Slope::LeftLow22),
-        _ => panic!("bad tile {ch:?}"),
-    }
-}
-
+/// A tilemap with its top-left corner at `origin` and tiles of [`T`].
 fn map(origin: IVec2, rows: &[&str]) -> Tilemap {
-    let w = rows[0].len();
-    assert!(rows.iter().all(|r| r.len() == w));
-    let tiles = rows.iter().flat_map(|r| r.chars().map(tile)).collect();
-    Tilemap::new(origin, T, w as u32, rows.len() as u32, tiles).unwrap()
+    map_at(origin, T, rows)
 }
 
 /// World x of column `c`'s left edge, y of row `r`'s top edge.

@@ -20,31 +20,41 @@ pub const JUMP: Buttons = Buttons(Buttons::JUMP);
 pub const DOWN_JUMP: Buttons = Buttons(Buttons::DOWN | Buttons::JUMP);
 pub const RIGHT_JUMP: Buttons = Buttons(Buttons::RIGHT | Buttons::JUMP);
 
-/// A tilemap at the origin from rows of characters: `.` empty, `#` solid,
-/// `=` one-way, `^` hazard, `/` and `\` 45 degree slopes, `a b` a 22.5
-/// degree ramp rising right (low, high), `c d` one rising left (high, low).
-pub fn map(rows: &[&str]) -> Tilemap {
+/// The tile of one map character: `.` empty, `#` solid, `=` or `-` one-way,
+/// `^` hazard, `/` and `\` 45 degree slopes, `a b` a 22.5 degree ramp rising
+/// right (low, high), `c d` one rising left (high, low). Panics on any other
+/// character, so that a typo in a map fails loudly.
+pub fn tile(ch: char) -> Tile {
+    match ch {
+        '.' => Tile::Empty,
+        '#' => Tile::Solid,
+        '=' | '-' => Tile::OneWay,
+        '^' => Tile::Hazard,
+        '/' => Tile::Slope(Slope::Right45),
+        '\\' => Tile::Slope(Slope::Left45),
+        'a' => Tile::Slope(Slope::RightLow22),
+        'b' => Tile::Slope(Slope::RightHigh22),
+        'c' => Tile::Slope(Slope::LeftHigh22),
+        'd' => Tile::Slope(Slope::LeftLow22),
+        _ => panic!("unknown tile {ch:?}"),
+    }
+}
+
+/// A tilemap from rows of characters ([`tile`]) with its top-left corner at
+/// `origin` and tiles of `size` units.
+pub fn map_at(origin: IVec2, size: i32, rows: &[&str]) -> Tilemap {
     let w = rows[0].len();
-    let mut tiles = Vec::new();
     for r in rows {
         assert_eq!(r.len(), w, "ragged map row {r:?}");
-        for ch in r.chars() {
-            tiles.push(match ch {
-                '.' => Tile::Empty,
-                '#' => Tile::Solid,
-                '=' => Tile::OneWay,
-                '^' => Tile::Hazard,
-                '/' => Tile::Slope(Slope::Right45),
-                '\\' => Tile::Slope(Slope::Left45),
-                'a' => Tile::Slope(Slope::RightLow22),
-                'b' => Tile::Slope(Slope::RightHigh22),
-                'c' => Tile::Slope(Slope::LeftHigh22),
-                'd' => Tile::Slope(Slope::LeftLow22),
-                _ => panic!("unknown tile {ch:?}"),
-            });
-        }
     }
-    Tilemap::new(IVec2::ZERO, T, w as u32, rows.len() as u32, tiles).unwrap()
+    let tiles = rows.iter().flat_map(|r| r.chars().map(tile)).collect();
+    Tilemap::new(origin, size, w as u32, rows.len() as u32, tiles).unwrap()
+}
+
+/// A tilemap at the origin with tiles of [`T`] from rows of characters
+/// ([`tile`]).
+pub fn map(rows: &[&str]) -> Tilemap {
+    map_at(IVec2::ZERO, T, rows)
 }
 
 /// Centre of tile `(c, r)`.
