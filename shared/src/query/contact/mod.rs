@@ -53,6 +53,8 @@ mod segment_circle;
 mod segment_obb;
 mod segment_polygon;
 mod segment_segment;
+#[cfg(test)]
+mod testing;
 
 #[cfg(test)]
 pub(crate) use sat::sat;

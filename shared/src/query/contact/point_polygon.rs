@@ -6,37 +6,9 @@ super::sat_contact!(Point, ConvexPolygon);
 
 #[cfg(test)]
 mod tests {
-    use crate::fixed::MAX_COORD;
-    use crate::query::contact::{
-        contact, Contact,
-        Proximity::{self, *},
-    };
+    use crate::query::contact::testing::{check, v};
+    use crate::query::contact::{contact, Proximity::*};
     use crate::shape::{ConvexPolygon, Point};
-    use glam::IVec2;
-
-    fn v(x: i32, y: i32) -> IVec2 {
-        IVec2::new(x, y)
-    }
-
-    /// Far from the origin, near the world bounds.
-    const FAR: IVec2 = IVec2::new(MAX_COORD - (1 << 20), -(MAX_COORD - (1 << 21)));
-
-    /// `a` against `b` is `want`, the reverse order is `want` reversed, and
-    /// both hold anywhere in the world.
-    fn check<A: Contact<B>, B: Contact<A>>(a: &A, pa: IVec2, b: &B, pb: IVec2, want: Proximity) {
-        for t in [IVec2::ZERO, FAR, -FAR] {
-            assert_eq!(
-                contact(a, pa + t, b, pb + t),
-                want,
-                "a at {pa}, b at {pb}, shifted by {t}"
-            );
-            assert_eq!(
-                contact(b, pb + t, a, pa + t),
-                want.reversed(),
-                "reverse: a at {pa}, b at {pb}, shifted by {t}"
-            );
-        }
-    }
 
     /// Right triangle (0,0), (100,0), (0,100): legs on x = 0 and y = 0,
     /// hypotenuse x + y = 100.
