@@ -81,6 +81,31 @@ fn stomping_a_walker_bounces_and_defeats_it() {
     panic!("never stomped");
 }
 
+/// Walks right (at most `ticks` ticks) into a hazard tile: hurt by the
+/// tile, then respawned at `respawn`, in that tick's events.
+fn walk_into_hazard_tile(s: &mut Sim, ticks: u32, respawn: IVec2) {
+    for _ in 0..ticks {
+        s.step(RIGHT);
+        if s.saw(|e| matches!(e, GameEvent::Hurt { .. })) {
+            assert_eq!(
+                s.events,
+                vec![
+                    GameEvent::Hurt {
+                        player: P1,
+                        cause: HurtCause::HazardTile
+                    },
+                    GameEvent::Respawned {
+                        player: P1,
+                        pos: respawn
+                    }
+                ]
+            );
+            return;
+        }
+    }
+    panic!("not hurt in {ticks} ticks, at {}", s.pos());
+}
+
 #[test]
 fn a_walker_walking_into_the_player_hurts_it() {
     let lv = room(
@@ -287,28 +312,7 @@ fn a_checkpoint_changes_the_respawn_point_and_hazards_hurt() {
     s.land(5);
     let spawn = s.pos();
     // Walk into the first hazard tile: back to the spawn.
-    let mut hurt = false;
-    for _ in 0..200 {
-        s.step(RIGHT);
-        if s.saw(|e| matches!(e, GameEvent::Hurt { .. })) {
-            assert_eq!(
-                s.events,
-                vec![
-                    GameEvent::Hurt {
-                        player: P1,
-                        cause: HurtCause::HazardTile
-                    },
-                    GameEvent::Respawned {
-                        player: P1,
-                        pos: spawn
-                    }
-                ]
-            );
-            hurt = true;
-            break;
-        }
-    }
-    assert!(hurt);
+    walk_into_hazard_tile(&mut s, 200, spawn);
     // Jump over it and reach the checkpoint.
     let mut reached = false;
     for t in 0..400 {
@@ -333,28 +337,7 @@ fn a_checkpoint_changes_the_respawn_point_and_hazards_hurt() {
     let checkpoint = IVec2::new(20 * T + T / 2, FLOOR - s.view().half.y);
     // The next hazard tile sends it to the checkpoint, without a new
     // checkpoint event.
-    let mut hurt = false;
-    for _ in 0..300 {
-        s.step(RIGHT);
-        if s.saw(|e| matches!(e, GameEvent::Hurt { .. })) {
-            assert_eq!(
-                s.events,
-                vec![
-                    GameEvent::Hurt {
-                        player: P1,
-                        cause: HurtCause::HazardTile
-                    },
-                    GameEvent::Respawned {
-                        player: P1,
-                        pos: checkpoint
-                    }
-                ]
-            );
-            hurt = true;
-            break;
-        }
-    }
-    assert!(hurt);
+    walk_into_hazard_tile(&mut s, 300, checkpoint);
     // Jump over the hazard tile: the hazard volume hurts too.
     let mut hurt = false;
     let mut jump = None;
