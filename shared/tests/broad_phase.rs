@@ -405,6 +405,37 @@ fn standard_scene_over_ticks() {
 }
 
 #[test]
+fn many_pairs_sort_in_parallel_like_on_one_thread() {
+    // Enough pairs (about 4,700) that the parallel paths sort their output
+    // in parallel, by id-range parts; the one-thread output is checked
+    // against brute force on the last tick.
+    let mut scene = StandardScene::new(20_000, 5);
+    let mut bp = BroadPhase::default();
+    let (mut one, mut many, mut pairs) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..3 {
+        scene.step();
+        bp.update_dynamic(&scene.boxes);
+        bp.contacts_aabb(&mut one);
+        assert!(one.len() > 4096, "{} pairs", one.len());
+        for pool in &pools()[1..] {
+            pool.install(|| {
+                bp.update_dynamic_par(&scene.boxes);
+                bp.contacts_aabb_par(&mut many);
+                bp.find_pairs_par(&mut pairs);
+            });
+            assert_eq!(many, one, "{} threads", pool.current_num_threads());
+            assert!(pairs
+                .iter()
+                .map(|p| (p.0, p.1))
+                .eq(one.iter().map(|c| (c.0, c.1))));
+        }
+    }
+    let mut expect = Vec::new();
+    brute_force(&[], &scene.boxes, &mut expect);
+    assert_eq!(one, expect);
+}
+
+#[test]
 fn parallel_update_over_ticks() {
     // Only parallel updates, on 2 and 8 threads, small batches.
     for pool in &pools()[1..] {
