@@ -463,7 +463,7 @@ trait Kernel<T>: Sync {
     fn pair(&self, a: &Strips, i: usize, b: &Strips, j: usize, out: &mut Parts<'_, T>);
 }
 
-/// A sink writing one kernel's output into one buffer.
+/// A sink writing one kernel's output into one work item's part buffers.
 struct Emit<'a, T, K> {
     out: Parts<'a, T>,
     kernel: &'a K,
