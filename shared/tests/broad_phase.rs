@@ -424,10 +424,7 @@ fn many_pairs_sort_in_parallel_like_on_one_thread() {
                 bp.find_pairs_par(&mut pairs);
             });
             assert_eq!(many, one, "{} threads", pool.current_num_threads());
-            assert!(pairs
-                .iter()
-                .map(|p| (p.0, p.1))
-                .eq(one.iter().map(|c| (c.0, c.1))));
+            assert!(pairs.iter().copied().eq(one.iter().map(|c| (c.0, c.1))));
         }
     }
     let mut expect = Vec::new();
