@@ -81,19 +81,16 @@ fn stomping_a_walker_bounces_and_defeats_it() {
     panic!("never stomped");
 }
 
-/// Walks right (at most `ticks` ticks) into a hazard tile: hurt by the
-/// tile, then respawned at `respawn`, in that tick's events.
-fn walk_into_hazard_tile(s: &mut Sim, ticks: u32, respawn: IVec2) {
+/// Walks right (at most `ticks` ticks) until hurt: hurt by `cause`, then
+/// respawned at `respawn`, in that tick's events.
+fn walk_until_hurt(s: &mut Sim, ticks: u32, cause: HurtCause, respawn: IVec2) {
     for _ in 0..ticks {
         s.step(RIGHT);
         if s.saw(|e| matches!(e, GameEvent::Hurt { .. })) {
             assert_eq!(
                 s.events,
                 vec![
-                    GameEvent::Hurt {
-                        player: P1,
-                        cause: HurtCause::HazardTile
-                    },
+                    GameEvent::Hurt { player: P1, cause },
                     GameEvent::Respawned {
                         player: P1,
                         pos: respawn
@@ -116,27 +113,8 @@ fn a_walker_walking_into_the_player_hurts_it() {
     s.land(5);
     let spawn = s.pos();
     // Walk towards the walker (which walks left, towards the player).
-    for _ in 0..300 {
-        s.step(RIGHT);
-        if s.saw(|e| matches!(e, GameEvent::Hurt { .. })) {
-            assert_eq!(
-                s.events,
-                vec![
-                    GameEvent::Hurt {
-                        player: P1,
-                        cause: HurtCause::Enemy(id_of(0))
-                    },
-                    GameEvent::Respawned {
-                        player: P1,
-                        pos: spawn
-                    }
-                ]
-            );
-            assert!(walker_view(&s, 0).active, "hurting does not defeat");
-            return;
-        }
-    }
-    panic!("never hurt");
+    walk_until_hurt(&mut s, 300, HurtCause::Enemy(id_of(0)), spawn);
+    assert!(walker_view(&s, 0).active, "hurting does not defeat");
 }
 
 #[test]
@@ -312,7 +290,7 @@ fn a_checkpoint_changes_the_respawn_point_and_hazards_hurt() {
     s.land(5);
     let spawn = s.pos();
     // Walk into the first hazard tile: back to the spawn.
-    walk_into_hazard_tile(&mut s, 200, spawn);
+    walk_until_hurt(&mut s, 200, HurtCause::HazardTile, spawn);
     // Jump over it and reach the checkpoint.
     let mut reached = false;
     for t in 0..400 {
@@ -337,7 +315,7 @@ fn a_checkpoint_changes_the_respawn_point_and_hazards_hurt() {
     let checkpoint = IVec2::new(20 * T + T / 2, FLOOR - s.view().half.y);
     // The next hazard tile sends it to the checkpoint, without a new
     // checkpoint event.
-    walk_into_hazard_tile(&mut s, 300, checkpoint);
+    walk_until_hurt(&mut s, 300, HurtCause::HazardTile, checkpoint);
     // Jump over the hazard tile: the hazard volume hurts too.
     let mut hurt = false;
     let mut jump = None;
