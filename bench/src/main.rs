@@ -184,26 +184,28 @@ fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Tra
             })
         });
         check("paired one thread", n, reference, &t, true);
-        let mut bp = BroadPhase::new(cfg);
-        let t = trace(n, a, |s, out| {
-            pool1.install(|| {
-                time(|| {
-                    bp.update_dynamic(&s.boxes);
-                    bp.contacts_aabb(out);
+        // Each tick handed to the one worker of `pool1`, by the plain path
+        // or the rayon path.
+        let on_worker = |par: bool| {
+            let mut bp = BroadPhase::new(cfg);
+            trace(n, a, |s, out| {
+                pool1.install(|| {
+                    time(|| {
+                        if par {
+                            bp.update_dynamic_par(&s.boxes);
+                            bp.contacts_aabb_par(out);
+                        } else {
+                            bp.update_dynamic(&s.boxes);
+                            bp.contacts_aabb(out);
+                        }
+                    })
                 })
             })
-        });
+        };
+        let t = on_worker(false);
         check("one thread on a worker", n, reference, &t, true);
         away.extend(t.ns);
-        let mut bp = BroadPhase::new(cfg);
-        let t = trace(n, a, |s, out| {
-            pool1.install(|| {
-                time(|| {
-                    bp.update_dynamic_par(&s.boxes);
-                    bp.contacts_aabb_par(out);
-                })
-            })
-        });
+        let t = on_worker(true);
         check("rayon on one thread", n, reference, &t, true);
         par1.extend(t.ns);
     }
