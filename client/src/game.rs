@@ -421,7 +421,7 @@ mod tests {
 
     #[test]
     fn names_follow_the_roster_and_stay_bounded() {
-        let level = ledge_shared::level::default_level();
+        let level = ledge_levels::default_level();
         let mut game = ClientGame::offline(level, Instant::now()).unwrap();
         game.on_player_joined(PlayerId(7), "bo");
         game.on_player_joined(PlayerId(7), "bob");

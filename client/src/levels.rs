@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use ledge_shared::level::{self, Level};
+use ledge_shared::level::Level;
 use ledge_shared::protocol::Welcome;
 
 use crate::error::ClientError;
@@ -28,11 +28,11 @@ pub fn level_hash(level: &Level) -> u64 {
 pub fn level_for(welcome: &Welcome, file: Option<&Path>) -> Result<Level, ClientError> {
     let (level, source) = match file {
         Some(path) => (
-            level::load_file(path).map_err(|e| ClientError::Level(e.to_string()))?,
+            ledge_levels::load_file(path).map_err(|e| ClientError::Level(e.to_string()))?,
             path.display().to_string(),
         ),
         None => (
-            level::default_level(),
+            ledge_levels::default_level(),
             "the embedded default level".to_owned(),
         ),
     };

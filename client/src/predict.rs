@@ -357,7 +357,7 @@ impl Predictor {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ledge_shared::level::default_level;
+    use ledge_levels::default_level;
 
     fn buttons(t: u64) -> Buttons {
         Buttons(match t % 90 {

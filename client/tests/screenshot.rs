@@ -13,11 +13,11 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use ledge_client::{connect, Session};
+use ledge_levels::default_level;
 use ledge_server::{Server, ServerConfig};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
-use ledge_shared::level::default_level;
 use ledge_shared::tilemap::Tile;
 use serde_json::Value;
 

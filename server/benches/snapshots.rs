@@ -152,7 +152,7 @@ struct RealGame {
 
 impl RealGame {
     fn new() -> RealGame {
-        let level = ledge_shared::level::default_level();
+        let level = ledge_levels::default_level();
         let mut game = Game::from_level(&level).expect("the default level plays");
         for p in 1..=CLIENTS as u32 {
             game.add_player(PlayerId(p)).unwrap();

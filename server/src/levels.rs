@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use ledge_shared::level::{self, Level};
+use ledge_shared::level::Level;
 use ledge_shared::protocol::{check_text, MAX_ID_LEN};
 
 /// Why the level could not be loaded.
@@ -20,10 +20,10 @@ pub enum LevelLoadError {
 }
 
 /// Loads `path` (OGMO `.json` or Tiled `.tmx`, see
-/// [`ledge_shared::level::load_file`]), or the embedded default level.
+/// [`ledge_levels::load_file`]), or the embedded default level.
 pub fn load(path: Option<&Path>) -> Result<Level, LevelLoadError> {
     match path {
-        Some(path) => level::load_file(path).map_err(|e| LevelLoadError::Load {
+        Some(path) => ledge_levels::load_file(path).map_err(|e| LevelLoadError::Load {
             path: path.display().to_string(),
             message: e.to_string(),
         }),
@@ -33,7 +33,7 @@ pub fn load(path: Option<&Path>) -> Result<Level, LevelLoadError> {
 
 /// The embedded default level.
 pub fn default_level() -> Level {
-    level::default_level()
+    ledge_levels::default_level()
 }
 
 /// The level's id as sent in `Welcome`: its name, or `"level"` when the name

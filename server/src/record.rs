@@ -193,7 +193,7 @@ impl Recorder {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ledge_shared::level::default_level;
+    use ledge_levels::default_level;
 
     fn game() -> Game {
         Game::from_level(&default_level()).unwrap()

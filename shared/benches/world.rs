@@ -24,9 +24,9 @@
 
 use std::time::{Duration, Instant};
 
+use ledge_levels::default_level;
 use ledge_shared::game::{Game, GameConfig};
 use ledge_shared::input::Buttons;
-use ledge_shared::level::default_level;
 use ledge_shared::protocol::PlayerId;
 use ledge_shared::scene::{scripted_inputs, warmup_room_with};
 use ledge_shared::world::{scenes, BroadPhaseKind, DetectionStats, Pipeline, SimConfig, World};

@@ -349,7 +349,7 @@ fn platforms_follow_the_tick_exactly() {
 
 #[test]
 fn the_default_level_runs() {
-    let lv = ledge_shared::level::default_level();
+    let lv = ledge_levels::default_level();
     let mut g = Game::from_level(&lv).unwrap();
     g.add_player(PlayerId(1)).unwrap();
     let mut grounded = false;

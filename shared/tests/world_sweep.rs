@@ -815,7 +815,7 @@ fn run_start_area(
     let mut config = GameConfig::default();
     config.player.shape = shape;
     config.sim.sweep = sweep;
-    let mut game = Game::with_config(&ledge_shared::level::default_level(), config).unwrap();
+    let mut game = Game::with_config(&ledge_levels::default_level(), config).unwrap();
     let id = PlayerId(1);
     game.add_player(id).unwrap();
     let (mut pos, mut hashes) = (Vec::new(), Vec::new());

@@ -19,10 +19,10 @@
 use std::sync::Arc;
 
 use glam::IVec2;
+use ledge_levels::default_level;
 use ledge_shared::fixed::px;
 use ledge_shared::game::{Game, GameConfig};
 use ledge_shared::input::Buttons;
-use ledge_shared::level::default_level;
 use ledge_shared::protocol::PlayerId;
 use ledge_shared::scene::{scripted_inputs, warmup_room_with};
 use ledge_shared::shape::{Aabb, Circle, ShapeKind};

@@ -21,9 +21,9 @@
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
+use ledge_levels::default_level;
 use ledge_shared::game::{Game, GameConfig};
 use ledge_shared::input::Buttons;
-use ledge_shared::level::default_level;
 use ledge_shared::protocol::PlayerId;
 use ledge_shared::scene::scripted_inputs;
 use ledge_shared::world::{scenes, SimConfig};

@@ -341,7 +341,7 @@ impl PredictedClient {
         let session = connect(addr, "localhost", server.fingerprint, name)
             .await
             .unwrap_or_else(|e| panic!("{name} is welcomed: {e}"));
-        let level = ledge_shared::level::default_level();
+        let level = ledge_levels::default_level();
         let mut game = ClientGame::new(
             session.welcome(),
             level,

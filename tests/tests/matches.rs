@@ -6,11 +6,12 @@ use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use ledge_client::bot::{RandomWalker, Runner};
+use ledge_levels::{default_level, default_route};
 use ledge_server::record::Change;
 use ledge_shared::game::state::{kind, player_flags};
 use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
-use ledge_shared::level::{default_level, default_route, EntityKind};
+use ledge_shared::level::EntityKind;
 use ledge_tests::e2e::{bot_options, spawn_bot, watch};
 use ledge_tests::TestServer;
 

@@ -16,8 +16,8 @@ use ledge_client::interp::Interpolator;
 use ledge_client::netstats::StatsTracker;
 use ledge_client::view::px2;
 use ledge_client::view::Vec2;
+use ledge_levels::default_level;
 use ledge_shared::game::Game;
-use ledge_shared::level::default_level;
 use ledge_shared::protocol::{PlayerId, StateSnapshot};
 
 const RATE: f64 = 60.0;

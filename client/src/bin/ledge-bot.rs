@@ -31,7 +31,7 @@ use ledge_client::bot::{
 use ledge_client::transport::resolve;
 use ledge_client::trust::{KnownHosts, Trust};
 use ledge_client::Fingerprint;
-use ledge_shared::level::default_route;
+use ledge_levels::default_route;
 
 /// Which brain the bots run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

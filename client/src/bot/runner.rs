@@ -126,7 +126,7 @@ pub struct Runner {
 }
 
 impl Runner {
-    /// A runner for `route` (e.g. [`ledge_shared::level::default_route`]).
+    /// A runner for `route` (e.g. [`ledge_levels::default_route`]).
     pub fn new(route: Vec<Waypoint>) -> Runner {
         Runner {
             route,
@@ -475,7 +475,8 @@ impl Brain for Runner {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ledge_shared::level::{default_level, default_route, EntityKind, Level};
+    use ledge_levels::{default_level, default_route};
+    use ledge_shared::level::{EntityKind, Level};
 
     const PX: i32 = UNITS_PER_PX;
     /// The walker trench of the default level: x from col 36 to col 44,

@@ -16,9 +16,9 @@
 
 use anyhow::{Context, Result};
 use glam::IVec2;
+use ledge_levels::default_level;
 use ledge_shared::game::{Game, GameConfig};
 use ledge_shared::input::Buttons;
-use ledge_shared::level::default_level;
 use ledge_shared::protocol::PlayerId;
 use ledge_shared::scene::scripted_inputs;
 

@@ -198,9 +198,10 @@ fn main() -> anyhow::Result<()> {
         .transpose()
         .map_err(anyhow::Error::msg)?;
     let level = match &cli.level {
-        Some(path) if !cli.local => ledge_shared::level::load_file(path)
-            .map_err(|e| anyhow::anyhow!("loading the level: {e}"))?,
-        _ => ledge_shared::level::default_level(),
+        Some(path) if !cli.local => {
+            ledge_levels::load_file(path).map_err(|e| anyhow::anyhow!("loading the level: {e}"))?
+        }
+        _ => ledge_levels::default_level(),
     };
     let mut server = None;
     let request = if cli.local {

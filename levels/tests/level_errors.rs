@@ -2,7 +2,7 @@
 //! message names the file and the field; and a property test feeding random
 //! and mutated bytes to the loaders (never a panic).
 
-use ledge_shared::level::{
+use ledge_levels::{
     load_default_level, load_file, load_file_with, ogmo, tmx, LevelError, LoadOptions,
 };
 use proptest::prelude::*;
@@ -12,8 +12,8 @@ const UNO: &str = concat!(
     "/../../shared/testdata/levels/ogmo3-sample/levels/uno.json"
 );
 const TILED_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/levels/tiled");
-const DEFAULT_JSON: &str = include_str!("../levels/default/default.json");
-const DEFAULT_PROJECT: &str = include_str!("../levels/default/ledge.ogmo");
+const DEFAULT_JSON: &str = include_str!("../default/default.json");
+const DEFAULT_PROJECT: &str = include_str!("../default/ledge.ogmo");
 
 /// A one-layer OGMO level: a 4 x 2 tile layer (`tiles_json` is its data
 /// field), and an entity layer with `entities_json`.
@@ -31,16 +31,12 @@ fn level(tiles_json: &str, entities_json: &str) -> String {
 const TILES: &str = r#""data": [1, 1, 1, 1, -1, 12, 13, 2], "exportMode": 0, "arrayMode": 0"#;
 const SPAWN: &str = r#"{"name": "player", "x": 8, "y": 8, "width": 16, "height": 16}"#;
 
-fn load(text: &str) -> Result<ledge_shared::level::LoadedLevel, LevelError> {
+fn load(text: &str) -> Result<ledge_levels::LoadedLevel, LevelError> {
     ogmo::load_str("levels/test.json", text, None, &LoadOptions::default())
 }
 
 /// The error's message, after checking it names the file and the field.
-fn check(
-    r: Result<ledge_shared::level::LoadedLevel, LevelError>,
-    file: &str,
-    field: &str,
-) -> String {
+fn check(r: Result<ledge_levels::LoadedLevel, LevelError>, file: &str, field: &str) -> String {
     let e = r.expect_err("should be refused");
     let msg = e.to_string();
     assert!(msg.starts_with(&format!("{file}: ")), "{msg}");
@@ -440,8 +436,7 @@ fn degenerate_platform_paths() {
         r#"{"loop": true}"#,
     ))
     .unwrap();
-    let ledge_shared::level::EntityKind::MovingPlatform { motion, .. } = &l.level.entities[1].kind
-    else {
+    let ledge_levels::EntityKind::MovingPlatform { motion, .. } = &l.level.entities[1].kind else {
         panic!()
     };
     assert_eq!(motion.path.len(), 3);

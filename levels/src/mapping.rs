@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use crate::tilemap::{Slope, Tile};
+use ledge_shared::tilemap::{Slope, Tile};
 
 /// The echo-slopes tileset (`echo-slopes/project.ogmo`, image 208 x 32 px,
 /// 16 px tiles, 13 columns x 2 rows, id = row * 13 + column), id by id, as
@@ -71,7 +71,7 @@ pub const ECHO_SLOPES: [Tile; 26] = {
     ]
 };
 
-/// ledge's own tileset (`shared/levels/default/ledge.png`, embedded in
+/// ledge's own tileset (`levels/default/ledge.png`, embedded in
 /// `ledge.ogmo`): the echo-slopes layout ([`ECHO_SLOPES`]) with spikes drawn
 /// in the blank slot 13, which is [`Tile::Hazard`].
 pub const LEDGE_TILESET: [Tile; 26] = {

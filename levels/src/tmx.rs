@@ -40,7 +40,7 @@ use super::entities::{
 };
 use super::mapping::{mirror, parse_tile_kind};
 use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
-use crate::tilemap::Tile;
+use ledge_shared::tilemap::Tile;
 
 /// Serves the map from memory (when given) and every other file (external
 /// tilesets, templates) from the filesystem, with the size limit.
@@ -533,7 +533,7 @@ impl Conv<'_> {
                 message: format!(
                     "polygon has {} vertices; it needs 3 to {}",
                     points.len(),
-                    crate::shape::MAX_POLYGON_VERTICES
+                    ledge_shared::shape::MAX_POLYGON_VERTICES
                 ),
             });
         }

@@ -3,12 +3,12 @@
 //! embedded default level with its bot route.
 
 use glam::IVec2;
-use ledge_shared::fixed::px;
-use ledge_shared::level::ogmo::{self, LayerContent};
-use ledge_shared::level::{
+use ledge_levels::ogmo::{self, LayerContent};
+use ledge_levels::{
     default_level, default_route, load_default_level, load_file, load_file_with, EntityKind,
     LoadOptions, RouteAction, TileMapping, TileTable,
 };
+use ledge_shared::fixed::px;
 use ledge_shared::tilemap::{Slope, Tile};
 
 const UNO: &str = concat!(
@@ -302,7 +302,7 @@ fn default_level_loads_with_every_kind() {
             _ => None,
         })
         .collect();
-    let leg = |m: &ledge_shared::level::PlatformMotion| m.path[1] - m.path[0];
+    let leg = |m: &ledge_levels::PlatformMotion| m.path[1] - m.path[0];
     assert!(platforms
         .iter()
         .any(|(m, _)| leg(m).x == 0 && leg(m).y != 0));
@@ -402,7 +402,7 @@ fn default_route_runs_from_spawn_to_goal_on_solid_footing() {
 
 #[test]
 fn default_level_file_loads_from_disk_like_the_embedded_one() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/levels/default/default.json");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/default/default.json");
     let from_disk = load_file(path).unwrap();
     let embedded = default_level();
     assert_eq!(from_disk.tilemap, embedded.tilemap);

@@ -73,7 +73,7 @@ pub enum LevelError {
         got: u64,
     },
     /// A size or position beyond the level limits ([`super::MAX_LEVEL_TILES`]
-    /// per side) or the numeric bounds of [`crate::fixed`].
+    /// per side) or the numeric bounds of [`ledge_shared::fixed`].
     #[error("{file}: {field}: {message}")]
     OutOfBounds {
         /// The file.

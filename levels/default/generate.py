@@ -7,7 +7,7 @@ Editor 3.3 to edit); this script records how they were made and can
 regenerate them. The tileset is the echo-slopes one (MIT, Austin East, see
 README.md) read from the test data, with spikes drawn in the blank slot 13.
 
-    python3 shared/levels/default/generate.py
+    python3 levels/default/generate.py
 """
 import base64
 import json
@@ -16,7 +16,7 @@ import struct
 import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ECHO = os.path.join(HERE, "../../../../shared/testdata/levels/echo-slopes/project.ogmo")
+ECHO = os.path.join(HERE, "../../../shared/testdata/levels/echo-slopes/project.ogmo")
 T = 16
 W, H = 100, 30
 

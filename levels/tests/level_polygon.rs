@@ -4,15 +4,16 @@
 //! naming the file and the field; a player stands on and walks along a
 //! polygon ramp.
 
+#[path = "../../shared/tests/platformer_kit/mod.rs"]
 mod platformer_kit;
 
 use glam::IVec2;
-use ledge_shared::fixed::px;
-use ledge_shared::game::{EntityType, Game, GameError};
-use ledge_shared::level::{
+use ledge_levels::{
     default_level, default_route, load_file, ogmo, tmx, EntityDef, EntityKind, Level, LevelError,
     LoadOptions, LoadedLevel,
 };
+use ledge_shared::fixed::px;
+use ledge_shared::game::{EntityType, Game, GameError};
 use ledge_shared::shape::ConvexPolygon;
 use ledge_shared::world::AnyShape;
 use platformer_kit::{Sim, LEFT, NONE, RIGHT};

@@ -1,4 +1,4 @@
-//! The embedded default level (`shared/levels/default/`, OGMO Editor 3).
+//! The embedded default level (`levels/default/`, OGMO Editor 3).
 //!
 //! Named "default"; 100 x 30 tiles of 16 px, ground at row 26, left to
 //! right (columns): the spawn (col 5) beside the elevator (an up/down
@@ -29,8 +29,8 @@ pub const DEFAULT_LEVEL_FILE: &str = "levels/default/default.json";
 /// Name of the embedded default project file (used in messages).
 pub const DEFAULT_PROJECT_FILE: &str = "levels/default/ledge.ogmo";
 
-const LEVEL_JSON: &str = include_str!("../../levels/default/default.json");
-const PROJECT_JSON: &str = include_str!("../../levels/default/ledge.ogmo");
+const LEVEL_JSON: &str = include_str!("../default/default.json");
+const PROJECT_JSON: &str = include_str!("../default/ledge.ogmo");
 
 /// Parses the embedded default level with the default options, with its
 /// route. [`default_level`] and [`default_route`] call this; it never fails

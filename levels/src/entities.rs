@@ -2,12 +2,11 @@
 //! bot route.
 
 use glam::IVec2;
-use serde::{Deserialize, Serialize};
 
 use super::mapping::normalize;
-use super::{EntityDef, EntityKind, LevelError, PlatformMotion};
-use crate::fixed::{MAX_COORD, MAX_EXTENT, MAX_SPEED, UNITS_PER_PX};
-use crate::shape::{ConvexPolygon, ShapeError, MAX_POLYGON_VERTICES};
+use super::{EntityDef, EntityKind, LevelError, PlatformMotion, RouteAction, Waypoint};
+use ledge_shared::fixed::{MAX_COORD, MAX_EXTENT, MAX_SPEED, UNITS_PER_PX};
+use ledge_shared::shape::{ConvexPolygon, ShapeError, MAX_POLYGON_VERTICES};
 
 /// Every entity name the loaders know, for messages (matching is ASCII
 /// case-insensitive, with `-` and spaces read as `_`):
@@ -65,31 +64,6 @@ pub const DEFAULT_WALKER_SPEED: i32 = UNITS_PER_PX / 2;
 pub const DEFAULT_SPRING_STRENGTH: i32 = 10 * UNITS_PER_PX;
 /// Most nodes a platform path may have.
 pub const MAX_PATH_NODES: usize = 256;
-
-/// What the runner bot does to reach a [`Waypoint`] from the previous one.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum RouteAction {
-    /// Walk along the ground (flat, slopes, one-way tiles) to the waypoint.
-    Walk,
-    /// Jump toward the waypoint (over a gap, a hazard or onto a higher or
-    /// one-way surface) and land on it.
-    Jump,
-    /// Walk onto the springboard under the waypoint's x, get launched, and
-    /// steer to land on the waypoint.
-    Spring,
-}
-
-/// One stop of a level's bot route: where the player's foot (the
-/// bottom-centre of its box) should stand, and how to get there from the
-/// previous waypoint.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub struct Waypoint {
-    /// Foot position in units: the bottom-centre of the waypoint entity,
-    /// which is placed standing on the ground.
-    pub foot: IVec2,
-    /// How to get here.
-    pub action: RouteAction,
-}
 
 /// A parameter value from an editor (OGMO `values`, Tiled `properties`).
 #[derive(Debug, Clone, PartialEq)]

@@ -4,11 +4,11 @@
 //! platform paths, group offsets, an image layer).
 
 use glam::IVec2;
-use ledge_shared::fixed::px;
-use ledge_shared::level::{
+use ledge_levels::{
     load_file, load_file_with, tmx, EntityDef, EntityKind, LoadOptions, PlatformMotion,
     RouteAction, Waypoint,
 };
+use ledge_shared::fixed::px;
 use ledge_shared::tilemap::{Slope, Tile};
 
 const FIXTURE: &str = concat!(

@@ -34,7 +34,7 @@ use super::entities::{
     PropValue,
 };
 use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
-use crate::tilemap::Tile;
+use ledge_shared::tilemap::Tile;
 
 type Obj = Map<String, Value>;
 
@@ -853,7 +853,7 @@ fn parse_polygon(
                 message: format!(
                     "polygon has {} vertices; it needs 3 to {}",
                     list.len() + 1,
-                    crate::shape::MAX_POLYGON_VERTICES
+                    ledge_shared::shape::MAX_POLYGON_VERTICES
                 ),
             });
         }

@@ -1,0 +1,336 @@
+//! ledge's level importers: OGMO Editor 3 and Tiled files into the
+//! simulation's [`Level`] model (`ledge_shared::level`), and the embedded
+//! default level.
+//!
+//! Editor files are translated through a documented name table;
+//! `ledge_shared::game::Game::from_level` turns the result into a running
+//! simulation. This crate does the file I/O and format parsing so that
+//! `ledge-shared` stays pure.
+//!
+//! * [`load_file`] / [`load_file_with`]: `.json` (OGMO Editor 3 level; the
+//!   nearest `.ogmo` project in its folder or up to five folders above is
+//!   used) or `.tmx` (Tiled, through the `tiled` crate);
+//! * [`ogmo::load_str`], [`tmx::load_str`]: the same from text;
+//! * [`default_level`], [`default_route`]: the embedded default level and the
+//!   route a runner bot can follow through it;
+//! * [`TileMapping`]: editor tile ids and grid values to [`Tile`]s;
+//! * [`ENTITY_NAMES`]: the entity name table (see its docs for parameters);
+//! * [`LevelError`]: every refusal names the file and the field.
+//!
+//! Collision layers (OGMO tile and grid layers, Tiled tile layers) are
+//! overlaid into one grid in file order: a later layer's non-empty cell
+//! replaces an earlier one. They must share one square cell size, cell count
+//! and origin. Nothing here panics on any input, and sizes are bounded
+//! ([`MAX_LEVEL_TILES`] per side, positions within
+//! [`ledge_shared::fixed::MAX_COORD`]).
+//! See `docs/LEVELS.md` for the user-facing description.
+
+mod default;
+mod entities;
+mod error;
+mod mapping;
+pub mod ogmo;
+pub mod tmx;
+
+use std::path::Path;
+
+use glam::IVec2;
+
+pub use default::{
+    default_level, default_route, load_default_level, DEFAULT_LEVEL_FILE, DEFAULT_PROJECT_FILE,
+};
+pub use entities::{
+    PlacedEntity, PlacedPolygon, PropValue, DEFAULT_PLATFORM_SPEED, DEFAULT_SPRING_STRENGTH,
+    DEFAULT_WALKER_SPEED, ENTITY_NAMES, MAX_PATH_NODES,
+};
+pub use error::LevelError;
+pub use ledge_shared::level::{
+    EntityDef, EntityKind, Level, LevelFeatures, PlatformMotion, RouteAction, Waypoint,
+};
+pub use mapping::{
+    parse_tile_kind, tile_kind_name, TileMapping, TileTable, ECHO_SLOPES, LEDGE_TILESET,
+};
+
+use entities::Classified;
+use ledge_shared::fixed::UNITS_PER_PX;
+use ledge_shared::tilemap::{Tile, Tilemap, TilemapError};
+
+/// Largest level side, in tiles (grids up to 4096 x 4096).
+pub const MAX_LEVEL_TILES: u32 = 4096;
+/// Largest level file read from disk, in bytes (64 MiB).
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
+/// How to load a level.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Tile ids and grid values to tiles.
+    pub mapping: TileMapping,
+    /// Skip entities whose name is not in [`ENTITY_NAMES`] (each is listed in
+    /// [`LoadedLevel::warnings`]) instead of refusing the file. Default:
+    /// refuse.
+    pub skip_unknown_entities: bool,
+    /// Only these tile/grid layers (by name) make the collision grid; `None`
+    /// (the default): every one.
+    pub collision_layers: Option<Vec<String>>,
+    /// Refuse a level without a player spawn. Default: true.
+    pub require_spawn: bool,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        Self {
+            mapping: TileMapping::default(),
+            skip_unknown_entities: false,
+            collision_layers: None,
+            require_spawn: true,
+        }
+    }
+}
+
+/// A loaded level and what came with it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadedLevel {
+    /// The level.
+    pub level: Level,
+    /// The bot route: `waypoint` entities in file order (empty when the file
+    /// has none).
+    pub route: Vec<Waypoint>,
+    /// Things skipped, one line each (unknown entities when
+    /// [`LoadOptions::skip_unknown_entities`] is set).
+    pub warnings: Vec<String>,
+}
+
+/// Loads a level file with the default options; see [`load_file_with`].
+pub fn load_file(path: impl AsRef<Path>) -> Result<Level, LevelError> {
+    load_file_with(path, &LoadOptions::default()).map(|l| l.level)
+}
+
+/// Loads a level file by extension: `.json` is an OGMO Editor 3 level (its
+/// project is the first `.ogmo` file, by name, in the level's folder or the
+/// nearest of up to five folders above it; without one, layer kinds are told
+/// from their fields and entities need explicit sizes), `.tmx` a Tiled map.
+pub fn load_file_with(
+    path: impl AsRef<Path>,
+    options: &LoadOptions,
+) -> Result<LoadedLevel, LevelError> {
+    let path = path.as_ref();
+    let file = path.display().to_string();
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match ext.as_deref() {
+        Some("json") => {
+            let text = read_text(path)?;
+            let project = match find_project(path) {
+                Some(p) => Some((p.display().to_string(), read_text(&p)?)),
+                None => None,
+            };
+            ogmo::load_str(
+                &file,
+                &text,
+                project.as_ref().map(|(f, t)| (f.as_str(), t.as_str())),
+                options,
+            )
+        }
+        Some("tmx") => tmx::load_path(path, options),
+        _ => Err(LevelError::UnsupportedFormat { file }),
+    }
+}
+
+/// Reads a file of at most [`MAX_FILE_BYTES`] as UTF-8.
+pub(crate) fn read_text(path: &Path) -> Result<String, LevelError> {
+    let bytes = read_bytes(path)?;
+    String::from_utf8(bytes).map_err(|e| LevelError::Syntax {
+        file: path.display().to_string(),
+        field: format!("byte {}", e.utf8_error().valid_up_to()),
+        format: "UTF-8 text",
+        message: e.to_string(),
+    })
+}
+
+/// Reads a file of at most [`MAX_FILE_BYTES`].
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, LevelError> {
+    use std::io::Read;
+    let io = |e: std::io::Error| LevelError::Io {
+        file: path.display().to_string(),
+        message: e.to_string(),
+    };
+    let f = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    f.take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(LevelError::Io {
+            file: path.display().to_string(),
+            message: format!("larger than {MAX_FILE_BYTES} bytes"),
+        });
+    }
+    Ok(bytes)
+}
+
+/// The OGMO project of a level: the first `.ogmo` file by name in the
+/// level's folder, else in the nearest of up to five folders above.
+fn find_project(level: &Path) -> Option<std::path::PathBuf> {
+    let mut dir = level.parent();
+    for _ in 0..6 {
+        let d = dir?;
+        let d = if d.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            d
+        };
+        if let Ok(rd) = std::fs::read_dir(d) {
+            let mut found: Vec<_> = rd
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| {
+                    p.is_file()
+                        && p.extension()
+                            .is_some_and(|e| e.eq_ignore_ascii_case("ogmo"))
+                })
+                .collect();
+            found.sort();
+            if let Some(p) = found.into_iter().next() {
+                return Some(p);
+            }
+        }
+        dir = d.parent();
+    }
+    None
+}
+
+/// One collision layer, decoded, before overlaying.
+pub(crate) struct GridLayer {
+    /// Path of the layer (`layers[0]`).
+    pub field: String,
+    /// Top-left corner in units.
+    pub origin: IVec2,
+    /// Cell width and height, pixels.
+    pub cell: (u32, u32),
+    /// Cells across and down.
+    pub cells: (u32, u32),
+    /// Row-major tiles.
+    pub tiles: Vec<Tile>,
+}
+
+/// Overlays the collision layers, classifies the entities, and checks the
+/// level as a whole.
+pub(crate) fn assemble(
+    file: &str,
+    name: String,
+    grids: Vec<GridLayer>,
+    entities: Vec<PlacedEntity>,
+    options: &LoadOptions,
+) -> Result<LoadedLevel, LevelError> {
+    let tilemap = match grids.split_first() {
+        None => Tilemap::new(IVec2::ZERO, 16 * UNITS_PER_PX, 0, 0, Vec::new())
+            .map_err(|e| tilemap_error(file, "layers", e))?,
+        Some((first, rest)) => {
+            let (cw, ch) = first.cell;
+            if cw != ch {
+                return Err(LevelError::BadValue {
+                    file: file.into(),
+                    field: first.field.clone(),
+                    message: format!("collision cells must be square, got {cw} x {ch} px"),
+                });
+            }
+            let mut tiles = first.tiles.clone();
+            for g in rest {
+                if (g.cell, g.cells, g.origin) != (first.cell, first.cells, first.origin) {
+                    return Err(LevelError::BadValue {
+                        file: file.into(),
+                        field: g.field.clone(),
+                        message: format!(
+                            "collision layer of {} x {} cells of {} x {} px at ({}, {}) units does not match {} ({} x {} cells of {} x {} px at ({}, {}) units); choose layers with LoadOptions::collision_layers",
+                            g.cells.0,
+                            g.cells.1,
+                            g.cell.0,
+                            g.cell.1,
+                            g.origin.x,
+                            g.origin.y,
+                            first.field,
+                            first.cells.0,
+                            first.cells.1,
+                            cw,
+                            ch,
+                            first.origin.x,
+                            first.origin.y
+                        ),
+                    });
+                }
+                for (t, &n) in tiles.iter_mut().zip(&g.tiles) {
+                    if n != Tile::Empty {
+                        *t = n;
+                    }
+                }
+            }
+            let size = cw as i64 * UNITS_PER_PX as i64;
+            Tilemap::new(
+                first.origin,
+                size.min(i32::MAX as i64) as i32,
+                first.cells.0,
+                first.cells.1,
+                tiles,
+            )
+            .map_err(|e| tilemap_error(file, &first.field, e))?
+        }
+    };
+    let mut out = LoadedLevel {
+        level: Level {
+            name,
+            tilemap,
+            entities: Vec::with_capacity(entities.len()),
+        },
+        route: Vec::new(),
+        warnings: Vec::new(),
+    };
+    for e in &entities {
+        match entities::classify(file, e)? {
+            Classified::Entity(d) => out.level.entities.push(d),
+            Classified::Waypoint(w) => out.route.push(w),
+            Classified::Unknown if options.skip_unknown_entities => out.warnings.push(format!(
+                "{file}: {}: skipped unknown entity {:?} in layer {:?}",
+                e.field, e.name, e.layer
+            )),
+            Classified::Unknown => {
+                return Err(LevelError::UnknownEntity {
+                    file: file.into(),
+                    field: format!("{}.name", e.field),
+                    layer: e.layer.clone(),
+                    name: e.name.clone(),
+                });
+            }
+        }
+    }
+    if options.require_spawn
+        && !out
+            .level
+            .entities
+            .iter()
+            .any(|e| e.kind == EntityKind::PlayerSpawn)
+    {
+        return Err(LevelError::MissingSpawn {
+            file: file.into(),
+            field: "entities".into(),
+        });
+    }
+    Ok(out)
+}
+
+fn tilemap_error(file: &str, field: &str, e: TilemapError) -> LevelError {
+    match e {
+        TilemapError::TileSize { value } => LevelError::BadValue {
+            file: file.into(),
+            field: format!("{field} (cell size)"),
+            message: format!(
+                "cell size {} px is not a power of two number of pixels",
+                value as f64 / UNITS_PER_PX as f64
+            ),
+        },
+        e => LevelError::OutOfBounds {
+            file: file.into(),
+            field: field.into(),
+            message: e.to_string(),
+        },
+    }
+}
