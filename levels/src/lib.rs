@@ -25,9 +25,11 @@
 //! [`ledge_shared::fixed::MAX_COORD`]).
 //! See `docs/LEVELS.md` for the user-facing description.
 
+pub mod art;
 mod default;
 mod entities;
 mod error;
+mod limits;
 mod mapping;
 pub mod ogmo;
 pub mod tmx;
@@ -98,6 +100,8 @@ pub struct LoadedLevel {
     /// Things skipped, one line each (unknown entities when
     /// [`LoadOptions::skip_unknown_entities`] is set).
     pub warnings: Vec<String>,
+    /// What a client draws: the editor's tile layers and tileset images.
+    pub art: art::LevelArt,
 }
 
 /// Loads a level file with the default options; see [`load_file_with`].
@@ -283,6 +287,7 @@ pub(crate) fn assemble(
         },
         route: Vec::new(),
         warnings: Vec::new(),
+        art: art::LevelArt::default(),
     };
     for e in &entities {
         match entities::classify(file, e)? {

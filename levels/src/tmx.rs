@@ -60,6 +60,7 @@ impl ResourceReader for Reader {
             }
         }
         super::read_bytes(path)
+            .and_then(|bytes| crate::limits::check_tmx_resource(path, bytes))
             .map(Cursor::new)
             .map_err(|e| std::io::Error::other(e.to_string()))
     }
@@ -111,12 +112,14 @@ fn load(
             });
         }
     };
-    Conv {
+    let mut loaded = Conv {
         file: &file,
         map: &map,
         options,
     }
-    .run(path)
+    .run(path)?;
+    loaded.art = crate::art::from_tiled(&file, &map)?;
+    Ok(loaded)
 }
 
 struct Conv<'a> {
