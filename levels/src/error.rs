@@ -143,6 +143,24 @@ pub enum LevelError {
         /// What is wrong, e.g. `polygon is concave at vertex 3 (40, 16) px`.
         message: String,
     },
+    /// A size, count, depth or decoded length beyond one of the bounds of
+    /// `docs/LEVELS.md` ("Limits"), found before anything was allocated for
+    /// it. `bound` names the constant (`MAX_TILESET_TILES`...).
+    #[error("{file}: {field}: {found} {what} is more than the limit of {limit} ({bound})")]
+    Limit {
+        /// The file.
+        file: String,
+        /// The element or attribute, e.g. `map.tileset[0].tilecount`.
+        field: String,
+        /// What was counted, e.g. "tiles".
+        what: String,
+        /// The bound.
+        limit: u64,
+        /// The count found (for totals: the total so far).
+        found: u64,
+        /// The constant of the bound, e.g. `MAX_TILESET_TILES`.
+        bound: &'static str,
+    },
     /// No entity is a player spawn.
     #[error("{file}: {field}: no player spawn (add an entity named \"player\" or \"spawn\")")]
     MissingSpawn {
@@ -169,7 +187,8 @@ impl LevelError {
             | LevelError::UnknownEntity { file, .. }
             | LevelError::DegeneratePath { file, .. }
             | LevelError::BadPolygon { file, .. }
-            | LevelError::MissingSpawn { file, .. } => file,
+            | LevelError::MissingSpawn { file, .. }
+            | LevelError::Limit { file, .. } => file,
         }
     }
 
@@ -187,7 +206,8 @@ impl LevelError {
             | LevelError::UnknownEntity { field, .. }
             | LevelError::DegeneratePath { field, .. }
             | LevelError::BadPolygon { field, .. }
-            | LevelError::MissingSpawn { field, .. } => Some(field),
+            | LevelError::MissingSpawn { field, .. }
+            | LevelError::Limit { field, .. } => Some(field),
         }
     }
 }

@@ -29,7 +29,7 @@ pub mod art;
 mod default;
 mod entities;
 mod error;
-mod limits;
+pub mod limits;
 mod mapping;
 pub mod ogmo;
 pub mod tmx;

@@ -1,12 +1,1112 @@
 //! Bounds on what a level file may ask for, checked before anything is
 //! allocated for it.
+//!
+//! * Tiled: every TMX, TSX and template (`.tx`) document is scanned with a
+//!   streaming XML reader ([`check_tmx_resource`]) before the `tiled` crate
+//!   sees it: nesting depth, counts (layers, tilesets, tiles, objects,
+//!   points, properties, elements, attributes), sizes (attributes, text,
+//!   images) and every tile layer's `<data>`, decoded and inflated with the
+//!   output bound enforced while inflating, whose cell count must be exactly
+//!   the layer's (or chunk's) width x height. Totals are kept across the
+//!   documents of one load ([`Budget`]). Old files that lack attributes the
+//!   `tiled` crate requires (`tilecount`, `columns`, an image's `width` and
+//!   `height`) are patched when the value can be derived.
+//! * OGMO: the JSON text is scanned ([`check_json`]) for its nesting depth
+//!   and its number of values before `serde_json` builds a tree of it.
+//!
+//! Every refusal is a [`LevelError`] naming the file, the element path (like
+//! `map.layers[3].data`) and the bound; see `docs/LEVELS.md` ("Limits").
 
-use std::path::Path;
+use std::collections::BTreeMap;
+use std::io::{self, Read};
+use std::path::{Path, PathBuf};
 
-use crate::LevelError;
+use quick_xml::events::{BytesStart, Event};
+
+use crate::{LevelError, MAX_FILE_BYTES, MAX_LEVEL_TILES};
+
+/// Deepest element nesting in a TMX, TSX or template document (the `tiled`
+/// crate parses group layers and class properties recursively).
+pub const MAX_XML_DEPTH: usize = 64;
+/// Most attributes on one element.
+pub const MAX_ATTRIBUTES: usize = 64;
+/// Longest attribute value, in bytes (as written, before unescaping).
+pub const MAX_ATTRIBUTE_BYTES: usize = 1 << 20;
+/// Longest text between tags, other than a tile layer's `<data>`, in bytes.
+pub const MAX_TEXT_BYTES: usize = 1 << 20;
+/// Most elements in all the documents of one Tiled load.
+pub const MAX_ELEMENTS: u64 = 1 << 20;
+/// Most documents (the map, its external tilesets and templates) read for one
+/// Tiled load.
+pub const MAX_DOCUMENTS: u64 = 64;
+/// Most layers (tile, object, image and group layers) in one Tiled load.
+pub const MAX_LAYERS: u64 = 1024;
+/// Most tilesets in one map.
+pub const MAX_TILESETS: u64 = 256;
+/// Largest `tilecount`, and most `<tile>` elements, of one tileset.
+pub const MAX_TILESET_TILES: u64 = 65_536;
+/// Most tiles (`tilecount` plus `<tile>` elements) of all the tilesets of one
+/// Tiled load.
+pub const MAX_TOTAL_TILESET_TILES: u64 = 1 << 18;
+/// Most tile cells in all the tile layers (and chunks) of one level, Tiled
+/// or OGMO. One layer is also at most [`MAX_LEVEL_TILES`] per side.
+pub const MAX_LEVEL_CELLS: u64 = 1 << 22;
+/// Most objects in one Tiled load (an object made from a template counts
+/// the template's objects again).
+pub const MAX_OBJECTS: u64 = 65_536;
+/// Most points in one polygon or polyline.
+pub const MAX_SHAPE_POINTS: u64 = 4096;
+/// Most polygon and polyline points in one Tiled load.
+pub const MAX_TOTAL_POINTS: u64 = 1 << 20;
+/// Most properties in one Tiled load.
+pub const MAX_PROPERTIES: u64 = 65_536;
+/// Widest or tallest image, in pixels.
+pub const MAX_IMAGE_SIDE: u64 = 16_384;
+/// Most pixels in one image.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
+/// Largest chunk coordinate (either sign) in an infinite map, in tiles.
+pub const MAX_CHUNK_COORD: i64 = 1 << 24;
+/// Most bytes the objects made from templates may copy: a template's size
+/// times the number of objects using it, added up.
+pub const MAX_TEMPLATE_BYTES: u64 = 64 << 20;
+/// Deepest nesting of arrays and objects in an OGMO JSON document (the same
+/// as `serde_json`'s own recursion limit).
+pub const MAX_JSON_DEPTH: usize = 128;
+/// Most values (numbers, strings, arrays, objects, keys included) in one
+/// OGMO JSON document.
+pub const MAX_JSON_VALUES: u64 = 1 << 22;
+
+/// Totals over the documents of one Tiled load.
+#[derive(Debug, Default)]
+pub(crate) struct Budget {
+    documents: u64,
+    elements: u64,
+    layers: u64,
+    tileset_tiles: u64,
+    cells: u64,
+    objects: u64,
+    points: u64,
+    properties: u64,
+    template_bytes: u64,
+    /// Objects using each template (path as the `tiled` crate resolves it).
+    template_uses: BTreeMap<PathBuf, u64>,
+}
+
+fn limit(
+    file: &str,
+    field: impl Into<String>,
+    what: &str,
+    limit: u64,
+    found: u64,
+    bound: &'static str,
+) -> LevelError {
+    LevelError::Limit {
+        file: file.into(),
+        field: field.into(),
+        what: what.into(),
+        limit,
+        found,
+        bound,
+    }
+}
 
 /// Checks one TMX, TSX or template file's bytes before the Tiled reader
-/// sees them, and returns the bytes to hand it.
-pub(crate) fn check_tmx_resource(_path: &Path, bytes: Vec<u8>) -> Result<Vec<u8>, LevelError> {
-    Ok(bytes)
+/// sees them, and returns the bytes to hand it (patched for old files).
+pub(crate) fn check_tmx_resource(
+    budget: &mut Budget,
+    path: &Path,
+    bytes: Vec<u8>,
+) -> Result<Vec<u8>, LevelError> {
+    let file = path.display().to_string();
+    budget.documents += 1;
+    if budget.documents > MAX_DOCUMENTS {
+        return Err(limit(
+            &file,
+            "(document)",
+            "documents read for one map (map, tilesets, templates)",
+            MAX_DOCUMENTS,
+            budget.documents,
+            "MAX_DOCUMENTS",
+        ));
+    }
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(limit(
+            &file,
+            "(document)",
+            "bytes",
+            MAX_FILE_BYTES,
+            bytes.len() as u64,
+            "MAX_FILE_BYTES",
+        ));
+    }
+    let uses = budget.template_uses.get(path).copied().unwrap_or(1).max(1);
+    let mut scan = Scan {
+        file,
+        path,
+        budget,
+        uses,
+        stack: Vec::new(),
+        patches: Vec::new(),
+        root_seen: false,
+    };
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("tx"))
+    {
+        let cost = (bytes.len() as u64).saturating_mul(uses);
+        scan.budget.template_bytes = scan.budget.template_bytes.saturating_add(cost);
+        if scan.budget.template_bytes > MAX_TEMPLATE_BYTES {
+            return Err(limit(
+                &scan.file,
+                "template",
+                "bytes copied into objects from templates",
+                MAX_TEMPLATE_BYTES,
+                scan.budget.template_bytes,
+                "MAX_TEMPLATE_BYTES",
+            ));
+        }
+    }
+    scan.run(&bytes)?;
+    let mut patches = std::mem::take(&mut scan.patches);
+    if patches.is_empty() {
+        return Ok(bytes);
+    }
+    patches.sort_by_key(|p| p.0);
+    let extra: usize = patches.iter().map(|p| p.1.len()).sum();
+    let mut out = Vec::with_capacity(bytes.len() + extra);
+    let mut at = 0;
+    for (pos, text) in patches {
+        out.extend_from_slice(&bytes[at..pos]);
+        out.extend_from_slice(text.as_bytes());
+        at = pos;
+    }
+    out.extend_from_slice(&bytes[at..]);
+    Ok(out)
+}
+
+/// What an open element is, for the checks at its children and its end.
+enum Ctx {
+    Other,
+    Map {
+        infinite: bool,
+        tilesets: u64,
+    },
+    Tileset(Box<TilesetScan>),
+    /// A tile layer: its size, when given.
+    Layer {
+        size: Option<(u64, u64)>,
+    },
+    Data(DataScan),
+}
+
+struct TilesetScan {
+    name: String,
+    field: String,
+    tilecount: Option<u64>,
+    has_columns: bool,
+    tile_size: (Option<u64>, Option<u64>),
+    spacing: u64,
+    margin: u64,
+    /// Width and height of the tileset's own image (`Some(None)`: an image
+    /// of unknown size).
+    image: Option<Option<(u64, u64)>>,
+    tiles: u64,
+    /// Where attributes can be added to the start tag.
+    insert_at: usize,
+    external: bool,
+}
+
+struct DataScan {
+    field: String,
+    encoding: Option<String>,
+    compression: Option<String>,
+    /// Cells the layer (or chunk) must have; `None` when its size is not given.
+    expected: Option<u64>,
+    /// Decoded already (the `tiled` crate reads only the first text).
+    done: bool,
+    /// Whether this element's text is tile data (a chunk of an infinite map,
+    /// or the data of a finite one).
+    decodes: bool,
+    chunks: u64,
+}
+
+struct Frame {
+    path: String,
+    ctx: Ctx,
+    /// Children seen so far, by segment name.
+    counts: Vec<(String, u64)>,
+}
+
+struct Scan<'a> {
+    file: String,
+    path: &'a Path,
+    budget: &'a mut Budget,
+    /// How many objects use this document (a template), else 1.
+    uses: u64,
+    stack: Vec<Frame>,
+    patches: Vec<(usize, String)>,
+    root_seen: bool,
+}
+
+/// The attributes of an element, by local name, unescaped.
+struct Attrs(Vec<(String, String)>);
+
+impl Attrs {
+    fn get(&self, k: &str) -> Option<&str> {
+        self.0.iter().find(|(n, _)| n == k).map(|(_, v)| v.as_str())
+    }
+    fn num(&self, k: &str) -> Option<u64> {
+        self.get(k).and_then(|v| v.parse().ok())
+    }
+    fn int(&self, k: &str) -> Option<i64> {
+        self.get(k).and_then(|v| v.parse().ok())
+    }
+}
+
+impl Scan<'_> {
+    fn syntax(&self, field: &str, message: impl ToString) -> LevelError {
+        LevelError::Syntax {
+            file: self.file.clone(),
+            field: field.into(),
+            format: "TMX",
+            message: message.to_string(),
+        }
+    }
+
+    fn current_path(&self) -> String {
+        self.stack
+            .last()
+            .map(|f| f.path.clone())
+            .unwrap_or_else(|| "(document)".into())
+    }
+
+    fn run(&mut self, bytes: &[u8]) -> Result<(), LevelError> {
+        let mut reader = quick_xml::Reader::from_reader(bytes);
+        let mut buf = Vec::new();
+        loop {
+            buf.clear();
+            let ev = reader
+                .read_event_into(&mut buf)
+                .map_err(|e| self.syntax(&self.current_path(), e))?;
+            let end = reader.buffer_position();
+            match ev {
+                Event::Start(e) => self.open(&e, false, end)?,
+                Event::Empty(e) => {
+                    self.open(&e, true, end)?;
+                    self.close()?;
+                }
+                Event::End(_) => self.close()?,
+                Event::Text(t) => {
+                    let text = t
+                        .unescape()
+                        .map_err(|e| self.syntax(&self.current_path(), e))?;
+                    self.text(text.as_bytes())?;
+                }
+                Event::CData(t) => {
+                    let text = t.into_inner();
+                    self.text(&text)?;
+                }
+                Event::Eof => break,
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// The path segment of a child named `name` of the innermost element.
+    fn segment(&mut self, name: &str) -> String {
+        let (key, indexed) = match name {
+            "layer" | "objectgroup" | "imagelayer" | "group" => ("layers", true),
+            "object" => ("objects", true),
+            "property" => ("properties", true),
+            "tileset" | "tile" | "chunk" | "frame" | "wangset" | "wangcolor" | "wangtile"
+            | "terrain" => (name, true),
+            _ => (name, false),
+        };
+        let Some(top) = self.stack.last_mut() else {
+            return name.to_owned();
+        };
+        let parent = &top.path;
+        if !indexed {
+            return format!("{parent}.{name}");
+        }
+        let n = match top.counts.iter_mut().find(|(k, _)| k == key) {
+            Some((_, n)) => {
+                *n += 1;
+                *n - 1
+            }
+            None => {
+                top.counts.push((key.to_owned(), 1));
+                0
+            }
+        };
+        format!("{parent}.{key}[{n}]")
+    }
+
+    fn attrs(&self, e: &BytesStart<'_>, field: &str) -> Result<Attrs, LevelError> {
+        let mut out = Vec::new();
+        let mut it = e.attributes();
+        it.with_checks(false);
+        for (i, a) in it.enumerate() {
+            if i >= MAX_ATTRIBUTES {
+                return Err(limit(
+                    &self.file,
+                    field,
+                    "attributes on one element (or more)",
+                    MAX_ATTRIBUTES as u64,
+                    i as u64 + 1,
+                    "MAX_ATTRIBUTES",
+                ));
+            }
+            let a = a.map_err(|e| self.syntax(field, e))?;
+            let key = String::from_utf8_lossy(a.key.local_name().as_ref()).into_owned();
+            if a.value.len() > MAX_ATTRIBUTE_BYTES {
+                return Err(limit(
+                    &self.file,
+                    format!("{field}.{key}"),
+                    "bytes in an attribute value",
+                    MAX_ATTRIBUTE_BYTES as u64,
+                    a.value.len() as u64,
+                    "MAX_ATTRIBUTE_BYTES",
+                ));
+            }
+            let v = a.unescape_value().map_err(|e| self.syntax(field, e))?;
+            out.push((key, v.into_owned()));
+        }
+        Ok(Attrs(out))
+    }
+
+    /// Adds `n` to a load-wide total and checks it.
+    #[allow(clippy::too_many_arguments)]
+    fn add(
+        file: &str,
+        total: &mut u64,
+        n: u64,
+        max: u64,
+        field: &str,
+        what: &str,
+        bound: &'static str,
+    ) -> Result<(), LevelError> {
+        *total = total.saturating_add(n);
+        if *total > max {
+            return Err(limit(file, field, what, max, *total, bound));
+        }
+        Ok(())
+    }
+
+    fn open(&mut self, e: &BytesStart<'_>, empty: bool, end: usize) -> Result<(), LevelError> {
+        let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+        let field = self.segment(&name);
+        if self.stack.len() + 1 > MAX_XML_DEPTH {
+            return Err(limit(
+                &self.file,
+                field,
+                "levels of element nesting",
+                MAX_XML_DEPTH as u64,
+                self.stack.len() as u64 + 1,
+                "MAX_XML_DEPTH",
+            ));
+        }
+        let file = self.file.clone();
+        Self::add(
+            &file,
+            &mut self.budget.elements,
+            self.uses,
+            MAX_ELEMENTS,
+            &field,
+            "elements in the map and its tilesets and templates",
+            "MAX_ELEMENTS",
+        )?;
+        let a = self.attrs(e, &field)?;
+        let is_root = self.stack.is_empty();
+        if is_root {
+            if self.root_seen {
+                return Err(self.syntax(&field, "more than one root element"));
+            }
+            self.root_seen = true;
+        }
+        // Where attributes go in the start tag: before `>` or `/>`.
+        let insert_at = end.saturating_sub(if empty { 2 } else { 1 });
+        let parent_is = |s: &Self, f: fn(&Ctx) -> bool| s.stack.last().is_some_and(|p| f(&p.ctx));
+        let in_template = self
+            .path
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("tx") || x.eq_ignore_ascii_case("tsx"));
+        let mut ctx = Ctx::Other;
+        match name.as_str() {
+            "map" if is_root => {
+                for k in ["width", "height"] {
+                    if let Some(v) = a.num(k) {
+                        if v > MAX_LEVEL_TILES as u64 {
+                            return Err(limit(
+                                &file,
+                                format!("{field}.{k}"),
+                                "tiles",
+                                MAX_LEVEL_TILES as u64,
+                                v,
+                                "MAX_LEVEL_TILES",
+                            ));
+                        }
+                    }
+                }
+                ctx = Ctx::Map {
+                    infinite: a.get("infinite") == Some("1"),
+                    tilesets: 0,
+                };
+            }
+            "tileset" => {
+                if let Some(Frame {
+                    ctx: Ctx::Map { tilesets, .. },
+                    ..
+                }) = self.stack.last_mut()
+                {
+                    *tilesets += 1;
+                    if *tilesets > MAX_TILESETS {
+                        return Err(limit(
+                            &file,
+                            field,
+                            "tilesets",
+                            MAX_TILESETS,
+                            *tilesets,
+                            "MAX_TILESETS",
+                        ));
+                    }
+                }
+                let tilecount = a.num("tilecount");
+                if let Some(n) = tilecount {
+                    if n > MAX_TILESET_TILES {
+                        return Err(limit(
+                            &file,
+                            format!("{field}.tilecount"),
+                            "tiles",
+                            MAX_TILESET_TILES,
+                            n,
+                            "MAX_TILESET_TILES",
+                        ));
+                    }
+                    Self::add(
+                        &file,
+                        &mut self.budget.tileset_tiles,
+                        n.saturating_mul(self.uses),
+                        MAX_TOTAL_TILESET_TILES,
+                        &format!("{field}.tilecount"),
+                        "tiles in all tilesets",
+                        "MAX_TOTAL_TILESET_TILES",
+                    )?;
+                }
+                ctx = Ctx::Tileset(Box::new(TilesetScan {
+                    name: a.get("name").unwrap_or_default().to_owned(),
+                    field: field.clone(),
+                    tilecount,
+                    has_columns: a.get("columns").is_some(),
+                    tile_size: (a.num("tilewidth"), a.num("tileheight")),
+                    spacing: a.num("spacing").unwrap_or(0),
+                    margin: a.num("margin").unwrap_or(0),
+                    image: None,
+                    tiles: 0,
+                    insert_at,
+                    external: !is_root && a.get("source").is_some(),
+                }));
+            }
+            "tile" if parent_is(self, |c| matches!(c, Ctx::Tileset(_))) => {
+                if let Some(Frame {
+                    ctx: Ctx::Tileset(ts),
+                    ..
+                }) = self.stack.last_mut()
+                {
+                    ts.tiles += 1;
+                    if ts.tiles > MAX_TILESET_TILES {
+                        return Err(limit(
+                            &file,
+                            field,
+                            "<tile> elements in one tileset",
+                            MAX_TILESET_TILES,
+                            ts.tiles,
+                            "MAX_TILESET_TILES",
+                        ));
+                    }
+                }
+                Self::add(
+                    &file,
+                    &mut self.budget.tileset_tiles,
+                    self.uses,
+                    MAX_TOTAL_TILESET_TILES,
+                    &field,
+                    "tiles in all tilesets",
+                    "MAX_TOTAL_TILESET_TILES",
+                )?;
+            }
+            "image" => {
+                let size = self.image(&a, &field, insert_at)?;
+                if let Some(Frame {
+                    ctx: Ctx::Tileset(ts),
+                    ..
+                }) = self.stack.last_mut()
+                {
+                    ts.image = Some(size);
+                }
+            }
+            "layer" | "objectgroup" | "imagelayer" | "group" => {
+                Self::add(
+                    &file,
+                    &mut self.budget.layers,
+                    self.uses,
+                    MAX_LAYERS,
+                    &field,
+                    "layers",
+                    "MAX_LAYERS",
+                )?;
+                if name == "layer" {
+                    let (w, h) = (a.num("width"), a.num("height"));
+                    for (v, k) in [(w, "width"), (h, "height")] {
+                        if let Some(v) = v {
+                            if v > MAX_LEVEL_TILES as u64 {
+                                return Err(limit(
+                                    &file,
+                                    format!("{field}.{k}"),
+                                    "tiles",
+                                    MAX_LEVEL_TILES as u64,
+                                    v,
+                                    "MAX_LEVEL_TILES",
+                                ));
+                            }
+                        }
+                    }
+                    ctx = Ctx::Layer { size: w.zip(h) };
+                }
+            }
+            "data" if parent_is(self, |c| matches!(c, Ctx::Layer { .. })) => {
+                let infinite = self
+                    .stack
+                    .iter()
+                    .any(|f| matches!(f.ctx, Ctx::Map { infinite: true, .. }));
+                let size = match self.stack.last().map(|f| &f.ctx) {
+                    Some(Ctx::Layer { size }) => *size,
+                    _ => None,
+                };
+                let expected = if infinite {
+                    None
+                } else {
+                    size.map(|(w, h)| w * h)
+                };
+                if let Some(n) = expected {
+                    Self::add(
+                        &file,
+                        &mut self.budget.cells,
+                        n,
+                        MAX_LEVEL_CELLS,
+                        &field,
+                        "tile cells in all layers",
+                        "MAX_LEVEL_CELLS",
+                    )?;
+                }
+                ctx = Ctx::Data(DataScan {
+                    field: field.clone(),
+                    encoding: a.get("encoding").map(str::to_owned),
+                    compression: a.get("compression").map(str::to_owned),
+                    expected,
+                    done: false,
+                    decodes: !infinite,
+                    chunks: 0,
+                });
+            }
+            "chunk" => {
+                let parent = self.stack.last_mut().map(|f| &mut f.ctx);
+                if let Some(Ctx::Data(d)) = parent {
+                    if !d.decodes {
+                        d.chunks += 1;
+                        let (encoding, compression) = (d.encoding.clone(), d.compression.clone());
+                        let (x, y) = (a.int("x").unwrap_or(0), a.int("y").unwrap_or(0));
+                        let (w, h) = (a.num("width").unwrap_or(0), a.num("height").unwrap_or(0));
+                        for (v, k) in [(x, "x"), (y, "y")] {
+                            if v.abs() > MAX_CHUNK_COORD {
+                                return Err(limit(
+                                    &file,
+                                    format!("{field}.{k}"),
+                                    "tiles from the origin",
+                                    MAX_CHUNK_COORD as u64,
+                                    v.unsigned_abs(),
+                                    "MAX_CHUNK_COORD",
+                                ));
+                            }
+                        }
+                        for (v, k) in [(w, "width"), (h, "height")] {
+                            if v > MAX_LEVEL_TILES as u64 {
+                                return Err(limit(
+                                    &file,
+                                    format!("{field}.{k}"),
+                                    "tiles",
+                                    MAX_LEVEL_TILES as u64,
+                                    v,
+                                    "MAX_LEVEL_TILES",
+                                ));
+                            }
+                        }
+                        // The tiled crate stores infinite layers in 16 x 16
+                        // blocks: count the blocks the chunk touches.
+                        let blocks = |p: i64, n: u64| {
+                            if n == 0 {
+                                0
+                            } else {
+                                ((p + n as i64 - 1).div_euclid(16) - p.div_euclid(16) + 1) as u64
+                            }
+                        };
+                        let cost = (w * h).max(blocks(x, w) * blocks(y, h) * 256);
+                        Self::add(
+                            &file,
+                            &mut self.budget.cells,
+                            cost,
+                            MAX_LEVEL_CELLS,
+                            &field,
+                            "tile cells in all layers (infinite maps count whole 16 x 16 blocks)",
+                            "MAX_LEVEL_CELLS",
+                        )?;
+                        ctx = Ctx::Data(DataScan {
+                            field: field.clone(),
+                            encoding,
+                            compression,
+                            expected: Some(w * h),
+                            done: false,
+                            decodes: true,
+                            chunks: 0,
+                        });
+                    }
+                }
+            }
+            "object" => {
+                Self::add(
+                    &file,
+                    &mut self.budget.objects,
+                    self.uses,
+                    MAX_OBJECTS,
+                    &field,
+                    "objects",
+                    "MAX_OBJECTS",
+                )?;
+                if let Some(t) = a.get("template") {
+                    if in_template {
+                        return Err(LevelError::BadValue {
+                            file,
+                            field: format!("{field}.template"),
+                            message: "an object in a tileset or template cannot use a template"
+                                .into(),
+                        });
+                    }
+                    let dir = self.path.parent().unwrap_or(Path::new(""));
+                    *self
+                        .budget
+                        .template_uses
+                        .entry(dir.join(Path::new(t)))
+                        .or_insert(0) += 1;
+                }
+            }
+            "polygon" | "polyline" => {
+                let n = a
+                    .get("points")
+                    .map_or(0, |p| p.split_ascii_whitespace().count() as u64);
+                if n > MAX_SHAPE_POINTS {
+                    return Err(limit(
+                        &file,
+                        format!("{field}.points"),
+                        "points",
+                        MAX_SHAPE_POINTS,
+                        n,
+                        "MAX_SHAPE_POINTS",
+                    ));
+                }
+                Self::add(
+                    &file,
+                    &mut self.budget.points,
+                    n.saturating_mul(self.uses),
+                    MAX_TOTAL_POINTS,
+                    &format!("{field}.points"),
+                    "polygon and polyline points",
+                    "MAX_TOTAL_POINTS",
+                )?;
+            }
+            "property" => {
+                Self::add(
+                    &file,
+                    &mut self.budget.properties,
+                    self.uses,
+                    MAX_PROPERTIES,
+                    &field,
+                    "properties",
+                    "MAX_PROPERTIES",
+                )?;
+            }
+            _ => {}
+        }
+        self.stack.push(Frame {
+            path: field,
+            ctx,
+            counts: Vec::new(),
+        });
+        Ok(())
+    }
+
+    /// Checks an `<image>`'s size; when it is not given, reads it from the
+    /// PNG's header and adds it (the `tiled` crate requires it). Returns the
+    /// size when known.
+    fn image(
+        &mut self,
+        a: &Attrs,
+        field: &str,
+        insert_at: usize,
+    ) -> Result<Option<(u64, u64)>, LevelError> {
+        let mut size = a.num("width").zip(a.num("height"));
+        if size.is_none() && a.get("width").is_none() && a.get("height").is_none() {
+            if let Some(src) = a.get("source") {
+                let dir = self.path.parent().unwrap_or(Path::new(""));
+                if let Some((w, h)) = png_size(&dir.join(src)) {
+                    self.patches
+                        .push((insert_at, format!(" width=\"{w}\" height=\"{h}\"")));
+                    size = Some((w as u64, h as u64));
+                }
+            }
+        }
+        if let Some((w, h)) = size {
+            for (v, k) in [(w, "width"), (h, "height")] {
+                if v > MAX_IMAGE_SIDE {
+                    return Err(limit(
+                        &self.file,
+                        format!("{field}.{k}"),
+                        "pixels",
+                        MAX_IMAGE_SIDE,
+                        v,
+                        "MAX_IMAGE_SIDE",
+                    ));
+                }
+            }
+            if w * h > MAX_IMAGE_PIXELS {
+                return Err(limit(
+                    &self.file,
+                    field,
+                    "pixels in one image",
+                    MAX_IMAGE_PIXELS,
+                    w * h,
+                    "MAX_IMAGE_PIXELS",
+                ));
+            }
+        }
+        Ok(size)
+    }
+
+    fn text(&mut self, text: &[u8]) -> Result<(), LevelError> {
+        let file = self.file.clone();
+        let remaining = MAX_LEVEL_CELLS.saturating_sub(self.budget.cells);
+        if let Some(Frame {
+            ctx: Ctx::Data(d), ..
+        }) = self.stack.last_mut()
+        {
+            if d.decodes && !d.done {
+                d.done = true;
+                return decode_data(&file, d, text, remaining);
+            }
+        }
+        if text.len() > MAX_TEXT_BYTES {
+            return Err(limit(
+                &file,
+                self.current_path(),
+                "bytes of text",
+                MAX_TEXT_BYTES as u64,
+                text.len() as u64,
+                "MAX_TEXT_BYTES",
+            ));
+        }
+        Ok(())
+    }
+
+    fn close(&mut self) -> Result<(), LevelError> {
+        let Some(frame) = self.stack.pop() else {
+            return Ok(());
+        };
+        match frame.ctx {
+            Ctx::Data(d) if d.decodes && !d.done => {
+                let remaining = MAX_LEVEL_CELLS.saturating_sub(self.budget.cells);
+                decode_data(&self.file, &d, b"", remaining)?;
+            }
+            Ctx::Tileset(ts) => self.finish_tileset(&ts)?,
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// Adds `tilecount` (and `columns`) to a tileset that lacks it.
+    fn finish_tileset(&mut self, ts: &TilesetScan) -> Result<(), LevelError> {
+        if ts.external || ts.tilecount.is_some() {
+            return Ok(());
+        }
+        let missing = |what: &str| {
+            LevelError::Missing {
+            file: self.file.clone(),
+            field: format!("{}.tilecount", ts.field),
+            hint: format!(
+                " (tileset {:?} has no tilecount, and it cannot be derived: {what}; save the tileset again with a recent Tiled)",
+                ts.name
+            ),
+        }
+        };
+        let (count, columns) = match ts.image {
+            None => (ts.tiles, 0),
+            Some(None) => return Err(missing("its image's width and height are not known")),
+            Some(Some((iw, ih))) => {
+                let (Some(tw), Some(th)) = ts.tile_size else {
+                    return Err(missing("no tilewidth or tileheight"));
+                };
+                let fit = |side: u64, tile: u64| {
+                    (side + ts.spacing).saturating_sub(ts.margin) / (tile + ts.spacing).max(1)
+                };
+                let (c, r) = (fit(iw, tw), fit(ih, th));
+                (c * r, c)
+            }
+        };
+        if count > MAX_TILESET_TILES {
+            return Err(limit(
+                &self.file,
+                format!("{}.tilecount", ts.field),
+                "tiles (derived from the image size)",
+                MAX_TILESET_TILES,
+                count,
+                "MAX_TILESET_TILES",
+            ));
+        }
+        if ts.image.is_some() {
+            let file = self.file.clone();
+            Self::add(
+                &file,
+                &mut self.budget.tileset_tiles,
+                count.saturating_mul(self.uses),
+                MAX_TOTAL_TILESET_TILES,
+                &format!("{}.tilecount", ts.field),
+                "tiles in all tilesets",
+                "MAX_TOTAL_TILESET_TILES",
+            )?;
+        }
+        let mut attrs = format!(" tilecount=\"{count}\"");
+        if !ts.has_columns {
+            attrs.push_str(&format!(" columns=\"{columns}\""));
+        }
+        self.patches.push((ts.insert_at, attrs));
+        Ok(())
+    }
+}
+
+/// Counts the cells of one `<data>` (or `<chunk>`) text, never holding more
+/// than a small buffer, and checks the count against the layer's size.
+fn decode_data(file: &str, d: &DataScan, text: &[u8], remaining: u64) -> Result<(), LevelError> {
+    let bad = |message: String| LevelError::Syntax {
+        file: file.into(),
+        field: d.field.clone(),
+        format: "TMX",
+        message,
+    };
+    // Cells counted at most: what the layer needs plus one, within the load's
+    // remaining budget (the layer's own cells are already counted in it).
+    let expected = d.expected;
+    let cap = match expected {
+        Some(n) => n.saturating_add(remaining).saturating_add(1),
+        None => remaining.saturating_add(1),
+    };
+    let got = match (d.encoding.as_deref(), d.compression.as_deref()) {
+        (Some("csv"), None) => {
+            let n = memchr_count(b',', text) + 1;
+            n.min(cap)
+        }
+        (Some("base64"), c) => {
+            let trimmed = trim_ascii(text);
+            let b64 = base64::read::DecoderReader::new(
+                trimmed,
+                &base64::engine::general_purpose::STANDARD,
+            );
+            let byte_cap = cap.saturating_mul(4);
+            let bytes = match c {
+                None => count_bytes(b64, byte_cap),
+                Some("zlib") => count_bytes(flate2::read::ZlibDecoder::new(b64), byte_cap),
+                Some("gzip") => count_bytes(flate2::read::GzDecoder::new(b64), byte_cap),
+                Some("zstd") => {
+                    return Err(LevelError::BadValue {
+                        file: file.into(),
+                        field: format!("{}.compression", d.field),
+                        message: "zstd-compressed tile data is not supported: in Tiled, set Map > Map Properties > Tile Layer Format to Base64 (zlib compressed) or Base64 (gzip compressed) and save again".into(),
+                    })
+                }
+                Some(other) => {
+                    return Err(LevelError::BadValue {
+                        file: file.into(),
+                        field: format!("{}.compression", d.field),
+                        message: format!("unknown compression {other:?} (expected zlib or gzip)"),
+                    })
+                }
+            }
+            .map_err(|e| bad(format!("cannot decode the tile data: {e}")))?;
+            if bytes % 4 != 0 && bytes < byte_cap {
+                return Err(bad(format!(
+                    "{bytes} bytes of tile data is not a whole number of 4-byte cells"
+                )));
+            }
+            bytes / 4
+        }
+        (Some("csv"), Some(c)) => {
+            return Err(LevelError::BadValue {
+                file: file.into(),
+                field: format!("{}.compression", d.field),
+                message: format!("CSV tile data cannot be compressed, got {c:?}"),
+            })
+        }
+        (None, _) => {
+            return Err(LevelError::BadValue {
+                file: file.into(),
+                field: format!("{}.encoding", d.field),
+                message: "tile data as XML <tile> elements is not supported: in Tiled, set Map > Map Properties > Tile Layer Format to CSV or Base64 and save again".into(),
+            })
+        }
+        (Some(e), _) => {
+            return Err(LevelError::BadValue {
+                file: file.into(),
+                field: format!("{}.encoding", d.field),
+                message: format!(
+                    "unknown tile data encoding {e:?} (expected csv or base64)"
+                ),
+            })
+        }
+    };
+    let over = match expected {
+        Some(n) => got > n.saturating_add(remaining),
+        None => got > remaining,
+    };
+    if over {
+        return Err(LevelError::Limit {
+            file: file.into(),
+            field: d.field.clone(),
+            what: "tile cells in all layers (decoding stopped there)".into(),
+            limit: MAX_LEVEL_CELLS,
+            found: MAX_LEVEL_CELLS.saturating_add(1),
+            bound: "MAX_LEVEL_CELLS",
+        });
+    }
+    if let Some(n) = expected {
+        if got != n {
+            return Err(LevelError::Length {
+                file: file.into(),
+                field: d.field.clone(),
+                expected: n,
+                got,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Reads `r` to its end or to `cap + 1` bytes, whichever is first, into a
+/// small buffer, and returns how many bytes there were.
+fn count_bytes(r: impl Read, cap: u64) -> io::Result<u64> {
+    io::copy(&mut r.take(cap.saturating_add(1)), &mut io::sink())
+}
+
+fn memchr_count(b: u8, s: &[u8]) -> u64 {
+    s.iter().filter(|&&c| c == b).count() as u64
+}
+
+fn trim_ascii(s: &[u8]) -> &[u8] {
+    let start = s
+        .iter()
+        .position(|c| !c.is_ascii_whitespace())
+        .unwrap_or(s.len());
+    let end = s
+        .iter()
+        .rposition(|c| !c.is_ascii_whitespace())
+        .map_or(start, |e| e + 1);
+    &s[start..end]
+}
+
+/// The width and height of a PNG file, from its header (24 bytes read).
+fn png_size(path: &Path) -> Option<(u32, u32)> {
+    let f = std::fs::File::open(path).ok()?;
+    let mut head = Vec::with_capacity(24);
+    f.take(24).read_to_end(&mut head).ok()?;
+    if head.len() < 24 || &head[..8] != b"\x89PNG\r\n\x1a\n" || &head[12..16] != b"IHDR" {
+        return None;
+    }
+    let w = u32::from_be_bytes(head[16..20].try_into().ok()?);
+    let h = u32::from_be_bytes(head[20..24].try_into().ok()?);
+    Some((w, h))
+}
+
+/// Checks an OGMO JSON document before `serde_json` parses it: its size,
+/// nesting depth ([`MAX_JSON_DEPTH`]) and number of values
+/// ([`MAX_JSON_VALUES`]), in one pass without allocating.
+pub(crate) fn check_json(file: &str, text: &str) -> Result<(), LevelError> {
+    let b = text.as_bytes();
+    if b.len() as u64 > MAX_FILE_BYTES {
+        return Err(limit(
+            file,
+            "(document)",
+            "bytes",
+            MAX_FILE_BYTES,
+            b.len() as u64,
+            "MAX_FILE_BYTES",
+        ));
+    }
+    let (mut depth, mut values) = (0usize, 0u64);
+    let mut i = 0;
+    let mut prev_scalar = false;
+    while i < b.len() {
+        let c = b[i];
+        let starts_value = match c {
+            b'[' | b'{' => {
+                depth += 1;
+                if depth > MAX_JSON_DEPTH {
+                    return Err(limit(
+                        file,
+                        format!("byte {i}"),
+                        "levels of array and object nesting",
+                        MAX_JSON_DEPTH as u64,
+                        depth as u64,
+                        "MAX_JSON_DEPTH",
+                    ));
+                }
+                prev_scalar = false;
+                true
+            }
+            b']' | b'}' => {
+                depth = depth.saturating_sub(1);
+                prev_scalar = false;
+                false
+            }
+            b'"' => {
+                i += 1;
+                while i < b.len() && b[i] != b'"' {
+                    i += if b[i] == b'\\' { 2 } else { 1 };
+                }
+                prev_scalar = false;
+                true
+            }
+            b',' | b':' | b' ' | b'\t' | b'\n' | b'\r' => {
+                prev_scalar = false;
+                false
+            }
+            _ => {
+                // A number or literal: count it once.
+                let first = !prev_scalar;
+                prev_scalar = true;
+                first
+            }
+        };
+        if starts_value {
+            values += 1;
+            if values > MAX_JSON_VALUES {
+                return Err(limit(
+                    file,
+                    format!("byte {i}"),
+                    "JSON values (numbers, strings, arrays, objects)",
+                    MAX_JSON_VALUES,
+                    values,
+                    "MAX_JSON_VALUES",
+                ));
+            }
+        }
+        i += 1;
+    }
+    Ok(())
 }

@@ -183,6 +183,7 @@ impl Cx<'_> {
     }
 
     fn parse(&self, text: &str, format: &'static str) -> Result<Obj, LevelError> {
+        crate::limits::check_json(self.file, text)?;
         match serde_json::from_str::<Value>(text) {
             Ok(Value::Object(o)) => Ok(o),
             Ok(other) => Err(self.expected("(document)", "an object", &other)),

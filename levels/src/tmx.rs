@@ -43,10 +43,29 @@ use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
 use ledge_shared::tilemap::Tile;
 
 /// Serves the map from memory (when given) and every other file (external
-/// tilesets, templates) from the filesystem, with the size limit.
+/// tilesets, templates) from the filesystem, with the size limit; every
+/// document goes through the pre-scan of [`crate::limits`] first, with one
+/// budget for the whole load.
 struct Reader {
     main: PathBuf,
     text: Option<Vec<u8>>,
+    budget: crate::limits::Budget,
+    /// The first refusal, kept whole: the `tiled` crate only passes on its
+    /// text (and may name another file).
+    error: Option<LevelError>,
+}
+
+impl Reader {
+    fn read(&mut self, path: &Path) -> Result<Vec<u8>, LevelError> {
+        let bytes = match self.text.take() {
+            Some(t) if path == self.main => t,
+            t => {
+                self.text = t;
+                super::read_bytes(path)?
+            }
+        };
+        crate::limits::check_tmx_resource(&mut self.budget, path, bytes)
+    }
 }
 
 impl ResourceReader for Reader {
@@ -54,15 +73,14 @@ impl ResourceReader for Reader {
     type Error = std::io::Error;
 
     fn read_from(&mut self, path: &Path) -> Result<Self::Resource, Self::Error> {
-        if path == self.main {
-            if let Some(t) = &self.text {
-                return Ok(Cursor::new(t.clone()));
-            }
+        if let Some(e) = &self.error {
+            return Err(std::io::Error::other(e.to_string()));
         }
-        super::read_bytes(path)
-            .and_then(|bytes| crate::limits::check_tmx_resource(path, bytes))
-            .map(Cursor::new)
-            .map_err(|e| std::io::Error::other(e.to_string()))
+        self.read(path).map(Cursor::new).map_err(|e| {
+            let io = std::io::Error::other(e.to_string());
+            self.error = Some(e);
+            io
+        })
     }
 }
 
@@ -86,8 +104,16 @@ fn load(
     let mut loader = Loader::<DefaultResourceCache, _>::with_reader(Reader {
         main: path.to_path_buf(),
         text,
+        budget: Default::default(),
+        error: None,
     });
-    let map = match catch_unwind(AssertUnwindSafe(|| loader.load_tmx_map(path))) {
+    let result = catch_unwind(AssertUnwindSafe(|| loader.load_tmx_map(path)));
+    // A refusal of the pre-scan wins over whatever the tiled crate made of it
+    // (and over a map it loaded anyway).
+    if let Some(e) = loader.reader_mut().error.take() {
+        return Err(e);
+    }
+    let map = match result {
         Ok(Ok(map)) => map,
         Ok(Err(::tiled::Error::ResourceLoadingError { path: p, err })) if p == path => {
             return Err(LevelError::Io {
