@@ -13,7 +13,7 @@ use ledge_shared::shape::{ConvexPolygon, ShapeError, MAX_POLYGON_VERTICES};
 ///
 /// | names | becomes | parameters (OGMO `values`, Tiled `properties`) |
 /// |---|---|---|
-/// | `player`, `spawn`, `player_spawn`, `start` | [`EntityKind::PlayerSpawn`] | |
+/// | `player`, `spawn`, `player_spawn`, `player_start`, `start` | [`EntityKind::PlayerSpawn`] | |
 /// | `block`, `solid`, `crate` | [`EntityKind::Block`]; a Tiled polygon object of these names: [`EntityKind::PolygonBlock`] | |
 /// | `polygon`, `polygon_block`, `ramp` | [`EntityKind::PolygonBlock`]: a static convex polygon of 3 to 8 vertices. OGMO: the vertices are the entity's position followed by its `nodes` (raw positions of the entity's origin, as the editor draws them); Tiled: a polygon object's points (an unnamed polygon object is one too) | |
 /// | `platform`, `moving_platform`, `mover`, `elevator` | [`EntityKind::MovingPlatform`] | `speed` (px/tick, default 1), `one_way` (bool, default false), `loop` (bool, default false); path: OGMO `nodes`, Tiled `path` (object property naming a polyline or polygon) |
@@ -28,6 +28,7 @@ pub const ENTITY_NAMES: &[&str] = &[
     "player",
     "spawn",
     "player_spawn",
+    "player_start",
     "start",
     "block",
     "solid",
@@ -131,6 +132,11 @@ pub(crate) fn is_polygon_name(name: &str) -> bool {
     matches!(class_of(name), Some(Class::Polygon))
 }
 
+/// Whether `name` is in the entity table ([`ENTITY_NAMES`]).
+pub(crate) fn is_entity_name(name: &str) -> bool {
+    class_of(name).is_some()
+}
+
 /// What an entity became.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Classified {
@@ -215,7 +221,8 @@ enum Class {
 
 fn class_of(name: &str) -> Option<Class> {
     Some(match normalize(name).as_str() {
-        "player" | "spawn" | "player_spawn" | "playerspawn" | "start" => Class::Spawn,
+        "player" | "spawn" | "player_spawn" | "playerspawn" | "player_start" | "playerstart"
+        | "start" => Class::Spawn,
         "block" | "solid" | "crate" => Class::Block,
         "polygon" | "polygon_block" | "polygonblock" | "ramp" => Class::Polygon,
         "platform" | "moving_platform" | "movingplatform" | "mover" | "elevator" => Class::Platform,

@@ -26,12 +26,14 @@
 //! See `docs/LEVELS.md` for the user-facing description.
 
 pub mod art;
+mod collision;
 mod default;
 mod entities;
 mod error;
 pub mod limits;
 mod mapping;
 pub mod ogmo;
+mod spawn;
 pub mod tmx;
 
 use std::path::Path;
@@ -51,6 +53,7 @@ pub use ledge_shared::level::{
 };
 pub use mapping::{
     parse_tile_kind, tile_kind_name, TileMapping, TileTable, ECHO_SLOPES, LEDGE_TILESET,
+    LEDGE_TILESET_NAME,
 };
 
 use entities::Classified;
@@ -69,7 +72,7 @@ pub struct LoadOptions {
     pub mapping: TileMapping,
     /// Skip entities whose name is not in [`ENTITY_NAMES`] (each is listed in
     /// [`LoadedLevel::warnings`]) instead of refusing the file. Default:
-    /// refuse.
+    /// skip.
     pub skip_unknown_entities: bool,
     /// Only these tile/grid layers (by name) make the collision grid; `None`
     /// (the default): every one.
@@ -82,7 +85,7 @@ impl Default for LoadOptions {
     fn default() -> Self {
         Self {
             mapping: TileMapping::default(),
-            skip_unknown_entities: false,
+            skip_unknown_entities: true,
             collision_layers: None,
             require_spawn: true,
         }
@@ -226,6 +229,7 @@ pub(crate) fn assemble(
     entities: Vec<PlacedEntity>,
     options: &LoadOptions,
 ) -> Result<LoadedLevel, LevelError> {
+    let mut mismatched = Vec::new();
     let tilemap = match grids.split_first() {
         None => Tilemap::new(IVec2::ZERO, 16 * UNITS_PER_PX, 0, 0, Vec::new())
             .map_err(|e| tilemap_error(file, "layers", e))?,
@@ -241,26 +245,26 @@ pub(crate) fn assemble(
             let mut tiles = first.tiles.clone();
             for g in rest {
                 if (g.cell, g.cells, g.origin) != (first.cell, first.cells, first.origin) {
-                    return Err(LevelError::BadValue {
-                        file: file.into(),
-                        field: g.field.clone(),
-                        message: format!(
-                            "collision layer of {} x {} cells of {} x {} px at ({}, {}) units does not match {} ({} x {} cells of {} x {} px at ({}, {}) units); choose layers with LoadOptions::collision_layers",
-                            g.cells.0,
-                            g.cells.1,
-                            g.cell.0,
-                            g.cell.1,
-                            g.origin.x,
-                            g.origin.y,
-                            first.field,
-                            first.cells.0,
-                            first.cells.1,
-                            cw,
-                            ch,
-                            first.origin.x,
-                            first.origin.y
-                        ),
-                    });
+                    // Grids of another cell size or origin are not merged
+                    // (yet): said, not guessed.
+                    mismatched.push(format!(
+                        "{file}: {}: this collision layer of {} x {} cells of {} x {} px at ({}, {}) px does not line up with {} ({} x {} cells of {} x {} px at ({}, {}) px), the level's grid: it does not collide (draw collision on one grid, or choose layers with LoadOptions::collision_layers)",
+                        g.field,
+                        g.cells.0,
+                        g.cells.1,
+                        g.cell.0,
+                        g.cell.1,
+                        g.origin.x / UNITS_PER_PX,
+                        g.origin.y / UNITS_PER_PX,
+                        first.field,
+                        first.cells.0,
+                        first.cells.1,
+                        cw,
+                        ch,
+                        first.origin.x / UNITS_PER_PX,
+                        first.origin.y / UNITS_PER_PX
+                    ));
+                    continue;
                 }
                 for (t, &n) in tiles.iter_mut().zip(&g.tiles) {
                     if n != Tile::Empty {
@@ -286,7 +290,7 @@ pub(crate) fn assemble(
             entities: Vec::with_capacity(entities.len()),
         },
         route: Vec::new(),
-        warnings: Vec::new(),
+        warnings: mismatched,
         art: art::LevelArt::default(),
     };
     for e in &entities {
@@ -314,10 +318,20 @@ pub(crate) fn assemble(
             .iter()
             .any(|e| e.kind == EntityKind::PlayerSpawn)
     {
-        return Err(LevelError::MissingSpawn {
-            file: file.into(),
-            field: "entities".into(),
-        });
+        let player = ledge_shared::game::PlayerConfig::default();
+        let Some(spawn) = spawn::find(&out.level, &player) else {
+            return Err(LevelError::MissingSpawn {
+                file: file.into(),
+                field: "entities".into(),
+            });
+        };
+        let px = |u: i32| u as f64 / UNITS_PER_PX as f64;
+        out.warnings.push(format!(
+            "{file}: no player spawn: players start at ({}, {}) px, the first free standing spot from the left (add an object or entity named \"player\" or \"spawn\" to choose)",
+            px(spawn.pos.x),
+            px(spawn.pos.y + spawn.size.y / 2)
+        ));
+        out.level.entities.push(spawn);
     }
     Ok(out)
 }

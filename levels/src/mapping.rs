@@ -101,13 +101,15 @@ impl TileTable {
 
 /// The configurable mapping from editor tiles to [`Tile`]s.
 ///
-/// * Tile layers (OGMO tile layers, Tiled tile layers): the tileset's
-///   [`TileTable`] (looked up by the tileset's label/name, case-insensitive),
-///   or the default table when the tileset has none. The default mapping's
-///   default table is [`LEDGE_TILESET`] (the echo-slopes layout plus a hazard
-///   tile), so the echo-slopes sample gets its slopes right. In Tiled a
-///   tile's own `kind` property (see [`parse_tile_kind`]) wins over the
-///   table.
+/// * Tile layers (OGMO tile layers, Tiled tile layers): the [`TileTable`] of
+///   the tileset (looked up by the tileset's label/name, case-insensitive),
+///   when the mapping has one. The default mapping has one only for ledge's
+///   own tileset, named `ledge` ([`LEDGE_TILESET`]): a foreign tileset never
+///   gets ledge's table by accident. In Tiled, a tileset without a table
+///   collides from the map's own data (tile collision shapes, properties,
+///   classes; see `docs/LEVELS.md`, "What collides"); an OGMO tile layer
+///   whose tileset has no table does not collide (with a warning).
+///   [`TileMapping::new`] sets a table for every tileset instead.
 /// * Grid layers (OGMO): the cell's string value. By default the value is the
 ///   tile's one-byte code ([`Tile::code`]): `"0"` empty, `"1"` solid, `"2"`
 ///   one-way, `"3"` hazard, `"4"`..`"9"` the slopes in [`Slope::ALL`] order;
@@ -116,28 +118,41 @@ impl TileTable {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TileMapping {
     tilesets: BTreeMap<String, TileTable>,
-    default_table: TileTable,
+    default_table: Option<TileTable>,
     grid: BTreeMap<String, Tile>,
 }
 
 impl Default for TileMapping {
-    /// [`LEDGE_TILESET`] for every tileset, grid values as tile codes.
+    /// [`LEDGE_TILESET`] for ledge's own tileset (`ledge`) only, grid values
+    /// as tile codes.
     fn default() -> Self {
-        Self::new(TileTable::Ids(LEDGE_TILESET.to_vec()))
+        Self {
+            tilesets: BTreeMap::new(),
+            default_table: None,
+            grid: grid_codes(),
+        }
+        .with_tileset(LEDGE_TILESET_NAME, TileTable::Ids(LEDGE_TILESET.to_vec()))
     }
+}
+
+/// The name of ledge's own tileset (the default level's), the only one the
+/// default mapping reads through [`LEDGE_TILESET`].
+pub const LEDGE_TILESET_NAME: &str = "ledge";
+
+fn grid_codes() -> BTreeMap<String, Tile> {
+    (0..=9u8)
+        .filter_map(|c| Some((c.to_string(), Tile::from_code(c)?)))
+        .collect()
 }
 
 impl TileMapping {
     /// A mapping using `default_table` for every tileset, grid values as tile
     /// codes.
     pub fn new(default_table: TileTable) -> Self {
-        let grid = (0..=9u8)
-            .filter_map(|c| Some((c.to_string(), Tile::from_code(c)?)))
-            .collect();
         Self {
             tilesets: BTreeMap::new(),
-            default_table,
-            grid,
+            default_table: Some(default_table),
+            grid: grid_codes(),
         }
     }
 
@@ -153,12 +168,21 @@ impl TileMapping {
         self
     }
 
-    /// The tile of `id` in tileset `tileset`; `None` when unmapped.
+    /// Whether tileset `tileset` has a table (its own or the default one).
+    pub fn has_table(&self, tileset: &str) -> bool {
+        self.table(tileset).is_some()
+    }
+
+    /// The tile of `id` in tileset `tileset`; `None` when the tileset has no
+    /// table or the table has no entry for `id`.
     pub fn tile(&self, tileset: &str, id: u32) -> Option<Tile> {
+        self.table(tileset)?.get(id)
+    }
+
+    fn table(&self, tileset: &str) -> Option<&TileTable> {
         self.tilesets
             .get(&tileset.to_lowercase())
-            .unwrap_or(&self.default_table)
-            .get(id)
+            .or(self.default_table.as_ref())
     }
 
     /// The tile of a grid layer value; `None` when unmapped.
@@ -218,8 +242,9 @@ pub fn tile_kind_name(tile: Tile) -> &'static str {
     }
 }
 
-/// The mirror image of a tile (left <-> right), for horizontally flipped
-/// Tiled tiles.
+/// The mirror image of a tile (left <-> right): the oracle for horizontally
+/// flipped Tiled tiles (`collision::flip`).
+#[cfg(test)]
 pub(crate) fn mirror(tile: Tile) -> Tile {
     use Slope::*;
     match tile {
@@ -282,7 +307,12 @@ mod tests {
     fn tables_per_tileset() {
         let m = TileMapping::default().with_tileset("Plain", TileTable::AllSolid);
         assert_eq!(m.tile("plain", 77), Some(Tile::Solid));
-        assert_eq!(m.tile("other", 13), Some(Tile::Hazard));
-        assert_eq!(m.tile("other", 26), None);
+        // Only ledge's own tileset reads through LEDGE_TILESET by default.
+        assert_eq!(m.tile("Ledge", 13), Some(Tile::Hazard));
+        assert_eq!(m.tile("ledge", 26), None);
+        assert!(!m.has_table("other"));
+        assert_eq!(m.tile("other", 13), None);
+        let all = TileMapping::new(TileTable::Ids(LEDGE_TILESET.to_vec()));
+        assert_eq!(all.tile("other", 13), Some(Tile::Hazard));
     }
 }

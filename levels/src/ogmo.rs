@@ -26,6 +26,8 @@
 //!
 //! Level and layer `offsetX`/`offsetY` shift everything in the layer.
 
+use std::collections::BTreeMap;
+
 use glam::IVec2;
 use serde_json::{Map, Value};
 
@@ -49,6 +51,8 @@ pub struct Project {
     pub entities: Vec<ProjectEntity>,
     /// Tilesets.
     pub tilesets: Vec<ProjectTileset>,
+    /// `backgroundColor` (`#rrggbbaa`), empty when absent.
+    pub background_color: String,
 }
 
 /// A layer definition of a [`Project`].
@@ -88,6 +92,14 @@ pub struct ProjectTileset {
     pub tile_height: u32,
     /// Tiles per row, when the embedded image's width could be read.
     pub columns: Option<u32>,
+    /// `tileMarginX`, pixels.
+    pub margin: u32,
+    /// `tileSeparationX`, pixels.
+    pub spacing: u32,
+    /// `path`: the image file the tileset was made from.
+    pub path: String,
+    /// `image`: the embedded image, a `data:image/png;base64,` URI.
+    pub image: String,
 }
 
 /// A decoded OGMO level: layers in file order, positions still per layer.
@@ -354,6 +366,9 @@ pub fn parse_project(file: &str, text: &str) -> Result<Project, LevelError> {
     let root = cx.parse(text, "OGMO project JSON")?;
     let mut p = Project {
         name: cx.opt_str(&root, "name", "")?.unwrap_or_default(),
+        background_color: cx
+            .opt_str(&root, "backgroundColor", "")?
+            .unwrap_or_default(),
         ..Project::default()
     };
     if let Some(v) = root.get("layers") {
@@ -418,6 +433,10 @@ pub fn parse_project(file: &str, text: &str) -> Result<Project, LevelError> {
                 tile_width: tw as u32,
                 tile_height: th as u32,
                 columns,
+                margin: margin as u32,
+                spacing: sep as u32,
+                path: cx.opt_str(o, "path", &f)?.unwrap_or_default(),
+                image,
             });
         }
     }
@@ -890,9 +909,14 @@ pub fn load_str(
     project: Option<(&str, &str)>,
     options: &LoadOptions,
 ) -> Result<LoadedLevel, LevelError> {
+    let project_file = project.map(|(pf, _)| pf);
     let project = project.map(|(pf, pt)| parse_project(pf, pt)).transpose()?;
     let level = parse_level(file, text, project.as_ref())?;
-    let warnings = level.warnings;
+    let art = match (project_file, &project) {
+        (Some(pf), Some(p)) => crate::art::from_ogmo(file, pf, p, &level)?,
+        _ => crate::art::LevelArt::default(),
+    };
+    let mut warnings = level.warnings;
     let mut grids = Vec::new();
     let mut entities = Vec::new();
     for l in level.layers {
@@ -901,6 +925,18 @@ pub fn load_str(
             .as_ref()
             .is_none_or(|names| names.contains(&l.name));
         let tiles = match l.content {
+            LayerContent::Tiles { tileset, .. }
+                if wanted && !options.mapping.has_table(&tileset) =>
+            {
+                // OGMO files say nothing about which tiles collide: only a
+                // tileset with a table (ledge's own, or one the caller maps)
+                // does.
+                warnings.push(format!(
+                    "{file}: {}: tile layer {:?} does not collide: its tileset {tileset:?} is not ledge's own and no tile table maps it (use a grid layer for collision, or map the tileset's tiles)",
+                    l.field, l.name
+                ));
+                continue;
+            }
             LayerContent::Tiles { tileset, key, ids } if wanted => ids
                 .iter()
                 .enumerate()
@@ -918,21 +954,30 @@ pub fn load_str(
                     })
                 })
                 .collect::<Result<Vec<_>, _>>()?,
-            LayerContent::Grid { key, values } if wanted => values
-                .iter()
-                .enumerate()
-                .map(|(i, v)| {
-                    options
-                        .mapping
-                        .grid_tile(v)
-                        .ok_or_else(|| LevelError::UnknownTile {
-                            file: file.into(),
-                            field: cell_field(&l.field, key, i, l.cells.0),
-                            tile: format!("grid value {v:?}"),
-                            tileset: "grid".into(),
+            LayerContent::Grid { key, values } if wanted => {
+                // Values the mapping does not know are solid (OGMO's own
+                // grids use "0" for empty and "1" for solid), said once per
+                // value.
+                let mut unknown: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
+                let tiles = values
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| {
+                        options.mapping.grid_tile(v).unwrap_or_else(|| {
+                            unknown.entry(v).or_insert((i, 0)).1 += 1;
+                            Tile::Solid
                         })
-                })
-                .collect::<Result<Vec<_>, _>>()?,
+                    })
+                    .collect();
+                for (v, (first, n)) in unknown {
+                    warnings.push(format!(
+                        "{file}: {}: grid value {v:?} ({n} cells) of layer {:?} is read as solid (ledge reads \"0\" as empty, \"1\" solid, \"2\" one-way, \"3\" hazard, \"4\"-\"9\" slopes, or tile kind names)",
+                        cell_field(&l.field, key, first, l.cells.0),
+                        l.name
+                    ));
+                }
+                tiles
+            }
             LayerContent::Entities(es) => {
                 entities.extend(es);
                 continue;
@@ -953,6 +998,7 @@ pub fn load_str(
         .unwrap_or_default();
     let mut loaded = super::assemble(file, name, grids, entities, options)?;
     loaded.warnings.splice(0..0, warnings);
+    loaded.art = art;
     Ok(loaded)
 }
 

@@ -24,6 +24,7 @@
 //!   objects.
 //! * Image layers are ignored.
 
+use std::cell::RefCell;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Cursor;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -35,11 +36,13 @@ use ::tiled::{
 };
 use glam::IVec2;
 
+use super::collision::{self, tile_of_props, Outline, Prop, TileShape};
+use super::entities::is_entity_name;
 use super::entities::{
     check_coord_field, place_box, px_to_units, PlacedEntity, PlacedPolygon, PropValue,
 };
-use super::mapping::{mirror, parse_tile_kind};
 use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
+use ledge_shared::shape::MAX_POLYGON_VERTICES;
 use ledge_shared::tilemap::Tile;
 
 /// Serves the map from memory (when given) and every other file (external
@@ -142,6 +145,8 @@ fn load(
         file: &file,
         map: &map,
         options,
+        fallback: Fallback::None,
+        notes: RefCell::new(Notes::default()),
     }
     .run(path)?;
     loaded.art = crate::art::from_tiled(&file, &map)?;
@@ -152,6 +157,96 @@ struct Conv<'a> {
     file: &'a str,
     map: &'a Map,
     options: &'a LoadOptions,
+    /// Which tile layers collide when nothing in the map says.
+    fallback: Fallback,
+    /// Warnings, aggregated.
+    notes: RefCell<Notes>,
+}
+
+/// What collides in a map that carries no collision data at all (no tile
+/// collision shapes, no collision properties or classes on tiles, tilesets
+/// or layers).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Fallback {
+    /// The map has collision data: tiles without any are empty.
+    None,
+    /// Every tile of the visible tile layers with a collision name
+    /// ([`collision::is_collision_layer_name`]).
+    NamedLayers,
+    /// Every tile of every visible tile layer.
+    AllLayers,
+}
+
+/// Warnings counted by what they say, with the first place each happened.
+#[derive(Default)]
+struct Notes {
+    by_key: BTreeMap<String, (usize, String)>,
+    order: Vec<String>,
+}
+
+impl Notes {
+    /// Records `what` (one line, the same for every occurrence) at `place`.
+    fn add(&mut self, what: String, place: impl FnOnce() -> String) {
+        match self.by_key.get_mut(&what) {
+            Some((n, _)) => *n += 1,
+            None => {
+                self.by_key.insert(what.clone(), (1, place()));
+                self.order.push(what);
+            }
+        }
+    }
+
+    fn lines(self, file: &str) -> Vec<String> {
+        let mut by_key = self.by_key;
+        self.order
+            .into_iter()
+            .filter_map(|what| {
+                let (n, place) = by_key.remove(&what)?;
+                Some(if n == 1 {
+                    format!("{file}: {place}: {what}")
+                } else {
+                    format!("{file}: {place} and {} more like it: {what}", n - 1)
+                })
+            })
+            .collect()
+    }
+}
+
+/// A layer as [`Conv::visit`] hands it over, groups applied.
+struct LayerInfo<'l> {
+    /// Path of the layer (`layers[1].layers[0]`).
+    field: String,
+    /// The layer's name.
+    name: &'l str,
+    /// Visible, with every group above it.
+    visible: bool,
+    /// What its properties/class (or its groups') say about collision.
+    collides: Option<bool>,
+    /// Offset in pixels, groups included.
+    off: (f64, f64),
+}
+
+impl LayerInfo<'_> {
+    /// `layer "Ground" (layers[2])`, for messages.
+    fn describe(&self) -> String {
+        format!("layer {:?} ({})", self.name, self.field)
+    }
+}
+
+/// A property as [`collision`] reads it.
+fn prop(v: &PropertyValue) -> Prop<'_> {
+    match v {
+        PropertyValue::BoolValue(b) => Prop::Bool(*b),
+        PropertyValue::StringValue(s) => Prop::Text(s),
+        _ => Prop::Other,
+    }
+}
+
+fn props(p: &::tiled::Properties) -> impl Iterator<Item = (&str, Prop<'_>)> {
+    // Sorted, so the outcome does not depend on the map's hash order.
+    let mut v: Vec<_> = p.iter().map(|(k, v)| (k.as_str(), prop(v))).collect();
+    v.sort_by(|a, b| a.0.cmp(b.0));
+    v.into_iter()
 }
 
 /// A path object: absolute points (pixels) and whether it is closed.
@@ -167,9 +262,18 @@ struct Paths {
     used: BTreeSet<u32>,
 }
 
-/// What [`Conv::visit`] calls on each layer: `(field, name, layer, offset)`.
-type LayerFn<'m, 'f> =
-    dyn FnMut(&str, &str, LayerType<'m>, (f64, f64)) -> Result<(), LevelError> + 'f;
+/// What [`Conv::visit`] calls on each layer.
+type LayerFn<'m, 'f> = dyn FnMut(&LayerInfo<'_>, LayerType<'m>) -> Result<(), LevelError> + 'f;
+
+/// What a tile's own data says about its collision.
+enum TileRule {
+    /// A ledge tile (flips still to apply to slopes).
+    Kind(Tile),
+    /// Collision outlines, tile-local pixels of the tile's own size.
+    Outlines(Vec<Outline>),
+    /// Nothing.
+    Silent,
+}
 
 impl Conv<'_> {
     fn bad(&self, field: impl Into<String>, message: String) -> LevelError {
@@ -180,13 +284,13 @@ impl Conv<'_> {
         }
     }
 
-    fn run(&self, path: &Path) -> Result<LoadedLevel, LevelError> {
+    fn run(mut self, path: &Path) -> Result<LoadedLevel, LevelError> {
         let m = self.map;
         if m.orientation != Orientation::Orthogonal {
             return Err(self.bad(
                 "map.orientation",
                 format!(
-                    "{:?} maps are not supported (use orthogonal)",
+                    "{:?} maps are not supported: ledge levels are orthogonal (side view); make an orthogonal map",
                     m.orientation
                 ),
             ));
@@ -194,7 +298,7 @@ impl Conv<'_> {
         if m.infinite() {
             return Err(self.bad(
                 "map.infinite",
-                "infinite maps are not supported (make the map finite)".into(),
+                "infinite maps are not supported yet (in Tiled: Map > Map Properties, untick Infinite)".into(),
             ));
         }
         if m.tile_width != m.tile_height || !(1..=4096).contains(&m.tile_width) {
@@ -215,94 +319,231 @@ impl Conv<'_> {
                 });
             }
         }
-        // Every polyline/polygon by id, and the ids platforms use as paths.
+        // Every polyline/polygon by id, the ids platforms use as paths, and
+        // whether the map says anything about collision.
         let mut paths = Paths::default();
-        self.visit(m.layers(), "layers", (0.0, 0.0), &mut |_, _, layer, off| {
-            if let LayerType::Objects(ol) = layer {
-                for o in ol.objects() {
-                    let (ox, oy) = (o.x as f64 + off.0, o.y as f64 + off.1);
-                    let (pts, closed) = match &o.shape {
-                        ObjectShape::Polyline { points } => (points, false),
-                        ObjectShape::Polygon { points } => (points, true),
-                        _ => {
-                            if let Some(PropertyValue::ObjectValue(id)) = o.properties.get("path") {
-                                paths.used.insert(*id);
-                            }
-                            continue;
-                        }
-                    };
-                    let points = pts
-                        .iter()
-                        .map(|&(x, y)| (ox + x as f64, oy + y as f64))
-                        .collect();
-                    paths.by_id.insert(o.id(), PathObj { points, closed });
+        let mut has_data = m.tilesets().iter().any(|ts| {
+            ts.tiles().any(|(_, t)| {
+                t.collision.is_some()
+                    || !matches!(tile_of_props(props(&t.properties), &t.user_type), Ok(None))
+            })
+        });
+        let mut named_layer = false;
+        self.visit(m.layers(), "layers", &mut |info, layer| {
+            has_data |= info.collides.is_some();
+            match layer {
+                LayerType::Tiles(_) => {
+                    named_layer |= info.visible && collision::is_collision_layer_name(info.name)
                 }
+                LayerType::Objects(ol) => {
+                    for o in ol.objects() {
+                        let (ox, oy) = (o.x as f64 + info.off.0, o.y as f64 + info.off.1);
+                        let (pts, closed) = match &o.shape {
+                            ObjectShape::Polyline { points } => (points, false),
+                            ObjectShape::Polygon { points } => (points, true),
+                            _ => {
+                                if let Some(PropertyValue::ObjectValue(id)) =
+                                    o.properties.get("path")
+                                {
+                                    paths.used.insert(*id);
+                                }
+                                continue;
+                            }
+                        };
+                        let points = pts
+                            .iter()
+                            .map(|&(x, y)| (ox + x as f64, oy + y as f64))
+                            .collect();
+                        paths.by_id.insert(o.id(), PathObj { points, closed });
+                    }
+                }
+                _ => {}
             }
             Ok(())
         })?;
+        self.fallback = match (has_data, named_layer) {
+            (true, _) => Fallback::None,
+            (false, true) => Fallback::NamedLayers,
+            (false, false) => Fallback::AllLayers,
+        };
         let mut grids = Vec::new();
         let mut entities = Vec::new();
-        self.visit(
-            m.layers(),
-            "layers",
-            (0.0, 0.0),
-            &mut |field, name, layer, off| {
-                match layer {
-                    LayerType::Tiles(tl) => {
-                        if let Some(g) = self.tile_layer(field, name, &tl, off)? {
-                            grids.push(g);
-                        }
+        let mut any_tiles = false;
+        self.visit(m.layers(), "layers", &mut |info, layer| {
+            match layer {
+                LayerType::Tiles(tl) => {
+                    if let Some(g) = self.tile_layer(info, &tl, &mut entities)? {
+                        any_tiles |= g.tiles.iter().any(|&t| t != Tile::Empty);
+                        grids.push(g);
                     }
-                    LayerType::Objects(ol) => {
-                        self.object_layer(field, name, &ol, off, &paths, &mut entities)?
-                    }
-                    _ => {}
                 }
-                Ok(())
-            },
-        )?;
+                LayerType::Objects(ol) => self.object_layer(info, &ol, &paths, &mut entities)?,
+                _ => {}
+            }
+            Ok(())
+        })?;
+        if self.fallback == Fallback::AllLayers && any_tiles {
+            self.notes.get_mut().add(
+                "the map has no collision data (no tile collision shapes, no `solid`/`collides`/`one_way`/`hazard` tile properties, no collision layer property or class, no layer named \"collision\"), so every tile of every visible tile layer is solid; mark what collides in Tiled (see docs/LEVELS.md, \"What collides\")".into(),
+                || "map".into(),
+            );
+        }
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        super::assemble(self.file, name, grids, entities, self.options)
+        let mut loaded = super::assemble(self.file, name, grids, entities, self.options)?;
+        let notes = std::mem::take(self.notes.get_mut());
+        loaded.warnings.splice(0..0, notes.lines(self.file));
+        Ok(loaded)
     }
 
-    /// Calls `f(field, name, layer, offset)` on every layer, groups flattened,
-    /// offsets accumulated (pixels).
+    /// Calls `f(info, layer)` on every layer, groups flattened: offsets
+    /// accumulated (pixels), a hidden group hides its layers, and a group's
+    /// collision property or class applies to the layers that have none.
     fn visit<'m>(
         &self,
         layers: impl Iterator<Item = ::tiled::Layer<'m>>,
         parent: &str,
-        off: (f64, f64),
         f: &mut LayerFn<'m, '_>,
     ) -> Result<(), LevelError> {
+        let top = LayerInfo {
+            field: String::new(),
+            name: "",
+            visible: true,
+            collides: None,
+            off: (0.0, 0.0),
+        };
+        self.visit_in(layers, parent, &top, f, 0)
+    }
+
+    fn visit_in<'m>(
+        &self,
+        layers: impl Iterator<Item = ::tiled::Layer<'m>>,
+        parent: &str,
+        up: &LayerInfo<'_>,
+        f: &mut LayerFn<'m, '_>,
+        depth: usize,
+    ) -> Result<(), LevelError> {
         for (i, l) in layers.enumerate() {
-            let field = format!("{parent}[{i}]");
-            let off = (off.0 + l.offset_x as f64, off.1 + l.offset_y as f64);
+            let info = LayerInfo {
+                field: format!("{parent}[{i}]"),
+                name: &l.name,
+                visible: up.visible && l.visible,
+                collides: collision::layer_collides(props(&l.properties), &l.user_type)
+                    .or(up.collides),
+                off: (up.off.0 + l.offset_x as f64, up.off.1 + l.offset_y as f64),
+            };
             match l.layer_type() {
                 LayerType::Group(g) => {
-                    self.visit(g.layers(), &format!("{field}.layers"), off, f)?
+                    if depth >= MAX_GROUP_DEPTH {
+                        return Err(self.bad(
+                            info.field,
+                            format!("groups nested deeper than {MAX_GROUP_DEPTH}"),
+                        ));
+                    }
+                    let field = format!("{}.layers", info.field);
+                    self.visit_in(g.layers(), &field, &info, f, depth + 1)?
                 }
-                t => f(&field, &l.name, t, off)?,
+                t => f(&info, t)?,
             }
         }
         Ok(())
     }
 
+    /// What a tileset tile says about its collision (its `kind` and
+    /// collision properties, its class, its collision outlines), or what
+    /// [`LoadOptions::mapping`] says for its tileset.
+    fn tile_rule(
+        &self,
+        ts: &::tiled::Tileset,
+        id: u32,
+        field: &str,
+    ) -> Result<TileRule, LevelError> {
+        let tile = ts.get_tile(id);
+        if let Some(t) = &tile {
+            let said = tile_of_props(props(&t.properties), &t.user_type).map_err(|m| {
+                self.bad(
+                    format!("{field} (tileset {:?} tile {id} properties)", ts.name),
+                    m,
+                )
+            })?;
+            if let Some(tile) = said {
+                return Ok(TileRule::Kind(tile));
+            }
+        }
+        if self.options.mapping.has_table(&ts.name) {
+            return match self.options.mapping.tile(&ts.name, id) {
+                Some(tile) => Ok(TileRule::Kind(tile)),
+                None => Err(LevelError::UnknownTile {
+                    file: self.file.into(),
+                    field: field.into(),
+                    tile: format!("tile id {id}"),
+                    tileset: ts.name.clone(),
+                }),
+            };
+        }
+        let Some(t) = tile else {
+            return Ok(TileRule::Silent);
+        };
+        let Some(group) = &t.collision else {
+            return Ok(TileRule::Silent);
+        };
+        let mut outlines = Vec::new();
+        for o in group.object_data() {
+            let (x, y, r) = (o.x as f64, o.y as f64, o.rotation as f64);
+            let outline = match &o.shape {
+                ObjectShape::Rect { width, height } => {
+                    collision::rect_outline(x, y, *width as f64, *height as f64, r)
+                }
+                ObjectShape::Ellipse { width, height } => {
+                    let e = collision::ellipse_outline(0.0, 0.0, *width as f64, *height as f64);
+                    collision::rotate_about(&e, (x, y), r)
+                }
+                ObjectShape::Polygon { points } => {
+                    let pts: Vec<_> = points.iter().map(|&(a, b)| (a as f64, b as f64)).collect();
+                    collision::rotate_about(&pts, (x, y), r)
+                }
+                _ => {
+                    self.notes.borrow_mut().add(
+                        format!(
+                            "tileset {:?} tile {id}: collision shapes other than rectangles, ellipses and polygons (polylines, points) are ignored",
+                            ts.name
+                        ),
+                        || field.to_owned(),
+                    );
+                    continue;
+                }
+            };
+            outlines.push(outline);
+        }
+        Ok(if outlines.is_empty() {
+            TileRule::Silent
+        } else {
+            TileRule::Outlines(outlines)
+        })
+    }
+
     fn tile_layer(
         &self,
-        field: &str,
-        name: &str,
+        info: &LayerInfo<'_>,
         tl: &TileLayer<'_>,
-        off: (f64, f64),
+        geometry: &mut Vec<PlacedEntity>,
     ) -> Result<Option<GridLayer>, LevelError> {
+        let field = info.field.as_str();
         let wanted = self
             .options
             .collision_layers
             .as_ref()
-            .is_none_or(|names| names.iter().any(|n| n == name));
-        if !wanted {
+            .is_none_or(|names| names.iter().any(|n| n == info.name));
+        if !wanted || info.collides == Some(false) {
+            return Ok(None);
+        }
+        if !info.visible {
+            self.notes.borrow_mut().add(
+                "hidden tile layer: not collided (make it visible in Tiled to collide)".into(),
+                || info.describe(),
+            );
             return Ok(None);
         }
         let TileLayer::Finite(fl) = tl else {
@@ -312,12 +553,12 @@ impl Conv<'_> {
                 kind: "infinite tile layer".into(),
             });
         };
-        if off != (0.0, 0.0) {
+        if info.off != (0.0, 0.0) {
             return Err(self.bad(
                 format!("{field}.offsetx"),
                 format!(
                     "tile layers must not be offset, got ({}, {}) px",
-                    off.0, off.1
+                    info.off.0, info.off.1
                 ),
             ));
         }
@@ -348,6 +589,13 @@ impl Conv<'_> {
                 ),
             ));
         }
+        let fallback = match self.fallback {
+            Fallback::None => false,
+            Fallback::NamedLayers => collision::is_collision_layer_name(info.name),
+            Fallback::AllLayers => true,
+        };
+        let t = self.map.tile_width as f64;
+        let mut rules: BTreeMap<(usize, u32), TileRule> = BTreeMap::new();
         let mut tiles = Vec::with_capacity(w as usize * h as usize);
         for y in 0..h as i32 {
             for x in 0..w as i32 {
@@ -355,56 +603,62 @@ impl Conv<'_> {
                     tiles.push(Tile::Empty);
                     continue;
                 };
-                let cf = format!("{field}.data[{}]", y as i64 * w as i64 + x as i64);
+                let cf = || format!("{field}.data[{}]", y as i64 * w as i64 + x as i64);
                 let ts = lt.get_tileset();
-                let kind_prop = lt
-                    .get_tile()
-                    .and_then(|t| t.properties.get("kind").cloned());
-                let tile = match kind_prop {
-                    Some(PropertyValue::StringValue(s)) => {
-                        parse_tile_kind(&s).ok_or_else(|| LevelError::UnknownTile {
-                            file: self.file.into(),
-                            field: format!(
-                                "{cf} (tileset {:?} tile {} properties.kind)",
+                let key = (lt.tileset_index(), lt.id());
+                if let std::collections::btree_map::Entry::Vacant(v) = rules.entry(key) {
+                    v.insert(self.tile_rule(ts, lt.id(), &cf())?);
+                }
+                let (tw, th) = (ts.tile_width as f64, ts.tile_height as f64);
+                let flips = (lt.flip_h, lt.flip_v, lt.flip_d);
+                let shape = match &rules[&key] {
+                    TileRule::Kind(Tile::Slope(s)) if flips != (false, false, false) => {
+                        let mut o = collision::region_outline(Tile::Slope(*s), t);
+                        collision::flip(&mut o, t, flips.0, flips.1, flips.2);
+                        collision::classify_outlines(vec![o], t)
+                    }
+                    TileRule::Kind(k) => TileShape::Tile(*k),
+                    TileRule::Outlines(outlines) => {
+                        let mut outlines = outlines.clone();
+                        for o in &mut outlines {
+                            collision::flip(o, tw, flips.0, flips.1, flips.2);
+                        }
+                        if (tw, th) == (t, t) {
+                            collision::classify_outlines(outlines, t)
+                        } else {
+                            // A tile of another size stands on the cell's
+                            // bottom-left corner.
+                            for o in &mut outlines {
+                                for p in o.iter_mut() {
+                                    p.1 += t - th;
+                                }
+                            }
+                            TileShape::Geometry(outlines)
+                        }
+                    }
+                    TileRule::Silent if info.collides == Some(true) || fallback => {
+                        TileShape::Tile(Tile::Solid)
+                    }
+                    TileRule::Silent => TileShape::Tile(Tile::Empty),
+                };
+                match shape {
+                    TileShape::Tile(tile) => tiles.push(tile),
+                    TileShape::Geometry(outlines) => {
+                        tiles.push(Tile::Empty);
+                        let corner = (x as f64 * t, y as f64 * t);
+                        for (k, o) in outlines.into_iter().enumerate() {
+                            let abs: Vec<_> =
+                                o.iter().map(|p| (corner.0 + p.0, corner.1 + p.1)).collect();
+                            let gf = format!(
+                                "{} (tileset {:?} tile {} collision shape {k})",
+                                cf(),
                                 ts.name,
                                 lt.id()
-                            ),
-                            tile: format!("kind {s:?}"),
-                            tileset: ts.name.clone(),
-                        })?
+                            );
+                            self.push_geometry(info, &gf, (x, y), &abs, geometry)?;
+                        }
                     }
-                    Some(other) => {
-                        return Err(self.bad(
-                            format!(
-                                "{cf} (tileset {:?} tile {} properties.kind)",
-                                ts.name,
-                                lt.id()
-                            ),
-                            format!("expected a string, got {other:?}"),
-                        ));
-                    }
-                    None => self
-                        .options
-                        .mapping
-                        .tile(&ts.name, lt.id())
-                        .ok_or_else(|| LevelError::UnknownTile {
-                            file: self.file.into(),
-                            field: cf.clone(),
-                            tile: format!("tile id {}", lt.id()),
-                            tileset: ts.name.clone(),
-                        })?,
-                };
-                let tile = match tile {
-                    Tile::Slope(_) if lt.flip_v || lt.flip_d => {
-                        return Err(self.bad(
-                            cf,
-                            "a slope flipped vertically or diagonally has no tile kind (ceilings are not supported)".into(),
-                        ));
-                    }
-                    t if lt.flip_h => mirror(t),
-                    t => t,
-                };
-                tiles.push(tile);
+                }
             }
         }
         let ts = self.map.tile_width;
@@ -417,29 +671,200 @@ impl Conv<'_> {
         }))
     }
 
+    /// Static solid geometry outside the grid from an outline in absolute
+    /// pixels: an axis-aligned box becomes a block, a convex outline of 3
+    /// to 8 points a polygon block; anything else is skipped with a
+    /// warning. `at` is the place (tiles) for the warning.
+    fn push_geometry(
+        &self,
+        info: &LayerInfo<'_>,
+        field: &str,
+        at: (i32, i32),
+        outline: &[(f64, f64)],
+        out: &mut Vec<PlacedEntity>,
+    ) -> Result<(), LevelError> {
+        let place = || format!("{} at ({}, {}) tiles", info.describe(), at.0, at.1);
+        let (mut lo, mut hi) = ((f64::MAX, f64::MAX), (f64::MIN, f64::MIN));
+        for p in outline {
+            lo = (lo.0.min(p.0), lo.1.min(p.1));
+            hi = (hi.0.max(p.0), hi.1.max(p.1));
+        }
+        let axis_box = outline.len() == 4
+            && outline
+                .iter()
+                .all(|p| [lo.0, hi.0].contains(&p.0) && [lo.1, hi.1].contains(&p.1));
+        if axis_box {
+            let l = px_to_units(self.file, &format!("{field}.x"), lo.0)?;
+            let tp = px_to_units(self.file, &format!("{field}.y"), lo.1)?;
+            if hi.0 - lo.0 <= 0.0 || hi.1 - lo.1 <= 0.0 {
+                self.notes.borrow_mut().add(
+                    "a collision rectangle of zero size is ignored".into(),
+                    place,
+                );
+                return Ok(());
+            }
+            let (centre, size) = place_box(self.file, field, l, tp, hi.0 - lo.0, hi.1 - lo.1)?;
+            out.push(geometry_entity(info, field, centre, size, None));
+            return Ok(());
+        }
+        if !collision::is_convex(outline) || !(3..=MAX_POLYGON_VERTICES).contains(&outline.len()) {
+            self.notes.borrow_mut().add(
+                format!(
+                    "a collision outline that is concave or has more than {MAX_POLYGON_VERTICES} points is ignored: split it into convex polygons of 3 to {MAX_POLYGON_VERTICES} points in Tiled"
+                ),
+                place,
+            );
+            return Ok(());
+        }
+        let mut poly = PlacedPolygon {
+            field: field.into(),
+            points: Vec::with_capacity(outline.len()),
+            point_fields: Vec::with_capacity(outline.len()),
+        };
+        for (i, &(x, y)) in outline.iter().enumerate() {
+            let pf = format!("{field}[{i}]");
+            let ux = px_to_units(self.file, &format!("{pf}.x"), x)?;
+            let uy = px_to_units(self.file, &format!("{pf}.y"), y)?;
+            poly.points.push(IVec2::new(ux as i32, uy as i32));
+            poly.point_fields.push(pf);
+        }
+        let first = poly.points[0];
+        out.push(geometry_entity(
+            info,
+            field,
+            first,
+            IVec2::splat(2),
+            Some(poly),
+        ));
+        Ok(())
+    }
+
     fn object_layer(
         &self,
-        field: &str,
-        layer_name: &str,
+        info: &LayerInfo<'_>,
         ol: &ObjectLayer<'_>,
-        off: (f64, f64),
         paths: &Paths,
         out: &mut Vec<PlacedEntity>,
     ) -> Result<(), LevelError> {
+        let field = info.field.as_str();
+        let off = info.off;
+        if !info.visible {
+            if ol.objects().len() > 0 {
+                self.notes.borrow_mut().add(
+                    format!(
+                        "hidden object layer: its {} objects are ignored (make it visible in Tiled to use them)",
+                        ol.objects().len()
+                    ),
+                    || info.describe(),
+                );
+            }
+            return Ok(());
+        }
         let tile_px = self.map.tile_width as f64;
         for (k, o) in ol.objects().enumerate() {
             if paths.used.contains(&o.id()) && paths.by_id.contains_key(&o.id()) {
                 continue;
             }
             let f = format!("{field}.objects[{k}]");
-            let name = if o.user_type.trim().is_empty() {
+            // The class names the entity, else the name (also when the
+            // class is not a ledge entity and the name is).
+            let name = if o.user_type.trim().is_empty()
+                || (!is_entity_name(&o.user_type) && is_entity_name(&o.name))
+            {
                 o.name.clone()
             } else {
                 o.user_type.clone()
             };
             let (x, y) = (o.x as f64 + off.0, o.y as f64 + off.1);
+            let at = || {
+                format!(
+                    "{} object {} {:?} at ({:.0}, {:.0}) px",
+                    info.describe(),
+                    o.id(),
+                    name,
+                    x,
+                    y
+                )
+            };
+            if !o.visible {
+                continue;
+            }
+            if !is_entity_name(&name) {
+                // Not an entity: solid geometry if it says so (or is an
+                // unnamed shape), a hazard, or something to skip.
+                let tile = o.get_tile();
+                let own = tile_of_props(props(&o.properties), "")
+                    .map_err(|m| self.bad(format!("{f}.properties"), m))?;
+                let from_tile = match (own, &tile) {
+                    (None, Some(t)) => match t.get_tile() {
+                        Some(td) => tile_of_props(props(&td.properties), &td.user_type)
+                            .map_err(|m| self.bad(format!("{f}.properties"), m))?,
+                        None => None,
+                    },
+                    _ => None,
+                };
+                let said = own.or(from_tile);
+                let unnamed_shape = name.trim().is_empty()
+                    && tile.is_none()
+                    && matches!(
+                        o.shape,
+                        ObjectShape::Rect { .. } | ObjectShape::Ellipse { .. }
+                    );
+                match said {
+                    Some(Tile::Solid) | Some(Tile::Slope(_)) => {}
+                    None if unnamed_shape => {}
+                    Some(Tile::Hazard) => {
+                        if let Some((l, t, w, h)) = object_box(&o.shape, x, y, tile.is_some()) {
+                            let lu = px_to_units(self.file, &format!("{f}.x"), l)?;
+                            let tu = px_to_units(self.file, &format!("{f}.y"), t)?;
+                            let (centre, size) = place_box(self.file, &f, lu, tu, w, h)?;
+                            let mut e = geometry_entity(info, &f, centre, size, None);
+                            e.name = "hazard".into();
+                            out.push(e);
+                        }
+                        continue;
+                    }
+                    Some(Tile::OneWay) => {
+                        self.notes.borrow_mut().add(
+                            "one-way objects are not supported (use one-way tiles or a platform object named \"platform\" with `one_way`); ignored".into(),
+                            at,
+                        );
+                        continue;
+                    }
+                    Some(Tile::Empty) => continue,
+                    None if name.trim().is_empty() => {
+                        // Decoration (tile objects), markers (points),
+                        // labels (text): nothing to collide with.
+                        if !matches!(o.shape, ObjectShape::Polygon { .. }) {
+                            continue;
+                        }
+                    }
+                    None => {
+                        if !self.options.skip_unknown_entities {
+                            return Err(LevelError::UnknownEntity {
+                                file: self.file.into(),
+                                field: format!("{f}.name"),
+                                layer: info.name.into(),
+                                name: name.clone(),
+                            });
+                        }
+                        self.notes.borrow_mut().add(
+                            format!(
+                                "skipped objects named {name:?}: not a ledge entity (known: {}); give them a known name or class, or an alias in the level's settings",
+                                crate::ENTITY_NAMES.join(", ")
+                            ),
+                            at,
+                        );
+                        continue;
+                    }
+                }
+                if !matches!(o.shape, ObjectShape::Polygon { .. }) {
+                    self.solid_object(info, &f, &o, (x, y), out)?;
+                    continue;
+                }
+            }
             if let ObjectShape::Polygon { points } = &o.shape {
-                let name = if name.trim().is_empty() {
+                let name = if name.trim().is_empty() || !is_entity_name(&name) {
                     "polygon".to_owned()
                 } else {
                     name
@@ -447,7 +872,7 @@ impl Conv<'_> {
                 let polygon = self.polygon(&f, o.id(), &name, points, (x, y), o.rotation)?;
                 out.push(PlacedEntity {
                     name,
-                    layer: layer_name.into(),
+                    layer: info.name.into(),
                     field: f,
                     values_key: "properties",
                     centre: polygon.points.first().copied().unwrap_or_default(),
@@ -459,24 +884,21 @@ impl Conv<'_> {
                 continue;
             }
             let (left, top, w, h) = match &o.shape {
-                ObjectShape::Rect { width, height } | ObjectShape::Ellipse { width, height } => {
-                    let (w, h) = (*width as f64, *height as f64);
-                    // Tile objects are anchored at their bottom-left corner.
-                    let top = if o.tile_data().is_some() { y - h } else { y };
-                    (x, top, w, h)
-                }
                 ObjectShape::Point(..) => (x - tile_px / 2.0, y - tile_px / 2.0, tile_px, tile_px),
-                other => {
-                    let shape = match other {
-                        ObjectShape::Polyline { .. } => "polyline",
-                        ObjectShape::Text { .. } => "text",
-                        _ => "capsule",
-                    };
-                    return Err(self.bad(
-                        format!("{f}.shape"),
-                        format!("a {shape} object is not an entity (polylines are platform paths: name them in a platform's `path` property)"),
-                    ));
-                }
+                shape => match object_box(shape, x, y, o.tile_data().is_some()) {
+                    Some(b) => b,
+                    None => {
+                        let shape = match shape {
+                            ObjectShape::Polyline { .. } => "polyline",
+                            ObjectShape::Text { .. } => "text",
+                            _ => "capsule",
+                        };
+                        return Err(self.bad(
+                            format!("{f}.shape"),
+                            format!("a {shape} object is not an entity (polylines are platform paths: name them in a platform's `path` property)"),
+                        ));
+                    }
+                },
             };
             let l = px_to_units(self.file, &format!("{f}.x"), left)?;
             let t = px_to_units(self.file, &format!("{f}.y"), top)?;
@@ -528,7 +950,7 @@ impl Conv<'_> {
             }
             out.push(PlacedEntity {
                 name,
-                layer: layer_name.into(),
+                layer: info.name.into(),
                 field: f,
                 values_key: "properties",
                 centre,
@@ -537,6 +959,86 @@ impl Conv<'_> {
                 values,
                 polygon: None,
             });
+        }
+        Ok(())
+    }
+
+    /// A solid object that is not an entity: a rectangle (turned by its
+    /// rotation), an ellipse (as an octagon), or a tile object (its tile's
+    /// collision outlines fitted to the object, else its box), as static
+    /// geometry.
+    fn solid_object(
+        &self,
+        info: &LayerInfo<'_>,
+        f: &str,
+        o: &::tiled::Object<'_>,
+        (x, y): (f64, f64),
+        out: &mut Vec<PlacedEntity>,
+    ) -> Result<(), LevelError> {
+        let r = o.rotation as f64;
+        let at = (
+            (x / self.map.tile_width as f64).floor() as i32,
+            (y / self.map.tile_height as f64).floor() as i32,
+        );
+        let outlines: Vec<Outline> = match (&o.shape, o.get_tile()) {
+            (ObjectShape::Rect { width, height }, Some(tile)) => {
+                // Tile objects stand on their bottom-left corner and turn
+                // about it; the tile's outlines scale to the object's size.
+                let (w, h) = (*width as f64, *height as f64);
+                let ts = tile.get_tileset();
+                let (tw, th) = match tile.get_tile().and_then(|t| t.image.clone()) {
+                    Some(img) => (img.width as f64, img.height as f64),
+                    None => (ts.tile_width as f64, ts.tile_height as f64),
+                };
+                let data = o.tile_data();
+                let (fh, fv) = data.map(|d| (d.flip_h, d.flip_v)).unwrap_or_default();
+                let own = match self.tile_rule(ts, tile.id(), f)? {
+                    TileRule::Outlines(v) => v,
+                    _ => vec![collision::rect_outline(0.0, 0.0, tw, th, 0.0)],
+                };
+                own.into_iter()
+                    .map(|mut ol| {
+                        for p in ol.iter_mut() {
+                            if fh {
+                                p.0 = tw - p.0;
+                            }
+                            if fv {
+                                p.1 = th - p.1;
+                            }
+                            *p = (p.0 * w / tw.max(1e-9), p.1 * h / th.max(1e-9) - h);
+                        }
+                        collision::rotate_about(&ol, (x, y), r)
+                    })
+                    .collect()
+            }
+            (ObjectShape::Rect { width, height }, None) => {
+                vec![collision::rect_outline(
+                    x,
+                    y,
+                    *width as f64,
+                    *height as f64,
+                    r,
+                )]
+            }
+            (ObjectShape::Ellipse { width, height }, _) => {
+                let e = collision::ellipse_outline(0.0, 0.0, *width as f64, *height as f64);
+                vec![collision::rotate_about(&e, (x, y), r)]
+            }
+            _ => {
+                self.notes.borrow_mut().add(
+                    "solid objects must be rectangles, ellipses, polygons or tile objects; this one is ignored".into(),
+                    || format!("{} object {}", info.describe(), o.id()),
+                );
+                return Ok(());
+            }
+        };
+        for (k, ol) in outlines.iter().enumerate() {
+            let gf = if outlines.len() == 1 {
+                f.to_owned()
+            } else {
+                format!("{f} (collision shape {k})")
+            };
+            self.push_geometry(info, &gf, at, ol, out)?;
         }
         Ok(())
     }
@@ -562,24 +1064,19 @@ impl Conv<'_> {
                 message: format!(
                     "polygon has {} vertices; it needs 3 to {}",
                     points.len(),
-                    ledge_shared::shape::MAX_POLYGON_VERTICES
+                    MAX_POLYGON_VERTICES
                 ),
             });
         }
-        let (sin, cos) = if rotation == 0.0 {
-            (0.0, 1.0)
-        } else {
-            (rotation as f64).to_radians().sin_cos()
-        };
+        let pts: Vec<_> = points.iter().map(|&(a, b)| (a as f64, b as f64)).collect();
+        let abs = collision::rotate_about(&pts, (x, y), rotation as f64);
         let mut out = PlacedPolygon {
             field,
             points: Vec::with_capacity(points.len()),
             point_fields: Vec::with_capacity(points.len()),
         };
-        for (i, &(px, py)) in points.iter().enumerate() {
+        for (i, &(ax, ay)) in abs.iter().enumerate() {
             let pf = format!("{f}.polygon[{i}] (object {id} {name:?})");
-            let (px, py) = (px as f64, py as f64);
-            let (ax, ay) = (x + px * cos - py * sin, y + px * sin + py * cos);
             let ux = px_to_units(self.file, &format!("{pf}.x"), ax)?;
             let uy = px_to_units(self.file, &format!("{pf}.y"), ay)?;
             check_coord_field(self.file, &format!("{pf}.x"), ux)?;
@@ -588,5 +1085,48 @@ impl Conv<'_> {
             out.point_fields.push(pf);
         }
         Ok(out)
+    }
+}
+
+/// Deepest nesting of group layers.
+const MAX_GROUP_DEPTH: usize = 64;
+
+/// The box `(left, top, width, height)` in pixels of a rectangle, ellipse
+/// or tile object (tile objects stand on their bottom-left corner); `None`
+/// for other shapes.
+fn object_box(shape: &ObjectShape, x: f64, y: f64, is_tile: bool) -> Option<(f64, f64, f64, f64)> {
+    match shape {
+        ObjectShape::Rect { width, height } | ObjectShape::Ellipse { width, height } => {
+            let (w, h) = (*width as f64, *height as f64);
+            let top = if is_tile { y - h } else { y };
+            Some((x, top, w, h))
+        }
+        _ => None,
+    }
+}
+
+/// A static solid from a tile collision shape or a solid object.
+fn geometry_entity(
+    info: &LayerInfo<'_>,
+    field: &str,
+    centre: IVec2,
+    size: IVec2,
+    polygon: Option<PlacedPolygon>,
+) -> PlacedEntity {
+    PlacedEntity {
+        name: if polygon.is_some() {
+            "polygon"
+        } else {
+            "block"
+        }
+        .into(),
+        layer: info.name.into(),
+        field: field.into(),
+        values_key: "properties",
+        centre,
+        size,
+        nodes: Vec::new(),
+        values: Vec::new(),
+        polygon,
     }
 }

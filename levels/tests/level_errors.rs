@@ -2,9 +2,11 @@
 //! message names the file and the field; and a property test feeding random
 //! and mutated bytes to the loaders (never a panic).
 
+use glam::IVec2;
 use ledge_levels::{
-    load_default_level, load_file, load_file_with, ogmo, tmx, LevelError, LoadOptions,
+    load_default_level, load_file, load_file_with, ogmo, tmx, EntityKind, LevelError, LoadOptions,
 };
+use ledge_shared::tilemap::Tile;
 use proptest::prelude::*;
 
 const UNO: &str = concat!(
@@ -313,16 +315,39 @@ fn bad_values() {
         "layers[0].dataCoords[0]",
     );
     assert!(msg.contains("column count"), "{msg}");
-    // Tiled: a slope flipped vertically, an unknown kind property.
+    // Tiled: a slope flipped vertically is a ceiling: no tile kind, so a
+    // static polygon over its cell (cell 165 = (5, 8) of 16 px tiles).
     let file = format!("{TILED_DIR}/flipped.tmx");
     let text = std::fs::read_to_string(format!("{TILED_DIR}/level.tmx"))
         .unwrap()
         .replacen("2147483651", "1073741827", 1);
-    check(
-        tmx::load_str(&file, &text, &LoadOptions::default()),
-        &file,
-        "layers[0].data[165]",
-    );
+    let l = tmx::load_str(&file, &text, &LoadOptions::default()).unwrap();
+    assert_eq!(l.level.tilemap.tile(IVec2::new(5, 8)), Tile::Empty);
+    let cell = |x: i32, y: i32| IVec2::new(x, y) * 16 * 256;
+    let ceiling = l
+        .level
+        .entities
+        .iter()
+        .find_map(|e| match &e.kind {
+            EntityKind::PolygonBlock { vertices } => {
+                let abs: Vec<_> = vertices.iter().map(|v| *v + e.pos).collect();
+                abs.iter()
+                    .all(|p| {
+                        (cell(5, 8).x..=cell(6, 8).x).contains(&p.x)
+                            && (cell(5, 8).y..=cell(5, 9).y).contains(&p.y)
+                    })
+                    .then_some(abs)
+            }
+            _ => None,
+        })
+        .expect("a polygon in cell (5, 8)");
+    // The `/` slope upside down: solid above the line, top-left to
+    // bottom-right corners... mirrored vertically: (0,0), (16,0), (16,16).
+    let mut want = vec![cell(5, 8), cell(6, 8), cell(6, 9)];
+    let mut got = ceiling.clone();
+    want.sort_by_key(|p| (p.x, p.y));
+    got.sort_by_key(|p| (p.x, p.y));
+    assert_eq!(got, want);
 }
 
 #[test]
@@ -334,12 +359,17 @@ fn unknown_tiles() {
         "layers[0].data[7]: tile id 99",
     );
     assert!(msg.contains("\"ledge\""), "{msg}");
+    // A grid value ledge does not know is solid, with a warning.
     let grid = r#"{"name": "solids", "gridCellWidth": 16, "gridCellHeight": 16, "gridCellsX": 2, "gridCellsY": 1, "grid2D": [["1", "z"]]}"#;
     let text = format!(r#"{{"layers": [{grid}, {{"name": "e", "entities": [{SPAWN}]}}]}}"#);
-    check(
-        load(&text),
-        "levels/test.json",
-        "layers[0].grid2D[0][1]: grid value \"z\"",
+    let l = load(&text).unwrap();
+    assert_eq!(l.level.tilemap.tiles(), &[Tile::Solid, Tile::Solid]);
+    assert_eq!(l.warnings.len(), 1, "{:?}", l.warnings);
+    assert!(
+        l.warnings[0].contains("layers[0].grid2D[0][1]: grid value \"z\" (1 cells)")
+            && l.warnings[0].contains("read as solid"),
+        "{:?}",
+        l.warnings
     );
     let file = format!("{TILED_DIR}/kind.tmx");
     let text = std::fs::read_to_string(format!("{TILED_DIR}/level.tmx"))
@@ -355,15 +385,29 @@ fn unknown_tiles() {
 
 #[test]
 fn unknown_entities_name_file_layer_and_entity() {
-    // With every layer, uno.json stops at its grid_2D layer's "g" cells.
-    let msg = load_file(UNO).unwrap_err().to_string();
-    assert!(msg.starts_with(UNO), "{msg}");
-    assert!(
-        msg.contains("layers[5].grid2D[9][24]: grid value \"g\" is not mapped"),
-        "{msg}"
-    );
+    // uno.json (a format sample, not a game) has nothing to stand on but
+    // a 2 x 2 corner of grid value "3" (hazard): refused for want of a
+    // spawn. Without that requirement it loads, and says what it did not
+    // use: its tile layers (a foreign tileset), the grid layer that does
+    // not line up, the unknown entity "Dude".
+    let e = load_file_with(UNO, &LoadOptions::default()).unwrap_err();
+    assert!(matches!(e, LevelError::MissingSpawn { .. }), "{e}");
+    let lenient = LoadOptions {
+        require_spawn: false,
+        ..LoadOptions::default()
+    };
+    let l = load_file_with(UNO, &lenient).unwrap();
+    let all = l.warnings.join("\n");
+    for needle in [
+        "tile layer \"tile_1D\" does not collide",
+        "layers[5]: this collision layer of 40 x 30 cells of 8 x 8 px",
+        "skipped unknown entity \"Dude\" in layer \"entity_layer\"",
+    ] {
+        assert!(all.contains(needle), "{needle:?} not in:\n{all}");
+    }
     let opts = LoadOptions {
         collision_layers: Some(Vec::new()),
+        skip_unknown_entities: false,
         ..LoadOptions::default()
     };
     let e = load_file_with(UNO, &opts).unwrap_err();
@@ -395,12 +439,26 @@ fn unknown_entities_name_file_layer_and_entity() {
     let text = std::fs::read_to_string(format!("{TILED_DIR}/level.tmx"))
         .unwrap()
         .replacen("name=\"coin\"", "name=\"ghost\"", 1);
+    let strict = LoadOptions {
+        skip_unknown_entities: false,
+        ..LoadOptions::default()
+    };
     let msg = check(
-        tmx::load_str(&file, &text, &LoadOptions::default()),
+        tmx::load_str(&file, &text, &strict),
         &file,
         "layers[2].objects[8].name",
     );
     assert!(msg.contains("\"ghost\" in layer \"objects\""), "{msg}");
+    // By default: skipped, and said where.
+    let l = tmx::load_str(&file, &text, &LoadOptions::default()).unwrap();
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.contains("layer \"objects\" (layers[2]) object")
+                && w.contains("skipped objects named \"ghost\"")),
+        "{:?}",
+        l.warnings
+    );
 }
 
 #[test]
@@ -466,7 +524,27 @@ fn missing_spawn() {
     let e = load(&level(TILES, "")).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "levels/test.json: entities: no player spawn (add an entity named \"player\" or \"spawn\")"
+        "levels/test.json: entities: no player spawn, and no free spot to stand on for one (add an entity named \"player\" or \"spawn\")"
+    );
+    // With a floor and room above it, one is placed on the first free
+    // spot from the left, and said.
+    let floor = r#""data": [-1, -1, -1, -1, 1, 1, 1, 1], "exportMode": 0, "arrayMode": 0"#;
+    let l = load(&level(floor, "")).unwrap();
+    let spawn = l
+        .level
+        .entities
+        .iter()
+        .find(|e| e.kind == EntityKind::PlayerSpawn)
+        .expect("a spawn");
+    // Standing on row 1's top (y = 16 px), in column 0.
+    assert_eq!(spawn.pos.y + spawn.size.y / 2, 16 * 256);
+    assert!((0..16 * 256).contains(&spawn.pos.x), "{spawn:?}");
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.contains("no player spawn: players start at (")),
+        "{:?}",
+        l.warnings
     );
     let opts = LoadOptions {
         require_spawn: false,
