@@ -1,0 +1,718 @@
+//! The bounds of `ledge_levels::limits`: for each one, a generated file that
+//! goes past it gets a clean `Err` naming the file, the element and the
+//! bound, with no panic (a panic hook records any) and a bounded peak of
+//! heap memory (a counting global allocator); the real Tiled examples that
+//! lack `tilecount` now get past the Tiled reader.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, MutexGuard, Once};
+use std::time::Instant;
+
+use ledge_levels::limits::*;
+use ledge_levels::{ogmo, tmx, LevelError, LoadOptions};
+
+/// Counts the heap bytes in use and their peak.
+struct Counting;
+
+static CURRENT: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        let p = unsafe { System.alloc(l) };
+        if !p.is_null() {
+            let now = CURRENT.fetch_add(l.size(), Ordering::Relaxed) + l.size();
+            PEAK.fetch_max(now, Ordering::Relaxed);
+        }
+        p
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        unsafe { System.dealloc(p, l) };
+        CURRENT.fetch_sub(l.size(), Ordering::Relaxed);
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, new: usize) -> *mut u8 {
+        let q = unsafe { System.realloc(p, l, new) };
+        if !q.is_null() {
+            if new >= l.size() {
+                let now = CURRENT.fetch_add(new - l.size(), Ordering::Relaxed) + new - l.size();
+                PEAK.fetch_max(now, Ordering::Relaxed);
+            } else {
+                CURRENT.fetch_sub(l.size() - new, Ordering::Relaxed);
+            }
+        }
+        q
+    }
+}
+
+#[global_allocator]
+static ALLOC: Counting = Counting;
+
+/// Peak heap use allowed while loading any generated file (beyond what was in
+/// use before the load).
+const PEAK_BYTES: usize = 256 << 20;
+
+static PANICS: AtomicUsize = AtomicUsize::new(0);
+static SERIAL: Mutex<()> = Mutex::new(());
+
+/// One test at a time (the peak is process-wide), with the panic hook set.
+fn serial() -> MutexGuard<'static, ()> {
+    static HOOK: Once = Once::new();
+    HOOK.call_once(|| {
+        let default = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            PANICS.fetch_add(1, Ordering::SeqCst);
+            default(info);
+        }));
+    });
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Runs `f` and checks that it did not panic (even caught) and stayed within
+/// [`PEAK_BYTES`] of extra heap; returns its result and the extra peak.
+fn measured<T>(f: impl FnOnce() -> T) -> (T, usize) {
+    let panics = PANICS.load(Ordering::SeqCst);
+    let base = CURRENT.load(Ordering::SeqCst);
+    PEAK.store(base, Ordering::SeqCst);
+    let out = f();
+    let peak = PEAK.load(Ordering::SeqCst).saturating_sub(base);
+    assert_eq!(
+        PANICS.load(Ordering::SeqCst),
+        panics,
+        "a panic happened (and its message was printed) while loading"
+    );
+    assert!(
+        peak < PEAK_BYTES,
+        "peak heap {peak} bytes is over {PEAK_BYTES}"
+    );
+    (out, peak)
+}
+
+fn opts() -> LoadOptions {
+    LoadOptions {
+        require_spawn: false,
+        ..LoadOptions::default()
+    }
+}
+
+fn load_tmx(file: &str, text: &str) -> Result<ledge_levels::LoadedLevel, LevelError> {
+    measured(|| tmx::load_str(file, text, &opts())).0
+}
+
+/// A map of `w` x `h` 16 px tiles with one embedded tileset, and `body`.
+fn map(w: u32, h: u32, body: &str) -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<map version="1.10" orientation="orthogonal" renderorder="right-down" width="{w}" height="{h}" tilewidth="16" tileheight="16" infinite="0">
+ <tileset firstgid="1" name="ledge" tilewidth="16" tileheight="16" tilecount="4" columns="2"/>
+{body}
+</map>
+"#
+    )
+}
+
+fn csv(n: u64) -> String {
+    vec!["0"; n as usize].join(",")
+}
+
+fn zlib(bytes: &[u8]) -> String {
+    use base64::Engine;
+    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::best());
+    z.write_all(bytes).unwrap();
+    base64::engine::general_purpose::STANDARD.encode(z.finish().unwrap())
+}
+
+/// Base64 of zlib-compressed `n` zero bytes, made a MiB at a time.
+fn zlib_zeros(n: usize) -> String {
+    use base64::Engine;
+    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::best());
+    let mib = vec![0u8; 1 << 20];
+    for _ in 0..n >> 20 {
+        z.write_all(&mib).unwrap();
+    }
+    base64::engine::general_purpose::STANDARD.encode(z.finish().unwrap())
+}
+
+fn gzip(bytes: &[u8]) -> String {
+    use base64::Engine;
+    let mut z = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+    z.write_all(bytes).unwrap();
+    base64::engine::general_purpose::STANDARD.encode(z.finish().unwrap())
+}
+
+/// Checks a refusal by a bound: the file, the field (a prefix) and the bound
+/// are named, in the value and in the message.
+#[track_caller]
+fn expect_limit<T: std::fmt::Debug>(
+    r: Result<T, LevelError>,
+    file: &str,
+    field: &str,
+    bound: &str,
+    limit: u64,
+) -> String {
+    let e = r.expect_err("the file must be refused");
+    let msg = e.to_string();
+    match &e {
+        LevelError::Limit {
+            file: f,
+            field: fl,
+            bound: b,
+            limit: l,
+            found,
+            ..
+        } => {
+            assert_eq!(f, file, "{msg}");
+            assert!(
+                fl.starts_with(field),
+                "field {fl:?} is not {field:?}: {msg}"
+            );
+            assert_eq!(*b, bound, "{msg}");
+            assert_eq!(*l, limit, "{msg}");
+            assert!(found > l, "{msg}");
+        }
+        other => panic!("expected a Limit error for {bound}, got {other:?}"),
+    }
+    assert!(msg.starts_with(&format!("{file}: {field}")), "{msg}");
+    assert!(
+        msg.contains(&limit.to_string()) && msg.contains(bound),
+        "{msg}"
+    );
+    msg
+}
+
+#[test]
+fn tilecount_beyond_the_bound_is_refused_before_allocating() {
+    let _s = serial();
+    // The brief's 400-byte map that aborted the process (431 GB allocation).
+    let text = map(2, 2, "").replace(r#"tilecount="4""#, r#"tilecount="1000000000""#);
+    assert!(text.len() < 500);
+    let msg = expect_limit(
+        load_tmx("maps/x.tmx", &text),
+        "maps/x.tmx",
+        "map.tileset[0].tilecount",
+        "MAX_TILESET_TILES",
+        MAX_TILESET_TILES,
+    );
+    assert!(
+        msg.contains("1000000000 tiles is more than the limit of 65536"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn nesting_beyond_the_depth_bound_is_refused() {
+    let _s = serial();
+    let deep = format!("{}{}", "<group>".repeat(5000), "</group>".repeat(5000));
+    expect_limit(
+        load_tmx("deep.tmx", &map(2, 2, &deep)),
+        "deep.tmx",
+        "map.layers[0].layers[0]",
+        "MAX_XML_DEPTH",
+        MAX_XML_DEPTH as u64,
+    );
+    // Just under the bound, the Tiled reader's recursion fits in a test
+    // thread's stack (2 MiB).
+    let n = MAX_XML_DEPTH - 2;
+    let ok = format!("{}{}", "<group>".repeat(n), "</group>".repeat(n));
+    load_tmx("deep.tmx", &map(2, 2, &ok)).unwrap();
+    let props = format!(
+        "<properties>{}{}</properties>",
+        r#"<property name="p" type="class"><properties>"#.repeat(20),
+        "</properties></property>".repeat(20)
+    );
+    let r = load_tmx("deep.tmx", &map(2, 2, &props));
+    assert!(!matches!(r, Err(LevelError::Limit { .. })), "{r:?}");
+}
+
+#[test]
+fn compressed_bombs_stop_at_the_cell_bound_while_inflating() {
+    let _s = serial();
+    // ~1.4 MB of zlib that inflates to 1.4 GB (the brief's bomb): refused at
+    // MAX_LEVEL_CELLS cells, inflating at most 16 MiB.
+    for (enc, b64) in [
+        ("zlib", zlib_zeros(1400 << 20)),
+        ("gzip", gzip(&[0u8; 64 << 20])),
+    ] {
+        let body = format!(
+            r#"<layer id="1" name="L" width="2" height="2"><data encoding="base64" compression="{enc}">{b64}</data></layer>"#
+        );
+        let text = map(2, 2, &body);
+        let t = Instant::now();
+        let (r, peak) = measured(|| tmx::load_str("bomb.tmx", &text, &opts()));
+        let secs = t.elapsed().as_secs_f64();
+        eprintln!(
+            "{enc} bomb ({} bytes of TMX): refused in {secs:.2} s, peak heap {peak} bytes",
+            text.len()
+        );
+        expect_limit(
+            r,
+            "bomb.tmx",
+            "map.layers[0].data",
+            "MAX_LEVEL_CELLS",
+            MAX_LEVEL_CELLS,
+        );
+        assert!(peak < 64 << 20, "peak {peak}");
+        assert!(secs < 10.0, "{secs} s");
+    }
+}
+
+#[test]
+fn data_must_have_exactly_width_times_height_cells() {
+    let _s = serial();
+    let four = [0u8; 16];
+    for (what, data, got) in [
+        (
+            "short csv",
+            r#"<data encoding="csv">1,1,1</data>"#.to_owned(),
+            3,
+        ),
+        (
+            "long csv",
+            r#"<data encoding="csv">1,1,1,1,1</data>"#.to_owned(),
+            5,
+        ),
+        ("empty", r#"<data encoding="csv"/>"#.to_owned(), 1),
+        (
+            "short zlib",
+            format!(
+                r#"<data encoding="base64" compression="zlib">{}</data>"#,
+                zlib(&four[..12])
+            ),
+            3,
+        ),
+        (
+            "long gzip",
+            format!(
+                r#"<data encoding="base64" compression="gzip">{}</data>"#,
+                gzip(&[0u8; 24])
+            ),
+            6,
+        ),
+        (
+            "empty base64",
+            r#"<data encoding="base64"></data>"#.to_owned(),
+            0,
+        ),
+    ] {
+        let body = format!(r#"<layer id="1" name="L" width="2" height="2">{data}</layer>"#);
+        let e = load_tmx("short.tmx", &map(2, 2, &body)).expect_err(what);
+        assert_eq!(
+            e,
+            LevelError::Length {
+                file: "short.tmx".into(),
+                field: "map.layers[0].data".into(),
+                expected: 4,
+                got,
+            },
+            "{what}: {e}"
+        );
+        assert!(e
+            .to_string()
+            .contains(&format!("expected 4 entries, got {got}")));
+    }
+    // The right count loads (the catch_unwind probe in the importer is not
+    // reached: the panic hook would have counted it).
+    let body = format!(
+        r#"<layer id="1" name="L" width="2" height="2"><data encoding="base64" compression="zlib">{}</data></layer>"#,
+        zlib(&four)
+    );
+    load_tmx("ok.tmx", &map(2, 2, &body)).unwrap();
+    // Infinite maps: each chunk's own size.
+    let text = map(2, 2, r#"<layer id="1" name="L" width="2" height="2"><data encoding="csv"><chunk x="0" y="0" width="16" height="16">0,0</chunk></data></layer>"#)
+        .replace(r#"infinite="0""#, r#"infinite="1""#);
+    let e = load_tmx("inf.tmx", &text).unwrap_err();
+    assert!(
+        matches!(&e, LevelError::Length { field, expected: 256, got: 2, .. } if field == "map.layers[0].data.chunk[0]"),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn zstd_and_xml_tile_data_are_refused_with_a_way_out() {
+    let _s = serial();
+    let body = r#"<layer id="1" name="L" width="2" height="2"><data encoding="base64" compression="zstd">KLUv/SAQgQAAAAAAAA==</data></layer>"#;
+    let e = load_tmx("z.tmx", &map(2, 2, body)).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.starts_with("z.tmx: map.layers[0].data.compression: zstd")
+            && msg.contains("zlib")
+            && msg.contains("gzip"),
+        "{msg}"
+    );
+    let body = r#"<layer id="1" name="L" width="2" height="2"><data><tile gid="1"/><tile/><tile/><tile/></data></layer>"#;
+    let msg = load_tmx("x.tmx", &map(2, 2, body)).unwrap_err().to_string();
+    assert!(
+        msg.starts_with("x.tmx: map.layers[0].data.encoding:") && msg.contains("CSV"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn layer_sizes_and_the_total_cell_count_are_bounded() {
+    let _s = serial();
+    let body =
+        r#"<layer id="1" name="L" width="5000" height="1"><data encoding="csv">0</data></layer>"#;
+    expect_limit(
+        load_tmx("wide.tmx", &map(2, 2, body)),
+        "wide.tmx",
+        "map.layers[0].width",
+        "MAX_LEVEL_TILES",
+        4096,
+    );
+    expect_limit(
+        load_tmx("wide.tmx", &map(5000, 2, "")),
+        "wide.tmx",
+        "map.width",
+        "MAX_LEVEL_TILES",
+        4096,
+    );
+    // Two 2048 x 2048 layers: 8 Mi cells (the second is refused before its
+    // data is decoded).
+    let zeros = zlib(&vec![0u8; 4 * 2048 * 2048]);
+    let layer = |i| {
+        format!(
+            r#"<layer id="{i}" name="L{i}" width="2048" height="2048"><data encoding="base64" compression="zlib">{zeros}</data></layer>"#
+        )
+    };
+    let text = map(2048, 2048, &format!("{}{}", layer(1), layer(2)));
+    expect_limit(
+        load_tmx("cells.tmx", &text),
+        "cells.tmx",
+        "map.layers[1].data",
+        "MAX_LEVEL_CELLS",
+        MAX_LEVEL_CELLS,
+    );
+    let body = r#"<layer id="1" name="L" width="2" height="2"><data encoding="csv"><chunk x="99999999" y="0" width="1" height="1">0</chunk></data></layer>"#;
+    let text = map(2, 2, body).replace(r#"infinite="0""#, r#"infinite="1""#);
+    expect_limit(
+        load_tmx("chunk.tmx", &text),
+        "chunk.tmx",
+        "map.layers[0].data.chunk[0].x",
+        "MAX_CHUNK_COORD",
+        MAX_CHUNK_COORD as u64,
+    );
+}
+
+#[test]
+fn counts_of_layers_tilesets_tiles_objects_points_and_properties_are_bounded() {
+    let _s = serial();
+    let n = |k: u64| k as usize;
+    let cases: Vec<(String, &str, &str, u64)> = vec![
+        (
+            "<objectgroup/>".repeat(n(MAX_LAYERS + 1)),
+            "map.layers[1024]",
+            "MAX_LAYERS",
+            MAX_LAYERS,
+        ),
+        (
+            r#"<tileset firstgid="1" name="t" tilewidth="16" tileheight="16" tilecount="1" columns="1"/>"#
+                .repeat(n(MAX_TILESETS)),
+            "map.tileset[256]",
+            "MAX_TILESETS",
+            MAX_TILESETS,
+        ),
+        (
+            format!(
+                r#"<tileset firstgid="9" name="t" tilewidth="16" tileheight="16" tilecount="1" columns="1">{}</tileset>"#,
+                "<tile/>".repeat(n(MAX_TILESET_TILES + 1))
+            ),
+            "map.tileset[1].tile[65536]",
+            "MAX_TILESET_TILES",
+            MAX_TILESET_TILES,
+        ),
+        (
+            r#"<tileset firstgid="9" name="t" tilewidth="16" tileheight="16" tilecount="65536" columns="256"/>"#
+                .repeat(5),
+            "map.tileset[4].tilecount",
+            "MAX_TOTAL_TILESET_TILES",
+            MAX_TOTAL_TILESET_TILES,
+        ),
+        (
+            format!(
+                "<objectgroup>{}</objectgroup>",
+                "<object/>".repeat(n(MAX_OBJECTS + 1))
+            ),
+            "map.layers[0].objects[65536]",
+            "MAX_OBJECTS",
+            MAX_OBJECTS,
+        ),
+        (
+            format!(
+                r#"<objectgroup><object><polygon points="{}"/></object></objectgroup>"#,
+                "1,2 ".repeat(n(MAX_SHAPE_POINTS + 1))
+            ),
+            "map.layers[0].objects[0].polygon.points",
+            "MAX_SHAPE_POINTS",
+            MAX_SHAPE_POINTS,
+        ),
+        (
+            format!(
+                "<objectgroup>{}</objectgroup>",
+                format!(
+                    r#"<object><polyline points="{}"/></object>"#,
+                    "1,2 ".repeat(n(MAX_SHAPE_POINTS))
+                )
+                .repeat(n(MAX_TOTAL_POINTS / MAX_SHAPE_POINTS + 1))
+            ),
+            "map.layers[0].objects[256].polyline.points",
+            "MAX_TOTAL_POINTS",
+            MAX_TOTAL_POINTS,
+        ),
+        (
+            format!(
+                "<properties>{}</properties>",
+                r#"<property name="a" value="b"/>"#.repeat(n(MAX_PROPERTIES + 1))
+            ),
+            "map.properties.properties[65536]",
+            "MAX_PROPERTIES",
+            MAX_PROPERTIES,
+        ),
+        (
+            format!("<x{}/>", (0..65).map(|i| format!(" a{i}=\"\"")).collect::<String>()),
+            "map.x",
+            "MAX_ATTRIBUTES",
+            MAX_ATTRIBUTES as u64,
+        ),
+        (
+            format!(
+                r#"<properties><property name="{}"/></properties>"#,
+                "a".repeat(MAX_ATTRIBUTE_BYTES + 1)
+            ),
+            "map.properties.properties[0].name",
+            "MAX_ATTRIBUTE_BYTES",
+            MAX_ATTRIBUTE_BYTES as u64,
+        ),
+        (
+            format!(
+                r#"<properties><property name="a">{}</property></properties>"#,
+                "a".repeat(MAX_TEXT_BYTES + 1)
+            ),
+            "map.properties.properties[0]",
+            "MAX_TEXT_BYTES",
+            MAX_TEXT_BYTES as u64,
+        ),
+        (
+            "<a/>".repeat(n(MAX_ELEMENTS)),
+            "map.a",
+            "MAX_ELEMENTS",
+            MAX_ELEMENTS,
+        ),
+        (
+            r#"<imagelayer><image source="a.png" width="20000" height="2"/></imagelayer>"#
+                .into(),
+            "map.layers[0].image.width",
+            "MAX_IMAGE_SIDE",
+            MAX_IMAGE_SIDE,
+        ),
+        (
+            r#"<imagelayer><image source="a.png" width="16000" height="16000"/></imagelayer>"#
+                .into(),
+            "map.layers[0].image",
+            "MAX_IMAGE_PIXELS",
+            MAX_IMAGE_PIXELS,
+        ),
+    ];
+    for (body, field, bound, limit) in cases {
+        expect_limit(
+            load_tmx("count.tmx", &map(2, 2, &body)),
+            "count.tmx",
+            field,
+            bound,
+            limit,
+        );
+    }
+}
+
+/// A fresh folder for files of one test.
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ledge-limits-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn documents_and_templates_are_bounded_across_one_load() {
+    let _s = serial();
+    let dir = temp_dir("docs");
+    for i in 0..MAX_DOCUMENTS {
+        std::fs::write(
+            dir.join(format!("t{i}.tsx")),
+            r#"<tileset name="t" tilewidth="16" tileheight="16" tilecount="1" columns="1"/>"#,
+        )
+        .unwrap();
+    }
+    let body: String = (0..MAX_DOCUMENTS)
+        .map(|i| format!(r#"<tileset firstgid="{}" source="t{i}.tsx"/>"#, i + 10))
+        .collect();
+    let file = dir.join("many.tmx").display().to_string();
+    let tsx63 = dir.join("t63.tsx").display().to_string();
+    expect_limit(
+        load_tmx(&file, &map(2, 2, &body)),
+        &tsx63,
+        "(document)",
+        "MAX_DOCUMENTS",
+        MAX_DOCUMENTS,
+    );
+    // A template copied into many objects: its bytes count once per object.
+    let big = format!(
+        r#"<template><object name="{}" width="16" height="16"/></template>"#,
+        "n".repeat(4000)
+    );
+    std::fs::write(dir.join("big.tx"), big).unwrap();
+    let objects = r#"<object template="big.tx" x="0" y="0"/>"#.repeat(20_000);
+    let file = dir.join("tpl.tmx").display().to_string();
+    let tx = dir.join("big.tx").display().to_string();
+    expect_limit(
+        load_tmx(
+            &file,
+            &map(2, 2, &format!("<objectgroup>{objects}</objectgroup>")),
+        ),
+        &tx,
+        "template",
+        "MAX_TEMPLATE_BYTES",
+        MAX_TEMPLATE_BYTES,
+    );
+    // A template that uses itself would recurse forever in the Tiled reader.
+    std::fs::write(
+        dir.join("self.tx"),
+        r#"<template><object template="self.tx"/></template>"#,
+    )
+    .unwrap();
+    let file = dir.join("self.tmx").display().to_string();
+    let e = load_tmx(
+        &file,
+        &map(
+            2,
+            2,
+            r#"<objectgroup><object template="self.tx"/></objectgroup>"#,
+        ),
+    )
+    .unwrap_err();
+    assert_eq!(e.file(), dir.join("self.tx").display().to_string(), "{e}");
+    assert_eq!(e.field(), Some("template.objects[0].template"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Loaded, or refused for something the Tiled reader did not choke on (the
+/// art of a generated map has no image files).
+#[track_caller]
+fn past_the_tiled_reader<T: std::fmt::Debug>(r: Result<T, LevelError>) {
+    if let Err(e) = r {
+        let msg = e.to_string();
+        assert!(
+            !msg.contains("tilecount")
+                && !msg.contains("Missing attribute")
+                && !msg.contains("malformed"),
+            "{msg}"
+        );
+    }
+}
+
+#[test]
+fn old_tilesets_without_tilecount_are_derived_or_named() {
+    let _s = serial();
+    // Image size given: tilecount and columns are derived (margin 1,
+    // spacing 2: (100 + 2 - 1) / 18 = 5 columns, (40 + 2 - 1) / 18 = 2 rows).
+    let ts = r#"<tileset firstgid="5" name="old" tilewidth="16" tileheight="16" margin="1" spacing="2"><image source="old.png" width="100" height="40"/></tileset>"#;
+    let body = format!(
+        r#"{ts}<layer id="1" name="L" width="2" height="2"><data encoding="csv">0,0,0,0</data></layer>"#
+    );
+    past_the_tiled_reader(load_tmx("old.tmx", &map(2, 2, &body)));
+    // No image size (and no such PNG to read it from): named.
+    let ts = r#"<tileset firstgid="5" name="old" tilewidth="16" tileheight="16"><image source="missing.png"/></tileset>"#;
+    let e = load_tmx("old.tmx", &map(2, 2, ts)).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(e, LevelError::Missing { .. })
+            && msg.starts_with("old.tmx: map.tileset[1].tilecount")
+            && msg.contains("\"old\""),
+        "{msg}"
+    );
+    // An image collection: the number of its tiles.
+    let ts = r#"<tileset firstgid="5" name="col" tilewidth="16" tileheight="16"><tile id="0"><image source="a.png" width="16" height="16"/></tile></tileset>"#;
+    past_the_tiled_reader(load_tmx("col.tmx", &map(2, 2, ts)));
+}
+
+#[test]
+fn the_tiled_examples_without_tilecount_get_past_the_tiled_reader() {
+    let _s = serial();
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../target/level-corpus/tiled-examples"
+    );
+    if !Path::new(dir).is_dir() {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "{dir} is missing: run scripts/fetch-level-corpus"
+        );
+        eprintln!("\n*** SKIPPED: {dir} is missing (run scripts/fetch-level-corpus) ***\n");
+        return;
+    }
+    let mut files = vec![
+        format!("{dir}/sewers.tmx"),
+        format!("{dir}/hexagonal-mini.tmx"),
+        format!("{dir}/perspective_walls.tmx"),
+    ];
+    for e in std::fs::read_dir(format!("{dir}/sewer_automap")).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "tmx") {
+            files.push(p.display().to_string());
+        }
+    }
+    assert!(files.len() >= 12, "{files:?}");
+    for f in files {
+        let (r, _) = measured(|| ledge_levels::load_file_with(&f, &LoadOptions::default()));
+        if let Err(e) = r {
+            let msg = e.to_string();
+            assert!(
+                !msg.contains("tilecount") && !msg.contains("Missing attribute"),
+                "{f}: {msg}"
+            );
+            assert!(!matches!(e, LevelError::Limit { .. }), "{f}: {msg}");
+        }
+    }
+}
+
+#[test]
+fn ogmo_json_depth_and_value_count_are_bounded_before_parsing() {
+    let _s = serial();
+    let opts = opts();
+    let deep = format!("{{\"layers\": {}{}}}", "[".repeat(200), "]".repeat(200));
+    let (r, _) = measured(|| ogmo::load_str("deep.json", &deep, None, &opts));
+    expect_limit(r, "deep.json", "byte", "MAX_JSON_DEPTH", 128);
+    // serde_json's own recursion limit is the same 128: one level under the
+    // bound is parsed (and refused for its content, not its depth).
+    let ok = format!("{{\"a\": {}{}}}", "[".repeat(126), "]".repeat(126));
+    let r = ogmo::load_str("ok.json", &ok, None, &opts);
+    assert!(
+        !matches!(
+            r,
+            Err(LevelError::Limit { .. }) | Err(LevelError::Syntax { .. })
+        ),
+        "{r:?}"
+    );
+    let wide = format!("{{\"layers\": [{}]}}", csv(MAX_JSON_VALUES));
+    let (r, peak) = measured(|| ogmo::load_str("wide.json", &wide, None, &opts));
+    expect_limit(r, "wide.json", "byte", "MAX_JSON_VALUES", MAX_JSON_VALUES);
+    assert!(
+        peak < 1 << 20,
+        "the count is checked before parsing: {peak}"
+    );
+}
+
+#[test]
+fn text_beyond_the_file_size_bound_is_refused() {
+    let _s = serial();
+    let text = format!("{}{}", map(2, 2, ""), " ".repeat(64 << 20));
+    let (r, _) = measured(|| tmx::load_str("huge.tmx", &text, &opts()));
+    expect_limit(
+        r,
+        "huge.tmx",
+        "(document)",
+        "MAX_FILE_BYTES",
+        ledge_levels::MAX_FILE_BYTES,
+    );
+}
