@@ -10,8 +10,10 @@ pub enum TilemapError {
     /// beyond the largest shape extent (names the value).
     #[error(transparent)]
     Bounds(#[from] BoundsError),
-    /// A tile size that is not a power of two of at least 2 units.
-    #[error("tile size = {value} units must be a power of two of at least 2 units")]
+    /// A tile size that is odd or below 2 units (a whole number of pixels is
+    /// always fine: 1 px is 256 units). Sizes beyond
+    /// [`crate::fixed::MAX_EXTENT`] are [`TilemapError::Bounds`].
+    #[error("tile size = {value} units must be an even number of at least 2 units")]
     TileSize {
         /// The offending size.
         value: i64,

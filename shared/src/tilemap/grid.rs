@@ -57,10 +57,14 @@ impl Tilemap {
     /// with square tiles of `tile_size` units, `tiles` in row-major order
     /// (row 0 first).
     ///
-    /// `tile_size` must be a power of two of at least 2 units (16 px is 4096)
-    /// and at most [`crate::fixed::MAX_EXTENT`]; both corners of the grid must
-    /// lie within [`crate::fixed::MAX_COORD`]; `tiles.len()` must be
-    /// `width * height`. Errors name the offending value.
+    /// `tile_size` must be even, at least 2 units and at most
+    /// [`crate::fixed::MAX_EXTENT`]: any whole number of pixels qualifies
+    /// (16 px is 4096 units, 21 px is 5376). Nothing needs a power of two
+    /// (lookups are floor divisions, never shifts or masks); evenness keeps a
+    /// tile's centre and the middle of a 22.5 degree ramp (`T / 2`) on whole
+    /// units. Both corners of the grid must lie within
+    /// [`crate::fixed::MAX_COORD`]; `tiles.len()` must be `width * height`.
+    /// Errors name the offending value.
     pub fn new(
         origin: IVec2,
         tile_size: i32,
@@ -68,7 +72,7 @@ impl Tilemap {
         height: u32,
         tiles: Vec<Tile>,
     ) -> Result<Self, TilemapError> {
-        if tile_size < 2 || (tile_size as u32).count_ones() != 1 {
+        if tile_size < 2 || tile_size % 2 != 0 {
             return Err(TilemapError::TileSize {
                 value: tile_size as i64,
             });
@@ -260,9 +264,19 @@ mod tests {
 
     #[test]
     fn errors_name_the_value() {
-        let e = Tilemap::new(IVec2::ZERO, 3000, 1, 1, vec![Tile::Solid]).unwrap_err();
-        assert_eq!(e, TilemapError::TileSize { value: 3000 });
-        assert!(e.to_string().contains("3000"));
+        let e = Tilemap::new(IVec2::ZERO, 3001, 1, 1, vec![Tile::Solid]).unwrap_err();
+        assert_eq!(e, TilemapError::TileSize { value: 3001 });
+        assert!(e.to_string().contains("3001"));
+        // Any even size is fine: 3000 units, 21 px, 2 units.
+        for t in [3000, 21 * 256, 2, crate::fixed::MAX_EXTENT] {
+            assert!(Tilemap::new(IVec2::ZERO, t, 1, 1, vec![Tile::Solid]).is_ok());
+        }
+        for t in [1, 3, 255, 257, 21 * 256 + 1, -2] {
+            assert_eq!(
+                Tilemap::new(IVec2::ZERO, t, 1, 1, vec![Tile::Solid]),
+                Err(TilemapError::TileSize { value: t as i64 })
+            );
+        }
         let e =
             Tilemap::new(IVec2::new(0, MAX_COORD + 1), 256, 1, 1, vec![Tile::Solid]).unwrap_err();
         assert_eq!(

@@ -12,6 +12,15 @@
 //! slope surfaces are integer functions of the unit column), and depends only
 //! on positions relative to the grid.
 //!
+//! The tile size `T` is any even number of units from 2 to
+//! [`crate::fixed::MAX_EXTENT`], so any whole number of pixels (1 px is 256
+//! units): 16, 18, 21, 24, 70 px alike. Nothing relies on a power of two:
+//! tile lookups are floor divisions (`div_euclid`), tile edges
+//! multiplications, never shifts or masks, and the exactness arguments
+//! (integer surfaces, the sweep's fractions) hold for any `T`. Evenness keeps
+//! `T / 2` whole: a tile's centre (its region's box, the world's
+//! far-side test) and the middle of a 22.5 degree ramp.
+//!
 //! # Contact rules ([`Tilemap::box_contacts`])
 //! For an axis-aligned box, each overlapped tile gives at most one contact
 //! whose MTV moves the box out of it:

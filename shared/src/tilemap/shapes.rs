@@ -363,7 +363,17 @@ mod tests {
 
     #[test]
     fn slope_polygons_are_valid_and_match_the_heights() {
-        for t in [2, 4, 4096] {
+        for t in [
+            2,
+            4,
+            6,
+            4096,
+            18 * 256,
+            21 * 256,
+            24 * 256,
+            31 * 256,
+            70 * 256,
+        ] {
             for s in Slope::ALL {
                 let p = slope_polygon(s, t).expect("valid polygon");
                 let top = p.vertices().iter().map(|v| v.y).min().unwrap();

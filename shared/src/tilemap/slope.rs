@@ -103,55 +103,84 @@ mod tests {
         assert_eq!(Slope::LeftLow22.height(T - 1, T), 1);
     }
 
+    /// Tile sizes: powers of two and not (whole pixels, 18 to 70 px, and
+    /// small even unit counts).
+    const SIZES: [i32; 9] = [
+        T,
+        2,
+        6,
+        10,
+        18 * 256,
+        21 * 256,
+        24 * 256,
+        31 * 256,
+        70 * 256,
+    ];
+
     #[test]
     fn ramps_are_continuous() {
+        for t in SIZES {
+            ramps_are_continuous_at(t);
+        }
+    }
+
+    fn ramps_are_continuous_at(t: i32) {
         // Flat (0) -> low -> high -> flat (T), rising to the right; and the
         // mirror. Height changes by at most one unit per unit column.
         let right = |x: i32| match x {
             x if x < 0 => 0,
-            x if x < T => Slope::RightLow22.height(x, T),
-            x if x < 2 * T => Slope::RightHigh22.height(x - T, T),
-            _ => T,
+            x if x < t => Slope::RightLow22.height(x, t),
+            x if x < 2 * t => Slope::RightHigh22.height(x - t, t),
+            _ => t,
         };
         let left = |x: i32| match x {
-            x if x < 0 => T,
-            x if x < T => Slope::LeftHigh22.height(x, T),
-            x if x < 2 * T => Slope::LeftLow22.height(x - T, T),
+            x if x < 0 => t,
+            x if x < t => Slope::LeftHigh22.height(x, t),
+            x if x < 2 * t => Slope::LeftLow22.height(x - t, t),
             _ => 0,
         };
-        let r45 = |x: i32| x.clamp(0, T);
+        let r45 = |x: i32| x.clamp(0, t);
         let l45 = |x: i32| {
             if x < 0 {
-                T
-            } else if x < T {
-                Slope::Left45.height(x, T)
+                t
+            } else if x < t {
+                Slope::Left45.height(x, t)
             } else {
                 0
             }
         };
-        for x in -2..2 * T + 2 {
-            assert!((right(x + 1) - right(x)).abs() <= 1, "right 22.5 at {x}");
-            assert!((left(x + 1) - left(x)).abs() <= 1, "left 22.5 at {x}");
-            assert!((r45(x + 1) - r45(x)).abs() <= 1);
-            assert!((l45(x + 1) - l45(x)).abs() <= 1);
-            if (0..2 * T).contains(&x) {
-                assert_eq!(right(x), x.div_euclid(2));
-                assert_eq!(left(x), T - x.div_euclid(2));
+        for x in -2..2 * t + 2 {
+            assert!(
+                (right(x + 1) - right(x)).abs() <= 1,
+                "right 22.5 at {x}, T {t}"
+            );
+            assert!(
+                (left(x + 1) - left(x)).abs() <= 1,
+                "left 22.5 at {x}, T {t}"
+            );
+            assert!((r45(x + 1) - r45(x)).abs() <= 1, "T {t}");
+            assert!((l45(x + 1) - l45(x)).abs() <= 1, "T {t}");
+            if (0..2 * t).contains(&x) {
+                assert_eq!(right(x), x.div_euclid(2), "T {t}");
+                assert_eq!(left(x), t - x.div_euclid(2), "T {t}");
             }
-            if (0..T).contains(&x) {
-                assert_eq!(r45(x), Slope::Right45.height(x, T));
+            if (0..t).contains(&x) {
+                assert_eq!(r45(x), Slope::Right45.height(x, t), "T {t}");
             }
         }
     }
 
     #[test]
     fn rises_right_matches_heights() {
-        for s in Slope::ALL {
-            assert_eq!(
-                s.rises_right(),
-                s.height(T - 1, T) > s.height(0, T),
-                "{s:?}"
-            );
+        // (At T = 2 a 22.5 degree half is flat: heights 0, 0.)
+        for t in SIZES.into_iter().filter(|&t| t >= 4) {
+            for s in Slope::ALL {
+                assert_eq!(
+                    s.rises_right(),
+                    s.height(t - 1, t) > s.height(0, t),
+                    "{s:?} T {t}"
+                );
+            }
         }
     }
 }

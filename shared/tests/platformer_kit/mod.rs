@@ -71,6 +71,21 @@ pub fn ent(kind: EntityKind, c: i32, r: i32) -> EntityDef {
     }
 }
 
+/// Centre of tile `(c, r)` on a map at the origin with tiles of `size`.
+pub fn tile_centre_sized(size: i32, c: i32, r: i32) -> IVec2 {
+    IVec2::new(c * size + size / 2, r * size + size / 2)
+}
+
+/// An entity of one tile at tile `(c, r)` on a map at the origin with tiles
+/// of `size` units.
+pub fn ent_sized(kind: EntityKind, size: i32, c: i32, r: i32) -> EntityDef {
+    EntityDef {
+        kind,
+        pos: tile_centre_sized(size, c, r),
+        size: IVec2::splat(size),
+    }
+}
+
 /// An entity with an explicit centre and size.
 pub fn ent_at(kind: EntityKind, pos: IVec2, size: IVec2) -> EntityDef {
     EntityDef { kind, pos, size }
@@ -97,6 +112,16 @@ pub fn level(rows: &[&str], entities: Vec<EntityDef>) -> Level {
     Level {
         name: "test".into(),
         tilemap: map(rows),
+        entities,
+    }
+}
+
+/// A level from a map at the origin with tiles of `size` units, and
+/// entities.
+pub fn level_sized(size: i32, rows: &[&str], entities: Vec<EntityDef>) -> Level {
+    Level {
+        name: "test".into(),
+        tilemap: map_at(IVec2::ZERO, size, rows),
         entities,
     }
 }

@@ -997,13 +997,18 @@ mod tests {
         // At every integer column offset, 2 h(X) >= a X + k (the line is at
         // or below the surface) and the difference is at most one (half a
         // unit): "below the line" is "below the surface" at integer points.
-        let t = 64i64;
-        for s in Slope::ALL {
-            let (a, k) = slope_line(s, t);
-            for x in 0..t {
-                let h2 = 2 * s.height(x as i32, t as i32) as i64;
-                let line = a * x + k;
-                assert!(h2 >= line && h2 - line <= 1, "{s:?} at {x}: {h2} vs {line}");
+        // Any even tile size, power of two or not.
+        for t in [2i64, 6, 64, 70, 18 * 256, 21 * 256] {
+            for s in Slope::ALL {
+                let (a, k) = slope_line(s, t);
+                for x in 0..t {
+                    let h2 = 2 * s.height(x as i32, t as i32) as i64;
+                    let line = a * x + k;
+                    assert!(
+                        h2 >= line && h2 - line <= 1,
+                        "{s:?} at {x}, T {t}: {h2} vs {line}"
+                    );
+                }
             }
         }
     }
