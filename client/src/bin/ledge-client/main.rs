@@ -15,6 +15,7 @@
 //! interpolated between the last two ticks. `--script`, `--screenshot` and
 //! `--exit-after-ticks` drive it without a human, for tests.
 
+mod art;
 mod camera;
 mod debug;
 mod hud;
@@ -169,6 +170,8 @@ struct Setup {
     name: String,
     debug: bool,
     look_at: Option<Vec2>,
+    /// The level's art (textures are made when the window exists).
+    level_art: ledge_levels::art::LevelArt,
     /// Kept alive for the whole game; dropped after the network thread.
     server: Option<local::LocalServer>,
 }
@@ -197,11 +200,18 @@ fn main() -> anyhow::Result<()> {
         .map(Script::load)
         .transpose()
         .map_err(anyhow::Error::msg)?;
-    let level = match &cli.level {
+    // A level file's own art is drawn; the embedded level keeps ledge's
+    // flat colours.
+    let (level, level_art) = match &cli.level {
         Some(path) if !cli.local => {
-            ledge_levels::load_file(path).map_err(|e| anyhow::anyhow!("loading the level: {e}"))?
+            let loaded = ledge_levels::load_file_with(path, &ledge_levels::LoadOptions::default())
+                .map_err(|e| anyhow::anyhow!("loading the level: {e}"))?;
+            for w in &loaded.art.warnings {
+                tracing::warn!("level art: {w}");
+            }
+            (loaded.level, loaded.art)
         }
-        _ => ledge_levels::default_level(),
+        _ => (ledge_levels::default_level(), Default::default()),
     };
     let mut server = None;
     let request = if cli.local {
@@ -242,6 +252,7 @@ fn main() -> anyhow::Result<()> {
         name: cli.name,
         debug: cli.debug,
         look_at: cli.look_at.map(|(x, y)| vec2(x, y)),
+        level_art,
         server,
     };
 
@@ -277,6 +288,10 @@ async fn game(mut setup: Setup) {
     // Ticks of play so far: the script's clock and --exit-after-ticks'.
     let mut played: u64 = 0;
     let mut last_frame = Instant::now();
+    let art = art::ArtView::new(
+        std::mem::take(&mut setup.level_art),
+        &setup.play.level().tilemap,
+    );
     // Closing the window ends the loop below, so we leave the server.
     prevent_quit();
     loop {
@@ -352,8 +367,12 @@ async fn game(mut setup: Setup) {
 
         // Draw: sky, tiles, entities, players, overlays.
         let time = now as f32;
-        render::draw_background(&view, time);
-        render::draw_tilemap(&level.tilemap, &view);
+        match art.background() {
+            Some(colour) => clear_background(colour),
+            None => render::draw_background(&view, time),
+        }
+        art.draw(&view);
+        render::draw_tilemap(&level.tilemap, &view, art.covered());
         render::draw_polygon_blocks(level, &view);
         render::draw_entities(
             &entities,

@@ -1,6 +1,8 @@
 //! Drawing the world: the tilemap, the level's entities and the players,
 //! through a [`View`] (world pixels to screen pixels). Plain shapes, no
-//! textures: every colour is in [`palette`].
+//! textures: every colour is in [`palette`]. A level's own art (its tile
+//! layers and tileset images) is drawn by `art.rs`; the tilemap's flat
+//! colours only fill the cells the art does not draw.
 
 use ledge_client::view::{EntityType, Facing};
 use ledge_shared::fixed::UNITS_PER_PX;
@@ -246,8 +248,10 @@ fn covers_below(tile: Tile) -> bool {
     matches!(tile, Tile::Solid | Tile::Slope(_))
 }
 
-/// Draws the tiles of `map` that `view` shows.
-pub fn draw_tilemap(map: &Tilemap, view: &View) {
+/// Draws the tiles of `map` that `view` shows, except those `covered`
+/// (row-major, one per cell; shorter: not covered) says the level's art
+/// draws.
+pub fn draw_tilemap(map: &Tilemap, view: &View, covered: &[bool]) {
     let t = map.tile_size() as f32 * PX;
     let origin = vec2(map.origin().x as f32, map.origin().y as f32) * PX;
     let seen = view.visible();
@@ -262,6 +266,12 @@ pub fn draw_tilemap(map: &Tilemap, view: &View) {
     for r in row0..row1 {
         for c in col0..col1 {
             let (x, y) = (origin.x + c as f32 * t, origin.y + r as f32 * t);
+            if covered
+                .get((r * map.width() as i64 + c) as usize)
+                .is_some_and(|&v| v)
+            {
+                continue;
+            }
             match at(c, r) {
                 Tile::Empty => {}
                 Tile::Solid => {

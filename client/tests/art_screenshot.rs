@@ -1,0 +1,303 @@
+//! The real client binary, under Xvfb, offline on a Tiled map drawn with a
+//! real tileset: `tests/fixtures/desert_art.tmx` with the Desert tileset
+//! image of Tiled's examples (`tmw_desert_spacing.png`: 32 px tiles, margin
+//! 1, spacing 1), copied beside the map from the level corpus
+//! (`scripts/fetch-level-corpus`). The screenshot must show, cell by cell,
+//! the tileset's own pixels: brick floor tiles, sand, and props over sand,
+//! four of them flipped (horizontally, vertically, diagonally, all three),
+//! as Tiled draws them, and none of ledge's flat colours.
+//!
+//! Needs `xvfb-run` and the corpus. Without either the test prints a loud
+//! notice and passes without checking anything, except with `CI=true`:
+//! there a missing corpus is fetched (the script is idempotent) and a
+//! missing `xvfb-run` fails the test.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
+
+/// The client must have saved its screenshot within this time.
+const CLIENT_TIMEOUT: Duration = Duration::from_secs(90);
+/// The map's tiles, pixels.
+const T: u32 = 32;
+/// Where the camera looks (world pixels): the right part of the map, away
+/// from the player's spawn on the left.
+const LOOK_AT: (f64, f64) = (448.0, 240.0);
+
+const H: u32 = 0x8000_0000;
+const V: u32 = 0x4000_0000;
+const D: u32 = 0x2000_0000;
+
+fn notice(what: &str) {
+    // Straight to the process's stderr: the test harness captures
+    // `eprintln!`, and this notice must be seen.
+    let text = format!(
+        "\n************************************************************\n\
+         *  SKIPPED art screenshot test: {what}\n\
+         *  with CI=true this test fails (or fetches) instead.\n\
+         ************************************************************\n\n"
+    );
+    let _ = std::io::Write::write_all(&mut std::io::stderr(), text.as_bytes());
+}
+
+fn xvfb_run() -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join("xvfb-run"))
+        .find(|p| p.is_file())
+}
+
+fn ci() -> bool {
+    std::env::var("CI").as_deref() == Ok("true")
+}
+
+/// The Desert tileset image from the corpus (fetched in CI when missing).
+fn corpus_image() -> Option<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let image = root.join("target/level-corpus/tiled-examples/tmw_desert_spacing.png");
+    if !image.is_file() && ci() {
+        let status = Command::new("bash")
+            .arg(root.join("scripts/fetch-level-corpus"))
+            .status()
+            .expect("scripts/fetch-level-corpus runs");
+        assert!(
+            status.success(),
+            "scripts/fetch-level-corpus failed: {status}"
+        );
+    }
+    image.is_file().then_some(image)
+}
+
+/// An RGBA picture.
+struct Png {
+    width: u32,
+    height: u32,
+    rgba: Vec<u8>,
+}
+
+impl Png {
+    fn load(path: &Path) -> Png {
+        let file = std::fs::File::open(path).expect("PNG exists");
+        let mut decoder = png::Decoder::new(file);
+        decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+        let mut reader = decoder.read_info().expect("a PNG");
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).expect("PNG data");
+        buf.truncate(info.buffer_size());
+        let rgba = match info.color_type {
+            png::ColorType::Rgba => buf,
+            png::ColorType::Rgb => buf
+                .chunks(3)
+                .flat_map(|c| [c[0], c[1], c[2], 255])
+                .collect(),
+            png::ColorType::GrayscaleAlpha => buf
+                .chunks(2)
+                .flat_map(|c| [c[0], c[0], c[0], c[1]])
+                .collect(),
+            png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g, 255]).collect(),
+            other => panic!("unexpected PNG colour type {other:?}"),
+        };
+        Png {
+            width: info.width,
+            height: info.height,
+            rgba,
+        }
+    }
+
+    fn at(&self, x: u32, y: u32) -> [u8; 4] {
+        assert!(x < self.width && y < self.height, "({x}, {y}) outside");
+        let i = (y as usize * self.width as usize + x as usize) * 4;
+        [
+            self.rgba[i],
+            self.rgba[i + 1],
+            self.rgba[i + 2],
+            self.rgba[i + 3],
+        ]
+    }
+}
+
+/// The tileset pixel that Tiled shows at `(u, v)` of tile `gid` (first gid
+/// 1; flip bits included): the diagonal flip is applied first, then the
+/// horizontal and vertical ones.
+fn texel(tiles: &Png, gid: u32, u: u32, v: u32) -> [u8; 4] {
+    let id = (gid & !(H | V | D)) - 1;
+    let (mut x, mut y) = (u, v);
+    if gid & V != 0 {
+        y = T - 1 - y;
+    }
+    if gid & H != 0 {
+        x = T - 1 - x;
+    }
+    if gid & D != 0 {
+        std::mem::swap(&mut x, &mut y);
+    }
+    let (col, row) = (id % 8, id / 8);
+    tiles.at(1 + col * (T + 1) + x, 1 + row * (T + 1) + y)
+}
+
+/// `top` over `under` (straight alpha), RGB.
+fn over(top: [u8; 4], under: [u8; 4]) -> [u8; 3] {
+    let a = top[3] as f64 / 255.0;
+    [0, 1, 2].map(|i| (top[i] as f64 * a + under[i] as f64 * (1.0 - a)).round() as u8)
+}
+
+fn pair(v: &Value) -> (f64, f64) {
+    let a = v.as_array().expect("[x, y]");
+    (a[0].as_f64().unwrap(), a[1].as_f64().unwrap())
+}
+
+#[test]
+fn the_client_draws_a_tiled_map_with_its_own_tileset() {
+    let Some(xvfb) = xvfb_run() else {
+        if ci() {
+            panic!("xvfb-run is not on PATH: install xvfb (apt-get install xvfb) to run the screenshot tests in CI");
+        }
+        notice("xvfb-run is not on PATH (apt-get install xvfb xauth).");
+        return;
+    };
+    let Some(image) = corpus_image() else {
+        notice("no level corpus: run scripts/fetch-level-corpus.");
+        return;
+    };
+
+    // The map and the corpus image side by side, as the map names it.
+    let level_dir = tempfile::tempdir().unwrap();
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/desert_art.tmx");
+    let map = level_dir.path().join("desert_art.tmx");
+    std::fs::copy(&fixture, &map).unwrap();
+    std::fs::copy(&image, level_dir.path().join("tmw_desert_spacing.png")).unwrap();
+
+    // LEDGE_SCREENSHOT_DIR keeps the picture (to look at it).
+    let out = tempfile::tempdir().unwrap();
+    let dir = std::env::var_os("LEDGE_SCREENSHOT_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| out.path().to_owned());
+    std::fs::create_dir_all(&dir).unwrap();
+    let png_path = dir.join("art.png");
+    let mut child = Command::new(xvfb)
+        .args(["-a", "-s", "-screen 0 1280x720x24"])
+        .arg(env!("CARGO_BIN_EXE_ledge-client"))
+        .arg("--level")
+        .arg(&map)
+        .args(["--exit-after-ticks", "10"])
+        .arg("--screenshot")
+        .arg(&png_path)
+        .args(["--look-at", &format!("{},{}", LOOK_AT.0, LOOK_AT.1)])
+        .args(["--window", "960x540"])
+        .env("LIBGL_ALWAYS_SOFTWARE", "1")
+        .stdin(Stdio::null())
+        .spawn()
+        .expect("xvfb-run starts");
+    let deadline = Instant::now() + CLIENT_TIMEOUT;
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("the client did not exit within {CLIENT_TIMEOUT:?}");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    assert!(status.success(), "the client failed: {status}");
+
+    let json: Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("art.png.json")).expect("the screenshot's JSON"),
+    )
+    .expect("valid JSON");
+    let shot = Png::load(&png_path);
+    let tiles = Png::load(&image);
+    assert_eq!(
+        (tiles.width, tiles.height),
+        (265, 199),
+        "the Desert tileset"
+    );
+    let zoom = json["camera"]["zoom"].as_f64().unwrap();
+    let (ox, oy) = pair(&json["camera"]["offset"]);
+    let solid = json["colors"]["solid"].clone();
+
+    // Cells (column, row) and what is drawn there, bottom layer first: the
+    // sand (gid 30) everywhere, then the fixture's "ground" layer.
+    let sand = 30;
+    let cells: [((u32, u32), &[u32]); 10] = [
+        ((7, 5), &[sand]),
+        ((6, 9), &[sand, 2]),
+        ((19, 9), &[sand, 3]),
+        ((8, 10), &[sand, 10]),
+        ((19, 10), &[sand, 11]),
+        ((10, 8), &[sand, 48 | H | V | D]),
+        ((12, 8), &[sand, 46 | H]),
+        ((14, 8), &[sand, 31 | V]),
+        ((16, 8), &[sand, 32 | D]),
+        ((17, 8), &[sand, 32]),
+    ];
+    // The centre of every other texel's screen square.
+    let samples: Vec<(u32, u32)> = (0..T)
+        .step_by(3)
+        .flat_map(|v| (0..T).step_by(3).map(move |u| (u, v)))
+        .collect();
+    let expected_at = |stack: &[u32], u: u32, v: u32| -> [u8; 3] {
+        let mut rgb = [0u8; 3];
+        for &gid in stack {
+            let t = texel(&tiles, gid, u, v);
+            let under = [rgb[0], rgb[1], rgb[2], 255];
+            rgb = over(t, under);
+        }
+        rgb
+    };
+    let matches = |stack: &[u32], (c, r): (u32, u32)| -> (usize, Vec<String>) {
+        let mut ok = 0;
+        let mut bad = Vec::new();
+        for &(u, v) in &samples {
+            let wx = (c * T + u) as f64 + 0.5;
+            let wy = (r * T + v) as f64 + 0.5;
+            let (sx, sy) = (wx * zoom + ox, wy * zoom + oy);
+            let got = shot.at(sx as u32, sy as u32);
+            let want = expected_at(stack, u, v);
+            if got[..3].iter().zip(want).all(|(&g, w)| g.abs_diff(w) <= 6) {
+                ok += 1;
+            } else if bad.len() < 5 {
+                bad.push(format!(
+                    "texel ({u}, {v}) at screen ({sx}, {sy}): got {:?}, want {want:?}",
+                    &got[..3]
+                ));
+            }
+        }
+        (ok, bad)
+    };
+    for ((c, r), stack) in cells {
+        let (ok, bad) = matches(stack, (c, r));
+        assert!(
+            ok * 100 >= samples.len() * 97,
+            "cell ({c}, {r}) drawn with {stack:x?}: {ok} of {} samples match the tileset: {bad:?} ({json})",
+            samples.len()
+        );
+        // A flipped tile is drawn flipped: unflipped, it would not match.
+        if let Some(&top) = stack.last() {
+            if top & (H | V | D) != 0 {
+                let plain = [sand, top & !(H | V | D)];
+                let (same, _) = matches(&plain, (c, r));
+                assert!(
+                    same * 100 < samples.len() * 90,
+                    "cell ({c}, {r}): {same} of {} samples also match the unflipped tile",
+                    samples.len()
+                );
+            }
+        }
+    }
+    // None of ledge's flat ground colour where the art draws.
+    let solid = [0, 1, 2].map(|i| solid[i].as_u64().unwrap() as u8);
+    let mut flat = 0;
+    for y in (0..shot.height).step_by(4) {
+        for x in (0..shot.width).step_by(4) {
+            flat += (shot.at(x, y)[..3] == solid) as u32;
+        }
+    }
+    assert!(
+        flat < 10,
+        "{flat} pixels of the flat solid colour {solid:?}"
+    );
+}
