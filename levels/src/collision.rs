@@ -353,6 +353,166 @@ pub(crate) fn is_convex(points: &[(f64, f64)]) -> bool {
     (turning.abs() - std::f64::consts::TAU).abs() < 1e-6
 }
 
+/// Splits a simple polygon (either winding, not crossing itself) into
+/// triangles by ear clipping, then merges neighbouring triangles while the
+/// result stays convex and at most `max_points` points; `None` when the
+/// outline crosses itself or is degenerate.
+pub(crate) fn convex_pieces(points: &[(f64, f64)], max_points: usize) -> Option<Vec<Outline>> {
+    let mut pts: Outline = points.to_vec();
+    if signed_area(&pts) < 0.0 {
+        pts.reverse();
+    }
+    let n = pts.len();
+    if n < 3 || signed_area(&pts).abs() < 1e-9 || crosses_itself(&pts) {
+        return None;
+    }
+    // Ear clipping on indices (counter-clockwise in maths terms, so a left
+    // turn is convex).
+    let mut idx: Vec<usize> = (0..n).collect();
+    let mut tris: Vec<[usize; 3]> = Vec::with_capacity(n - 2);
+    let cross = |a: (f64, f64), b: (f64, f64), c: (f64, f64)| {
+        (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0)
+    };
+    let mut guard = 0;
+    while idx.len() > 3 {
+        guard += 1;
+        if guard > 4 * n * n {
+            return None;
+        }
+        let m = idx.len();
+        let mut clipped = false;
+        for i in 0..m {
+            let (ia, ib, ic) = (idx[(i + m - 1) % m], idx[i], idx[(i + 1) % m]);
+            let (a, b, c) = (pts[ia], pts[ib], pts[ic]);
+            if cross(a, b, c) <= 0.0 {
+                continue;
+            }
+            let inside = idx.iter().any(|&j| {
+                j != ia
+                    && j != ib
+                    && j != ic
+                    && cross(a, b, pts[j]) >= 0.0
+                    && cross(b, c, pts[j]) >= 0.0
+                    && cross(c, a, pts[j]) >= 0.0
+            });
+            if !inside {
+                tris.push([ia, ib, ic]);
+                idx.remove(i);
+                clipped = true;
+                break;
+            }
+        }
+        if !clipped {
+            // Only collinear points left: drop one.
+            let m = idx.len();
+            let i = (0..m).find(|&i| {
+                let (a, b, c) = (
+                    pts[idx[(i + m - 1) % m]],
+                    pts[idx[i]],
+                    pts[idx[(i + 1) % m]],
+                );
+                cross(a, b, c).abs() < 1e-9
+            })?;
+            idx.remove(i);
+        }
+    }
+    if cross(pts[idx[0]], pts[idx[1]], pts[idx[2]]) > 0.0 {
+        tris.push([idx[0], idx[1], idx[2]]);
+    }
+    // Merge triangles across shared edges while convex.
+    let mut pieces: Vec<Vec<usize>> = tris.into_iter().map(|t| t.to_vec()).collect();
+    let mut merged = true;
+    while merged {
+        merged = false;
+        'outer: for i in 0..pieces.len() {
+            for j in i + 1..pieces.len() {
+                if let Some(u) = union_on_edge(&pieces[i], &pieces[j]) {
+                    let poly: Outline = u.iter().map(|&k| pts[k]).collect();
+                    if u.len() <= max_points && is_convex(&poly) {
+                        pieces[i] = u;
+                        pieces.remove(j);
+                        merged = true;
+                        break 'outer;
+                    }
+                }
+            }
+        }
+    }
+    Some(
+        pieces
+            .into_iter()
+            .map(|p| p.into_iter().map(|k| pts[k]).collect())
+            .collect(),
+    )
+}
+
+/// Two index cycles (same winding) sharing one edge, joined along it.
+fn union_on_edge(a: &[usize], b: &[usize]) -> Option<Vec<usize>> {
+    let (na, nb) = (a.len(), b.len());
+    for i in 0..na {
+        let (p, q) = (a[i], a[(i + 1) % na]);
+        // The same edge runs q -> p in b.
+        if let Some(j) = (0..nb).find(|&j| b[j] == q && b[(j + 1) % nb] == p) {
+            let mut out = Vec::with_capacity(na + nb - 2);
+            for k in 0..na {
+                out.push(a[(i + 1 + k) % na]);
+                if k == na - 1 {
+                    break;
+                }
+            }
+            // out runs q .. p around a; continue from p through b back to q.
+            for k in 2..nb {
+                out.push(b[(j + k) % nb]);
+            }
+            return Some(out);
+        }
+    }
+    None
+}
+
+fn signed_area(p: &[(f64, f64)]) -> f64 {
+    (0..p.len())
+        .map(|i| {
+            let (a, b) = (p[i], p[(i + 1) % p.len()]);
+            a.0 * b.1 - b.0 * a.1
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+/// Whether two non-adjacent edges of the outline cross or touch.
+fn crosses_itself(p: &[(f64, f64)]) -> bool {
+    let n = p.len();
+    let orient = |a: (f64, f64), b: (f64, f64), c: (f64, f64)| {
+        let v = (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0);
+        if v > 0.0 {
+            1
+        } else if v < 0.0 {
+            -1
+        } else {
+            0
+        }
+    };
+    for i in 0..n {
+        for j in i + 1..n {
+            if j == i + 1 || (i == 0 && j == n - 1) {
+                continue;
+            }
+            let (a, b, c, d) = (p[i], p[(i + 1) % n], p[j], p[(j + 1) % n]);
+            let (o1, o2, o3, o4) = (
+                orient(a, b, c),
+                orient(a, b, d),
+                orient(c, d, a),
+                orient(c, d, b),
+            );
+            if o1 != o2 && o3 != o4 {
+                return true;
+            }
+        }
+    }
+    false
+}
+
 /// An ellipse inside the box `(x, y, w, h)` as an outline of 8 points (the
 /// regular octagon's corners on the ellipse): what ledge collides with for
 /// an ellipse shape.
@@ -451,6 +611,43 @@ mod tests {
             (4.0, 0.0),
             (4.0, 4.0)
         ]));
+    }
+
+    #[test]
+    fn concave_outlines_split_into_convex_pieces_of_the_same_area() {
+        let l = [
+            (0.0, 0.0),
+            (4.0, 0.0),
+            (4.0, 2.0),
+            (2.0, 2.0),
+            (2.0, 4.0),
+            (0.0, 4.0),
+        ];
+        let star: Vec<_> = (0..10)
+            .map(|k| {
+                let r = if k % 2 == 0 { 10.0 } else { 4.0 };
+                let a = k as f64 * std::f64::consts::PI / 5.0;
+                (r * a.cos(), r * a.sin())
+            })
+            .collect();
+        let circle: Vec<_> = (0..20)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::PI / 10.0;
+                (5.0 * a.cos(), 5.0 * a.sin())
+            })
+            .rev()
+            .collect();
+        for poly in [l.to_vec(), star, circle] {
+            let pieces = convex_pieces(&poly, 8).unwrap();
+            let total: f64 = pieces.iter().map(|p| signed_area(p).abs()).sum();
+            assert!((total - signed_area(&poly).abs()).abs() < 1e-9, "{poly:?}");
+            for p in &pieces {
+                assert!(is_convex(p) && (3..=8).contains(&p.len()), "{p:?}");
+            }
+        }
+        assert_eq!(convex_pieces(&l, 8).unwrap().len(), 2);
+        // A bow tie crosses itself.
+        assert!(convex_pieces(&[(0.0, 0.0), (4.0, 4.0), (4.0, 0.0), (0.0, 4.0)], 8).is_none());
     }
 
     #[test]

@@ -4,7 +4,7 @@
 use glam::IVec2;
 
 use super::mapping::normalize;
-use super::{EntityDef, EntityKind, LevelError, PlatformMotion, RouteAction, Waypoint};
+use super::{EntityDef, EntityKind, LevelError, PlatformMotion, RouteAction, SpeedUnit, Waypoint};
 use ledge_shared::fixed::{MAX_COORD, MAX_EXTENT, MAX_SPEED, UNITS_PER_PX};
 use ledge_shared::shape::{ConvexPolygon, ShapeError, MAX_POLYGON_VERTICES};
 
@@ -240,6 +240,8 @@ fn class_of(name: &str) -> Option<Class> {
 struct Params<'a> {
     file: &'a str,
     e: &'a PlacedEntity,
+    /// Units of the speeds.
+    unit: SpeedUnit,
 }
 
 impl Params<'_> {
@@ -275,32 +277,38 @@ impl Params<'_> {
         }
     }
 
-    /// A speed in px/tick, as units/tick in `(0, MAX_SPEED]`.
+    /// A speed in the file's unit (px/tick unless the settings say px/s),
+    /// as units/tick in `(0, MAX_SPEED]`.
     fn speed(&self, keys: &[&str], default: i32) -> Result<i32, LevelError> {
         let Some((field, v)) = self.find(keys) else {
             return Ok(default);
         };
+        let unit = self.unit.name();
         let n = match v {
             PropValue::Number(n) => *n,
             PropValue::Text(s) => s.trim().parse::<f64>().map_err(|_| {
                 self.bad(
                     field.clone(),
-                    format!("expected a number (px per tick), got {s:?}"),
+                    format!("expected a number ({unit}), got {s:?}"),
                 )
             })?,
             other => {
                 return Err(self.bad(
                     field,
-                    format!("expected a number (px per tick), got {}", other.describe()),
+                    format!("expected a number ({unit}), got {}", other.describe()),
                 ));
             }
         };
+        let per_tick = n * self.unit.px_per_tick();
         let max = (MAX_SPEED / UNITS_PER_PX) as f64;
-        let units = (n * UNITS_PER_PX as f64).round();
-        if !n.is_finite() || units < 1.0 || n > max {
+        let units = (per_tick * UNITS_PER_PX as f64).round();
+        if !n.is_finite() || units < 1.0 || per_tick > max {
             return Err(self.bad(
                 field,
-                format!("{n} px/tick is not a speed in (0, {max}] px/tick"),
+                format!(
+                    "{n} {unit} is not a speed in (0, {}] {unit}",
+                    max / self.unit.px_per_tick()
+                ),
             ));
         }
         Ok(units as i32)
@@ -333,8 +341,12 @@ impl Params<'_> {
 
 /// Classifies one placed entity through the name table and reads its
 /// parameters.
-pub(crate) fn classify(file: &str, e: &PlacedEntity) -> Result<Classified, LevelError> {
-    let p = Params { file, e };
+pub(crate) fn classify(
+    file: &str,
+    e: &PlacedEntity,
+    unit: SpeedUnit,
+) -> Result<Classified, LevelError> {
+    let p = Params { file, e, unit };
     let Some(class) = class_of(&e.name) else {
         return Ok(Classified::Unknown);
     };

@@ -33,9 +33,11 @@ mod error;
 pub mod limits;
 mod mapping;
 pub mod ogmo;
+mod settings;
 mod spawn;
 pub mod tmx;
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use glam::IVec2;
@@ -55,6 +57,7 @@ pub use mapping::{
     parse_tile_kind, tile_kind_name, TileMapping, TileTable, ECHO_SLOPES, LEDGE_TILESET,
     LEDGE_TILESET_NAME,
 };
+pub use settings::{settings_path_for, LevelSettings, MAX_SETTINGS_BYTES, SETTINGS_SUFFIX};
 
 use entities::Classified;
 use ledge_shared::fixed::UNITS_PER_PX;
@@ -65,7 +68,8 @@ pub const MAX_LEVEL_TILES: u32 = 4096;
 /// Largest level file read from disk, in bytes (64 MiB).
 pub const MAX_FILE_BYTES: u64 = 64 << 20;
 
-/// How to load a level.
+/// How to load a level. [`LevelSettings`] (the settings file beside a
+/// level) sets these from TOML.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LoadOptions {
     /// Tile ids and grid values to tiles.
@@ -74,11 +78,58 @@ pub struct LoadOptions {
     /// [`LoadedLevel::warnings`]) instead of refusing the file. Default:
     /// skip.
     pub skip_unknown_entities: bool,
-    /// Only these tile/grid layers (by name) make the collision grid; `None`
-    /// (the default): every one.
+    /// Only these tile/grid layers (by name) collide, every tile of them
+    /// (unless a tile says otherwise); `None` (the default): what the file's
+    /// own data says.
     pub collision_layers: Option<Vec<String>>,
-    /// Refuse a level without a player spawn. Default: true.
+    /// Layers (by name) that never collide.
+    pub decoration_layers: Vec<String>,
+    /// Refuse a level without a player spawn; when false, or when a spawn
+    /// can be placed, a level without one loads. Default: true (one is
+    /// placed on the first free standing spot, with a warning).
     pub require_spawn: bool,
+    /// Editor entity names (normalised: lower case, `_` for `-` and spaces)
+    /// read as ledge entity names.
+    pub entity_aliases: BTreeMap<String, String>,
+    /// Tile kinds by (tileset name in lower case, tile id): they win over
+    /// the file's own data.
+    pub tile_kinds: BTreeMap<(String, u32), Tile>,
+    /// Tile property names (normalised) that make a tile of a kind when set
+    /// (and not false).
+    pub tile_properties: BTreeMap<String, Tile>,
+    /// Units of the speeds in the file.
+    pub speed_unit: SpeedUnit,
+}
+
+/// Units of entity speeds in a level file.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum SpeedUnit {
+    /// Pixels per tick (ledge's own, the default).
+    #[default]
+    PxPerTick,
+    /// Pixels per second, at [`TICKS_PER_SECOND`].
+    PxPerSecond,
+}
+
+/// The tick rate speeds in pixels per second are converted at.
+pub const TICKS_PER_SECOND: f64 = 60.0;
+
+impl SpeedUnit {
+    /// Pixels per tick of one unit of this kind.
+    pub fn px_per_tick(self) -> f64 {
+        match self {
+            SpeedUnit::PxPerTick => 1.0,
+            SpeedUnit::PxPerSecond => 1.0 / TICKS_PER_SECOND,
+        }
+    }
+
+    /// Its name, for messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            SpeedUnit::PxPerTick => "px/tick",
+            SpeedUnit::PxPerSecond => "px/s",
+        }
+    }
 }
 
 impl Default for LoadOptions {
@@ -87,9 +138,64 @@ impl Default for LoadOptions {
             mapping: TileMapping::default(),
             skip_unknown_entities: true,
             collision_layers: None,
+            decoration_layers: Vec::new(),
             require_spawn: true,
+            entity_aliases: BTreeMap::new(),
+            tile_kinds: BTreeMap::new(),
+            tile_properties: BTreeMap::new(),
+            speed_unit: SpeedUnit::PxPerTick,
         }
     }
+}
+
+impl LoadOptions {
+    /// The ledge entity name an editor name stands for: its alias, else
+    /// itself.
+    pub fn entity_name<'a>(&'a self, name: &'a str) -> &'a str {
+        self.entity_aliases
+            .get(&mapping::normalize(name))
+            .map_or(name, |s| s.as_str())
+    }
+
+    /// Whether layer `name` collides by these options: `Some(true)` listed
+    /// in [`LoadOptions::collision_layers`], `Some(false)` a decoration
+    /// layer or left out of that list, `None` up to the file.
+    pub fn layer_collides(&self, name: &str) -> Option<bool> {
+        if self.decoration_layers.iter().any(|n| n == name) {
+            return Some(false);
+        }
+        self.collision_layers
+            .as_ref()
+            .map(|names| names.iter().any(|n| n == name))
+    }
+
+    /// Whether the options give tileset `tileset` any tile kinds.
+    pub(crate) fn has_tile_kinds(&self, tileset: &str) -> bool {
+        let t = tileset.to_lowercase();
+        self.tile_kinds
+            .range((t.clone(), 0)..=(t, u32::MAX))
+            .next()
+            .is_some()
+    }
+}
+
+/// Loads a level the way the server, the client and `ledge-level` do: with
+/// the settings file `settings` when given, else the one beside the level
+/// ([`settings_path_for`]) when there is one.
+pub fn load_level(path: &Path, settings: Option<&Path>) -> Result<LoadedLevel, LevelError> {
+    let beside = settings_path_for(path);
+    let settings = match settings {
+        Some(s) => Some(s.to_path_buf()),
+        None if beside.is_file() => Some(beside),
+        None => None,
+    };
+    let options = match &settings {
+        Some(s) => {
+            LevelSettings::load(s)?.options(&s.display().to_string(), LoadOptions::default())?
+        }
+        None => LoadOptions::default(),
+    };
+    load_file_with(path, &options)
 }
 
 /// A loaded level and what came with it.
@@ -157,6 +263,12 @@ pub(crate) fn read_text(path: &Path) -> Result<String, LevelError> {
 
 /// Reads a file of at most [`MAX_FILE_BYTES`].
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, LevelError> {
+    read_bytes_capped(path, MAX_FILE_BYTES)
+}
+
+/// Reads a file of at most `cap` bytes (a larger one is refused unread
+/// past the cap).
+pub(crate) fn read_bytes_capped(path: &Path, cap: u64) -> Result<Vec<u8>, LevelError> {
     use std::io::Read;
     let io = |e: std::io::Error| LevelError::Io {
         file: path.display().to_string(),
@@ -164,13 +276,11 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, LevelError> {
     };
     let f = std::fs::File::open(path).map_err(io)?;
     let mut bytes = Vec::new();
-    f.take(MAX_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(io)?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
+    f.take(cap + 1).read_to_end(&mut bytes).map_err(io)?;
+    if bytes.len() as u64 > cap {
         return Err(LevelError::Io {
             file: path.display().to_string(),
-            message: format!("larger than {MAX_FILE_BYTES} bytes"),
+            message: format!("larger than {cap} bytes"),
         });
     }
     Ok(bytes)
@@ -293,8 +403,20 @@ pub(crate) fn assemble(
         warnings: mismatched,
         art: art::LevelArt::default(),
     };
+    let scale = options.speed_unit;
     for e in &entities {
-        match entities::classify(file, e)? {
+        let aliased;
+        let e = match options.entity_name(&e.name) {
+            n if n != e.name => {
+                aliased = PlacedEntity {
+                    name: n.to_owned(),
+                    ..e.clone()
+                };
+                &aliased
+            }
+            _ => e,
+        };
+        match entities::classify(file, e, scale)? {
             Classified::Entity(d) => out.level.entities.push(d),
             Classified::Waypoint(w) => out.route.push(w),
             Classified::Unknown if options.skip_unknown_entities => out.warnings.push(format!(

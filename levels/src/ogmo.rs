@@ -920,19 +920,20 @@ pub fn load_str(
     let mut grids = Vec::new();
     let mut entities = Vec::new();
     for l in level.layers {
-        let wanted = options
-            .collision_layers
-            .as_ref()
-            .is_none_or(|names| names.contains(&l.name));
+        let listed = options.layer_collides(&l.name);
+        let wanted = listed != Some(false);
         let tiles = match l.content {
             LayerContent::Tiles { tileset, .. }
-                if wanted && !options.mapping.has_table(&tileset) =>
+                if wanted
+                    && listed.is_none()
+                    && !options.mapping.has_table(&tileset)
+                    && !options.has_tile_kinds(&tileset) =>
             {
                 // OGMO files say nothing about which tiles collide: only a
-                // tileset with a table (ledge's own, or one the caller maps)
-                // does.
+                // tileset with a table (ledge's own, or one the settings
+                // map) does.
                 warnings.push(format!(
-                    "{file}: {}: tile layer {:?} does not collide: its tileset {tileset:?} is not ledge's own and no tile table maps it (use a grid layer for collision, or map the tileset's tiles)",
+                    "{file}: {}: tile layer {:?} does not collide: its tileset {tileset:?} is not ledge's own and no tile table maps it (use a grid layer for collision, map its tiles under [tiles.\"{tileset}\"] in the level's settings, or list the layer in collision_layers)",
                     l.field, l.name
                 ));
                 continue;
@@ -943,6 +944,18 @@ pub fn load_str(
                 .map(|(i, &id)| {
                     if id < 0 {
                         return Ok(Tile::Empty);
+                    }
+                    let kinds = options.has_tile_kinds(&tileset);
+                    if kinds || !options.mapping.has_table(&tileset) {
+                        // Settings (missing ids are empty), or a layer the
+                        // settings list as colliding (every tile solid).
+                        return Ok(
+                            match options.tile_kinds.get(&(tileset.to_lowercase(), id as u32)) {
+                                Some(&k) => k,
+                                None if kinds => Tile::Empty,
+                                None => Tile::Solid,
+                            },
+                        );
                     }
                     options.mapping.tile(&tileset, id as u32).ok_or_else(|| {
                         LevelError::UnknownTile {

@@ -41,6 +41,7 @@ use super::entities::is_entity_name;
 use super::entities::{
     check_coord_field, place_box, px_to_units, PlacedEntity, PlacedPolygon, PropValue,
 };
+use super::mapping::normalize;
 use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
 use ledge_shared::shape::MAX_POLYGON_VERTICES;
 use ledge_shared::tilemap::Tile;
@@ -382,6 +383,12 @@ impl Conv<'_> {
             }
             Ok(())
         })?;
+        if self.fallback == Fallback::NamedLayers && any_tiles {
+            self.notes.get_mut().add(
+                "the map has no collision data (no tile collision shapes, no `solid`/`collides`/`one_way`/`hazard` tile properties, no collision layer property or class), so every tile of the visible layers named like collision layers (collision, solid, walls, ground, terrain, platforms, ...) is solid and the other layers are decoration; mark what collides in Tiled (see docs/LEVELS.md, \"What collides\")".into(),
+                || "map".into(),
+            );
+        }
         if self.fallback == Fallback::AllLayers && any_tiles {
             self.notes.get_mut().add(
                 "the map has no collision data (no tile collision shapes, no `solid`/`collides`/`one_way`/`hazard` tile properties, no collision layer property or class, no layer named \"collision\"), so every tile of every visible tile layer is solid; mark what collides in Tiled (see docs/LEVELS.md, \"What collides\")".into(),
@@ -430,7 +437,10 @@ impl Conv<'_> {
                 field: format!("{parent}[{i}]"),
                 name: &l.name,
                 visible: up.visible && l.visible,
-                collides: collision::layer_collides(props(&l.properties), &l.user_type)
+                collides: self
+                    .options
+                    .layer_collides(&l.name)
+                    .or_else(|| collision::layer_collides(props(&l.properties), &l.user_type))
                     .or(up.collides),
                 off: (up.off.0 + l.offset_x as f64, up.off.1 + l.offset_y as f64),
             };
@@ -460,8 +470,21 @@ impl Conv<'_> {
         id: u32,
         field: &str,
     ) -> Result<TileRule, LevelError> {
+        if let Some(&k) = self.options.tile_kinds.get(&(ts.name.to_lowercase(), id)) {
+            return Ok(TileRule::Kind(k));
+        }
         let tile = ts.get_tile(id);
         if let Some(t) = &tile {
+            let mut named: Vec<_> = t
+                .properties
+                .iter()
+                .filter(|(_, v)| !matches!(v, PropertyValue::BoolValue(false)))
+                .filter_map(|(k, _)| self.options.tile_properties.get(&normalize(k)))
+                .collect();
+            named.sort_by_key(|t| t.code());
+            if let Some(&&k) = named.first() {
+                return Ok(TileRule::Kind(k));
+            }
             let said = tile_of_props(props(&t.properties), &t.user_type).map_err(|m| {
                 self.bad(
                     format!("{field} (tileset {:?} tile {id} properties)", ts.name),
@@ -708,12 +731,17 @@ impl Conv<'_> {
             return Ok(());
         }
         if !collision::is_convex(outline) || !(3..=MAX_POLYGON_VERTICES).contains(&outline.len()) {
-            self.notes.borrow_mut().add(
-                format!(
-                    "a collision outline that is concave or has more than {MAX_POLYGON_VERTICES} points is ignored: split it into convex polygons of 3 to {MAX_POLYGON_VERTICES} points in Tiled"
-                ),
-                place,
-            );
+            // Concave, or too many points: convex pieces of the same area.
+            let Some(pieces) = collision::convex_pieces(outline, MAX_POLYGON_VERTICES) else {
+                self.notes.borrow_mut().add(
+                    "a collision outline that crosses itself (or has no area) is ignored: redraw it as a simple polygon".into(),
+                    place,
+                );
+                return Ok(());
+            };
+            for (k, piece) in pieces.iter().enumerate() {
+                self.push_geometry(info, &format!("{field} (convex piece {k})"), at, piece, out)?;
+            }
             return Ok(());
         }
         let mut poly = PlacedPolygon {
@@ -768,8 +796,8 @@ impl Conv<'_> {
             let f = format!("{field}.objects[{k}]");
             // The class names the entity, else the name (also when the
             // class is not a ledge entity and the name is).
-            let name = if o.user_type.trim().is_empty()
-                || (!is_entity_name(&o.user_type) && is_entity_name(&o.name))
+            let known = |n: &str| is_entity_name(self.options.entity_name(n));
+            let name = if o.user_type.trim().is_empty() || (!known(&o.user_type) && known(&o.name))
             {
                 o.name.clone()
             } else {
@@ -789,7 +817,7 @@ impl Conv<'_> {
             if !o.visible {
                 continue;
             }
-            if !is_entity_name(&name) {
+            if !known(&name) {
                 // Not an entity: solid geometry if it says so (or is an
                 // unnamed shape), a hazard, or something to skip.
                 let tile = o.get_tile();
@@ -858,13 +886,11 @@ impl Conv<'_> {
                         continue;
                     }
                 }
-                if !matches!(o.shape, ObjectShape::Polygon { .. }) {
-                    self.solid_object(info, &f, &o, (x, y), out)?;
-                    continue;
-                }
+                self.solid_object(info, &f, &o, (x, y), out)?;
+                continue;
             }
             if let ObjectShape::Polygon { points } = &o.shape {
-                let name = if name.trim().is_empty() || !is_entity_name(&name) {
+                let name = if name.trim().is_empty() || !known(&name) {
                     "polygon".to_owned()
                 } else {
                     name
@@ -1023,6 +1049,21 @@ impl Conv<'_> {
             (ObjectShape::Ellipse { width, height }, _) => {
                 let e = collision::ellipse_outline(0.0, 0.0, *width as f64, *height as f64);
                 vec![collision::rotate_about(&e, (x, y), r)]
+            }
+            (ObjectShape::Polygon { points }, _) => {
+                if points.len() > super::MAX_PATH_NODES {
+                    return Err(LevelError::BadPolygon {
+                        file: self.file.into(),
+                        field: format!("{f}.polygon"),
+                        message: format!(
+                            "polygon has {} vertices; at most {} are read",
+                            points.len(),
+                            super::MAX_PATH_NODES
+                        ),
+                    });
+                }
+                let pts: Vec<_> = points.iter().map(|&(a, b)| (a as f64, b as f64)).collect();
+                vec![collision::rotate_about(&pts, (x, y), r)]
             }
             _ => {
                 self.notes.borrow_mut().add(

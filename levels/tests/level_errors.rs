@@ -208,10 +208,8 @@ fn inconsistent_data_lengths() {
         .replacen("2,2,2,2,2,2,2,2,2,2,2,2,2,2,2,2,2,2,2,2\n", "2\n", 1);
     let r = tmx::load_str(&file, &text, &LoadOptions::default());
     let msg = check(r, &file, "layers[0].data");
-    assert!(
-        msg.contains("fewer entries than the layer's 20 x 10 = 200 cells"),
-        "{msg}"
-    );
+    // Refused by the pre-scan before the Tiled reader sees it.
+    assert!(msg.contains("expected 200 entries, got 181"), "{msg}");
 }
 
 #[test]
@@ -622,7 +620,8 @@ proptest! {
         let text = String::from_utf8_lossy(&mutate(&base, &edits)).into_owned();
         let file = format!("{TILED_DIR}/fuzz.tmx");
         if let Err(e) = tmx::load_str(&file, &text, &LoadOptions::default()) {
-            prop_assert!(e.to_string().starts_with(&file));
+            // The map, or the external tileset or image it names.
+            prop_assert!(e.to_string().starts_with(TILED_DIR), "{}", e);
         }
     }
 }

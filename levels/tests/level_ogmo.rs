@@ -6,7 +6,7 @@ use glam::IVec2;
 use ledge_levels::ogmo::{self, LayerContent};
 use ledge_levels::{
     default_level, default_route, load_default_level, load_file, load_file_with, EntityKind,
-    LoadOptions, RouteAction, TileMapping, TileTable,
+    LoadOptions, RouteAction, TileMapping, TileTable, ECHO_SLOPES,
 };
 use ledge_shared::fixed::px;
 use ledge_shared::tilemap::{Slope, Tile};
@@ -189,6 +189,7 @@ fn uno_builds_a_level_with_chosen_layers() {
             .to_vec(),
         ),
         require_spawn: false,
+        ..LoadOptions::default()
     };
     let loaded = load_file_with(UNO, &opts).unwrap();
     let m = &loaded.level.tilemap;
@@ -213,7 +214,31 @@ fn uno_builds_a_level_with_chosen_layers() {
 
 #[test]
 fn echo_slopes_land_where_the_file_puts_them() {
+    // The echo sample's tileset (named "tileset") is not ledge's own: say
+    // which table reads it (a level's settings file does the same with
+    // [tiles."tileset"]). Without, its tile layer does not collide.
+    let plain = load_file_with(
+        SLOPES,
+        &LoadOptions {
+            require_spawn: false,
+            ..LoadOptions::default()
+        },
+    )
+    .unwrap();
+    assert!(plain
+        .level
+        .tilemap
+        .tiles()
+        .iter()
+        .all(|t| *t == Tile::Empty));
+    assert!(
+        plain.warnings[0].contains("tile layer") && plain.warnings[0].contains("does not collide"),
+        "{:?}",
+        plain.warnings
+    );
     let opts = LoadOptions {
+        mapping: TileMapping::default()
+            .with_tileset("tileset", TileTable::Ids(ECHO_SLOPES.to_vec())),
         require_spawn: false,
         ..LoadOptions::default()
     };

@@ -86,6 +86,9 @@ pub struct ServerConfig {
     pub cert_dir: PathBuf,
     /// Level file to play; `None`: the embedded default level.
     pub level: Option<PathBuf>,
+    /// The level's settings file (`None`: `LEVEL.ledge.toml` beside the
+    /// level, when there is one).
+    pub level_settings: Option<PathBuf>,
     /// Simulation ticks per second.
     pub tick_rate: u32,
     /// Snapshots per second (rounded to a whole number of ticks between
@@ -118,6 +121,7 @@ impl Default for ServerConfig {
             bind: DEFAULT_BIND.parse().expect("valid default address"),
             cert_dir: PathBuf::from(DEFAULT_CERT_DIR),
             level: None,
+            level_settings: None,
             tick_rate: DEFAULT_TICK_RATE,
             snapshot_rate: DEFAULT_SNAPSHOT_RATE,
             max_players: DEFAULT_MAX_PLAYERS,
@@ -225,6 +229,10 @@ pub struct Cli {
     /// Level file to play [default: the embedded default level].
     #[arg(long, value_name = "PATH")]
     pub level: Option<PathBuf>,
+    /// The level's settings file [default: LEVEL.ledge.toml beside the
+    /// level, when there is one].
+    #[arg(long, value_name = "PATH")]
+    pub level_settings: Option<PathBuf>,
     /// Simulation ticks per second [default: 60].
     #[arg(long, value_name = "HZ")]
     pub tick_rate: Option<u32>,
@@ -255,6 +263,7 @@ pub struct Cli {
 struct FileConfig {
     bind: Option<SocketAddr>,
     level: Option<PathBuf>,
+    level_settings: Option<PathBuf>,
     tick_rate: Option<u32>,
     snapshot_rate: Option<u32>,
     max_players: Option<usize>,
@@ -290,6 +299,10 @@ impl Cli {
         };
         set(&mut c.bind, file.bind);
         set(&mut c.level, file.level.map(|p| Some(relative(p))));
+        set(
+            &mut c.level_settings,
+            file.level_settings.map(|p| Some(relative(p))),
+        );
         set(&mut c.tick_rate, file.tick_rate);
         set(&mut c.snapshot_rate, file.snapshot_rate);
         set(&mut c.max_players, file.max_players);
@@ -306,6 +319,7 @@ impl Cli {
         // Flags win.
         set(&mut c.bind, self.bind);
         set(&mut c.level, self.level.clone().map(Some));
+        set(&mut c.level_settings, self.level_settings.clone().map(Some));
         set(&mut c.tick_rate, self.tick_rate);
         set(&mut c.snapshot_rate, self.snapshot_rate);
         set(&mut c.max_players, self.max_players);

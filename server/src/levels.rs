@@ -5,6 +5,7 @@ use std::path::Path;
 
 use ledge_shared::level::Level;
 use ledge_shared::protocol::{check_text, MAX_ID_LEN};
+use tracing::warn;
 
 /// Why the level could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -19,14 +20,23 @@ pub enum LevelLoadError {
     },
 }
 
-/// Loads `path` (OGMO `.json` or Tiled `.tmx`, see
-/// [`ledge_levels::load_file`]), or the embedded default level.
-pub fn load(path: Option<&Path>) -> Result<Level, LevelLoadError> {
+/// Loads `path` (OGMO `.json` or Tiled `.tmx`) with its settings file
+/// (`settings`, else `LEVEL.ledge.toml` beside it when there is one; see
+/// [`ledge_levels::load_level`]), logging every warning the importer gives
+/// (what it ignored or placed, and where); or the embedded default level.
+pub fn load(path: Option<&Path>, settings: Option<&Path>) -> Result<Level, LevelLoadError> {
     match path {
-        Some(path) => ledge_levels::load_file(path).map_err(|e| LevelLoadError::Load {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        }),
+        Some(path) => {
+            let loaded =
+                ledge_levels::load_level(path, settings).map_err(|e| LevelLoadError::Load {
+                    path: path.display().to_string(),
+                    message: e.to_string(),
+                })?;
+            for w in &loaded.warnings {
+                warn!("level: {w}");
+            }
+            Ok(loaded.level)
+        }
         None => Ok(default_level()),
     }
 }
@@ -62,8 +72,8 @@ mod tests {
 
     #[test]
     fn the_default_level_loads_and_has_a_stable_identity() {
-        let a = load(None).unwrap();
-        let b = load(None).unwrap();
+        let a = load(None, None).unwrap();
+        let b = load(None, None).unwrap();
         assert_eq!(level_hash(&a), level_hash(&b));
         assert!(check_text("level id", &level_id(&a), 1, MAX_ID_LEN).is_ok());
         let mut renamed = a.clone();
@@ -74,7 +84,7 @@ mod tests {
 
     #[test]
     fn a_missing_file_is_an_error() {
-        let err = load(Some(Path::new("/nonexistent/level.json"))).unwrap_err();
+        let err = load(Some(Path::new("/nonexistent/level.json")), None).unwrap_err();
         assert!(err.to_string().contains("/nonexistent/level.json"), "{err}");
     }
 }

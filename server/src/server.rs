@@ -101,7 +101,7 @@ impl Server {
     /// Must be called inside a tokio runtime (the sockets register with it).
     pub fn bind(config: ServerConfig) -> Result<Server, ServerError> {
         config.validate()?;
-        let level = levels::load(config.level.as_deref())?;
+        let level = levels::load(config.level.as_deref(), config.level_settings.as_deref())?;
         Game::from_level(&level)?;
         let identity = Identity::load_or_generate(&config.cert_dir)?;
         if identity.generated {

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use ledge_levels::{load_file_with, LoadOptions, LoadedLevel};
+use ledge_levels::{load_level, settings_path_for, LoadedLevel};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::level::EntityKind;
 use ledge_shared::tilemap::Tile;
@@ -32,18 +32,34 @@ enum Command {
         /// Level files (.json from OGMO Editor 3, .tmx from Tiled).
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// A settings file for every level (default: each level's own
+        /// LEVEL.ledge.toml beside it, when there is one).
+        #[arg(long, value_name = "FILE")]
+        settings: Option<PathBuf>,
     },
 }
 
 fn main() -> ExitCode {
-    let Command::Check { files } = Cli::parse().command;
+    let Command::Check { files, settings } = Cli::parse().command;
     let mut failed = 0;
     for (i, file) in files.iter().enumerate() {
         if i > 0 {
             println!();
         }
-        match load_file_with(file, &LoadOptions::default()) {
-            Ok(loaded) => print!("{}", describe(&file.display().to_string(), &loaded)),
+        let used = settings
+            .clone()
+            .or_else(|| Some(settings_path_for(file)).filter(|p| p.is_file()));
+        match load_level(file, used.as_deref()) {
+            Ok(loaded) => {
+                print!("{}", describe(&file.display().to_string(), &loaded));
+                match used {
+                    Some(s) => println!("  settings: {}", s.display()),
+                    None => println!(
+                        "  settings: none ({} would be read)",
+                        settings_path_for(file).display()
+                    ),
+                }
+            }
             Err(e) => {
                 failed += 1;
                 eprintln!("error: {e}");
