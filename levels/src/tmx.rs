@@ -331,7 +331,9 @@ impl Conv<'_> {
         });
         let mut named_layer = false;
         self.visit(m.layers(), "layers", &mut |info, layer| {
-            has_data |= info.collides.is_some();
+            // A layer said to collide is collision data; one said not to
+            // is not (the other layers may still collide by the fallback).
+            has_data |= info.collides == Some(true);
             match layer {
                 LayerType::Tiles(_) => {
                     named_layer |= info.visible && collision::is_collision_layer_name(info.name)
