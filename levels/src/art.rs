@@ -51,6 +51,9 @@ pub const MAX_ART_OBJECTS: usize = 1 << 16;
 pub struct LevelArt {
     /// The map's background colour, RGBA (none: the game's own background).
     pub background: Option<[u8; 4]>,
+    /// The map's extent, world pixels (Tiled: its cells; OGMO: its tile
+    /// layers'), for a camera when the collision grid is smaller.
+    pub size: (f32, f32),
     /// Where parallax factors are measured from (world pixels; Tiled's
     /// `parallaxoriginx/y`, else the origin).
     pub parallax_origin: (f32, f32),

@@ -109,6 +109,7 @@ fn tiled_layers_in_draw_order_with_offsets_flips_and_objects() {
     assert!(art.warnings.is_empty(), "{:?}", art.warnings);
     assert_eq!(art.background, Some([0x10, 0x20, 0x30, 0xff]));
     assert_eq!(art.parallax_origin, (8.0, 4.0));
+    assert_eq!(art.size, (64.0, 32.0));
     // Back to front; the hidden layer is left out, and so are its tileset
     // and image (never read: it does not exist).
     let names: Vec<&str> = art.layers.iter().map(|l| l.name.as_str()).collect();

@@ -133,6 +133,15 @@ pub(crate) fn from_ogmo(
     }
     Ok(LevelArt {
         background: parse_colour(&project.background_color),
+        size: layers
+            .iter()
+            .fold((0.0, 0.0), |(w, h), l: &ArtLayer| match &l.content {
+                ArtContent::Tiles(g) => (
+                    f32::max(w, l.offset.0 + (g.width * g.cell_width) as f32),
+                    f32::max(h, l.offset.1 + (g.height * g.cell_height) as f32),
+                ),
+                _ => (w, h),
+            }),
         parallax_origin: (0.0, 0.0),
         images: images.into_vec(),
         tilesets,

@@ -59,6 +59,10 @@ pub(crate) fn from_tiled(file: &str, map: &Map) -> Result<LevelArt, LevelError> 
         background: map
             .background_color
             .map(|c| [c.red, c.green, c.blue, c.alpha]),
+        size: (
+            (map.width as u64 * map.tile_width as u64) as f32,
+            (map.height as u64 * map.tile_height as u64) as f32,
+        ),
         parallax_origin: (map.parallax_origin_x, map.parallax_origin_y),
         images: images.into_vec(),
         tilesets,

@@ -70,6 +70,12 @@ impl ArtView {
             .map(|[r, g, b, a]| Color::from_rgba(r, g, b, a))
     }
 
+    /// The art's extent (world pixels from the origin), if any.
+    pub fn extent(&self) -> Option<Rect> {
+        let (w, h) = self.art.size;
+        (w > 0.0 && h > 0.0).then(|| Rect::new(0.0, 0.0, w, h))
+    }
+
     /// Per collision cell (row-major): drawn by the art.
     pub fn covered(&self) -> &[bool] {
         &self.covered

@@ -347,7 +347,13 @@ async fn game(mut setup: Setup) {
             let map = &level.tilemap;
             let o = px2(map.origin());
             let t = map.tile_size() as f32 / UNITS_PER_PX as f32;
-            Rect::new(o.x, o.y, map.width() as f32 * t, map.height() as f32 * t)
+            let grid = Rect::new(o.x, o.y, map.width() as f32 * t, map.height() as f32 * t);
+            // A map drawn beyond its collision grid (or without one).
+            match art.extent() {
+                Some(e) if grid.w <= 0.0 || grid.h <= 0.0 => e,
+                Some(e) => grid.combine_with(e),
+                None => grid,
+            }
         };
         let frame_view = setup.play.view().unwrap_or_default();
         let local: Option<PlayerSprite> = frame_view.local.as_ref().map(PlayerSprite::from);
