@@ -28,7 +28,9 @@ pub fn level_hash(level: &Level) -> u64 {
 pub fn level_for(welcome: &Welcome, file: Option<&Path>) -> Result<Level, ClientError> {
     let (level, source) = match file {
         Some(path) => (
-            ledge_levels::load_file(path).map_err(|e| ClientError::Level(e.to_string()))?,
+            ledge_levels::load_level(path, None)
+                .map_err(|e| ClientError::Level(e.to_string()))?
+                .level,
             path.display().to_string(),
         ),
         None => (

@@ -194,10 +194,48 @@ pub(crate) fn layer_collides<'a>(
     }
 }
 
+/// Words of a layer's name that mark a collision layer ("Walls level 2",
+/// "Ground_1"), unless another word marks decoration.
+const COLLISION_LAYER_WORDS: &[&str] = &[
+    "collision",
+    "collisions",
+    "collider",
+    "colliders",
+    "solid",
+    "solids",
+    "wall",
+    "walls",
+    "ground",
+    "terrain",
+    "platform",
+    "platforms",
+    "blocks",
+];
+const DECORATION_LAYER_WORDS: &[&str] = &[
+    "decoration",
+    "decorations",
+    "decor",
+    "deco",
+    "background",
+    "foreground",
+    "bg",
+    "fg",
+    "shadow",
+    "shadows",
+];
+
 /// Whether a layer's name marks it as a collision layer (used only when the
-/// map carries no collision data at all).
+/// map carries no collision data at all): the whole name (`level`,
+/// `world`, ...) or one of its words (`Walls level 2`), and no decoration
+/// word (`Ground decoration`).
 pub(crate) fn is_collision_layer_name(name: &str) -> bool {
-    COLLISION_LAYER_NAMES.contains(&normalize(name).as_str())
+    let n = normalize(name);
+    let words: Vec<&str> = n.split('_').filter(|w| !w.is_empty()).collect();
+    if words.iter().any(|w| DECORATION_LAYER_WORDS.contains(w)) {
+        return false;
+    }
+    COLLISION_LAYER_NAMES.contains(&n.as_str())
+        || words.iter().any(|w| COLLISION_LAYER_WORDS.contains(w))
 }
 
 /// An outline in tile-local pixels (origin at the tile's top-left corner).
@@ -717,6 +755,10 @@ mod tests {
         assert_eq!(layer_collides([], "background"), Some(false));
         assert_eq!(layer_collides([], ""), None);
         assert!(is_collision_layer_name("Walls"));
+        assert!(is_collision_layer_name("Walls level 2"));
+        assert!(is_collision_layer_name("level"));
         assert!(!is_collision_layer_name("Fringe"));
+        assert!(!is_collision_layer_name("Ground decoration"));
+        assert!(!is_collision_layer_name("Background level"));
     }
 }

@@ -31,7 +31,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
 use ::tiled::{
-    DefaultResourceCache, LayerType, Loader, Map, ObjectLayer, ObjectShape, Orientation,
+    ChunkData, DefaultResourceCache, LayerType, Loader, Map, ObjectLayer, ObjectShape, Orientation,
     PropertyValue, ResourceReader, TileLayer,
 };
 use glam::IVec2;
@@ -43,6 +43,7 @@ use super::entities::{
 };
 use super::mapping::normalize;
 use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
+use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::shape::MAX_POLYGON_VERTICES;
 use ledge_shared::tilemap::Tile;
 
@@ -148,6 +149,7 @@ fn load(
         options,
         fallback: Fallback::None,
         notes: RefCell::new(Notes::default()),
+        grid: (0, 0, map.width, map.height),
     }
     .run(path)?;
     loaded.art = crate::art::from_tiled(&file, &map)?;
@@ -162,6 +164,9 @@ struct Conv<'a> {
     fallback: Fallback,
     /// Warnings, aggregated.
     notes: RefCell<Notes>,
+    /// The collision grid in tiles: left and top column/row, width and
+    /// height (the map's size; an infinite map's: the chunks' bounds).
+    grid: (i32, i32, u32, u32),
 }
 
 /// What collides in a map that carries no collision data at all (no tile
@@ -296,12 +301,6 @@ impl Conv<'_> {
                 ),
             ));
         }
-        if m.infinite() {
-            return Err(self.bad(
-                "map.infinite",
-                "infinite maps are not supported yet (in Tiled: Map > Map Properties, untick Infinite)".into(),
-            ));
-        }
         if m.tile_width != m.tile_height || !(1..=4096).contains(&m.tile_width) {
             return Err(self.bad(
                 "map.tilewidth",
@@ -311,7 +310,10 @@ impl Conv<'_> {
                 ),
             ));
         }
-        for (v, f) in [(m.width, "map.width"), (m.height, "map.height")] {
+        if m.infinite() {
+            self.grid = self.chunk_bounds()?;
+        }
+        for (v, f) in [(self.grid.2, "map.width"), (self.grid.3, "map.height")] {
             if v > MAX_LEVEL_TILES {
                 return Err(LevelError::OutOfBounds {
                     file: self.file.into(),
@@ -571,13 +573,6 @@ impl Conv<'_> {
             );
             return Ok(None);
         }
-        let TileLayer::Finite(fl) = tl else {
-            return Err(LevelError::UnknownLayer {
-                file: self.file.into(),
-                field: field.into(),
-                kind: "infinite tile layer".into(),
-            });
-        };
         if info.off != (0.0, 0.0) {
             return Err(self.bad(
                 format!("{field}.offsetx"),
@@ -587,33 +582,42 @@ impl Conv<'_> {
                 ),
             ));
         }
-        let (w, h) = (fl.width(), fl.height());
-        if (w, h) != (self.map.width, self.map.height) {
-            return Err(self.bad(
-                format!("{field}.width"),
-                format!(
-                    "layer is {w} x {h} tiles, the map {} x {}",
-                    self.map.width, self.map.height
-                ),
-            ));
+        let (ox, oy, w, h) = self.grid;
+        if let TileLayer::Finite(fl) = tl {
+            if (fl.width(), fl.height()) != (w, h) {
+                return Err(self.bad(
+                    format!("{field}.width"),
+                    format!(
+                        "layer is {} x {} tiles, the map {w} x {h}",
+                        fl.width(),
+                        fl.height()
+                    ),
+                ));
+            }
+            // The tiled crate does not check the data length against the
+            // size, and indexing past short data panics: the pre-scan
+            // refuses such data; probe the last cell all the same.
+            if w > 0
+                && h > 0
+                && catch_unwind(AssertUnwindSafe(|| {
+                    fl.get_tile_data(w as i32 - 1, h as i32 - 1).is_some()
+                }))
+                .is_err()
+            {
+                return Err(self.bad(
+                    format!("{field}.data"),
+                    format!(
+                        "fewer entries than the layer's {w} x {h} = {} cells",
+                        w as u64 * h as u64
+                    ),
+                ));
+            }
         }
-        // The tiled crate does not check the data length against the size,
-        // and indexing past short data panics: probe the last cell first.
-        if w > 0
-            && h > 0
-            && catch_unwind(AssertUnwindSafe(|| {
-                fl.get_tile_data(w as i32 - 1, h as i32 - 1).is_some()
-            }))
-            .is_err()
-        {
-            return Err(self.bad(
-                format!("{field}.data"),
-                format!(
-                    "fewer entries than the layer's {w} x {h} = {} cells",
-                    w as u64 * h as u64
-                ),
-            ));
-        }
+        // Grid cell (x, y) is map tile (x + ox, y + oy).
+        let cell = |x: i32, y: i32| match tl {
+            TileLayer::Finite(fl) => fl.get_tile(x, y),
+            TileLayer::Infinite(il) => il.get_tile(x + ox, y + oy),
+        };
         let fallback = match self.fallback {
             Fallback::None => false,
             Fallback::NamedLayers => collision::is_collision_layer_name(info.name),
@@ -624,7 +628,7 @@ impl Conv<'_> {
         let mut tiles = Vec::with_capacity(w as usize * h as usize);
         for y in 0..h as i32 {
             for x in 0..w as i32 {
-                let Some(lt) = fl.get_tile(x, y) else {
+                let Some(lt) = cell(x, y) else {
                     tiles.push(Tile::Empty);
                     continue;
                 };
@@ -670,7 +674,7 @@ impl Conv<'_> {
                     TileShape::Tile(tile) => tiles.push(tile),
                     TileShape::Geometry(outlines) => {
                         tiles.push(Tile::Empty);
-                        let corner = (x as f64 * t, y as f64 * t);
+                        let corner = ((x + ox) as f64 * t, (y + oy) as f64 * t);
                         for (k, o) in outlines.into_iter().enumerate() {
                             let abs: Vec<_> =
                                 o.iter().map(|p| (corner.0 + p.0, corner.1 + p.1)).collect();
@@ -680,20 +684,60 @@ impl Conv<'_> {
                                 ts.name,
                                 lt.id()
                             );
-                            self.push_geometry(info, &gf, (x, y), &abs, geometry)?;
+                            self.push_geometry(info, &gf, (x + ox, y + oy), &abs, geometry)?;
                         }
                     }
                 }
             }
         }
         let ts = self.map.tile_width;
+        let origin = [ox, oy].map(|o| o as i64 * ts as i64 * UNITS_PER_PX as i64);
+        for (v, axis) in origin.iter().zip(["x", "y"]) {
+            check_coord_field(self.file, &format!("{field} (grid origin {axis})"), *v)?;
+        }
         Ok(Some(GridLayer {
             field: field.into(),
-            origin: IVec2::ZERO,
+            origin: IVec2::new(origin[0] as i32, origin[1] as i32),
             cell: (ts, ts),
             cells: (w, h),
             tiles,
         }))
+    }
+
+    /// An infinite map's grid: the bounds, in tiles, of every chunk holding
+    /// a tile in any tile layer (`(left, top, width, height)`; empty
+    /// chunks do not count).
+    fn chunk_bounds(&self) -> Result<(i32, i32, u32, u32), LevelError> {
+        let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
+        self.visit(self.map.layers(), "layers", &mut |_, layer| {
+            if let LayerType::Tiles(TileLayer::Infinite(il)) = layer {
+                for ((cx, cy), chunk) in il.chunks() {
+                    let (cw, ch) = (ChunkData::WIDTH as i32, ChunkData::HEIGHT as i32);
+                    let used = (0..ch).any(|y| (0..cw).any(|x| chunk.get_tile(x, y).is_some()));
+                    if used {
+                        let (x0, y0) = (cx as i64 * cw as i64, cy as i64 * ch as i64);
+                        lo = (lo.0.min(x0), lo.1.min(y0));
+                        hi = (hi.0.max(x0 + cw as i64), hi.1.max(y0 + ch as i64));
+                    }
+                }
+            }
+            Ok(())
+        })?;
+        if lo.0 > hi.0 {
+            return Ok((0, 0, 0, 0));
+        }
+        let (w, h) = (hi.0 - lo.0, hi.1 - lo.1);
+        if w > MAX_LEVEL_TILES as i64 || h > MAX_LEVEL_TILES as i64 {
+            return Err(LevelError::OutOfBounds {
+                file: self.file.into(),
+                field: "map (infinite: the chunks' extent)".into(),
+                message: format!(
+                    "the tiles span {w} x {h} tiles (from ({}, {})), more than {MAX_LEVEL_TILES} per side",
+                    lo.0, lo.1
+                ),
+            });
+        }
+        Ok((lo.0 as i32, lo.1 as i32, w as u32, h as u32))
     }
 
     /// Static solid geometry outside the grid from an outline in absolute

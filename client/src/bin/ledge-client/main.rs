@@ -93,6 +93,11 @@ struct Cli {
     /// embedded level. `--local` always plays the embedded level.
     #[arg(long, value_name = "FILE")]
     level: Option<PathBuf>,
+    /// The level's settings file for offline play [default: LEVEL.ledge.toml
+    /// beside the level, when there is one; online, always that one, as the
+    /// server's default].
+    #[arg(long, value_name = "FILE")]
+    level_settings: Option<PathBuf>,
     /// Player name.
     #[arg(long, default_value = "player")]
     name: String,
@@ -204,10 +209,15 @@ fn main() -> anyhow::Result<()> {
     // flat colours.
     let (level, level_art) = match &cli.level {
         Some(path) if !cli.local => {
-            let loaded = ledge_levels::load_file_with(path, &ledge_levels::LoadOptions::default())
+            let loaded = ledge_levels::load_level(path, cli.level_settings.as_deref())
                 .map_err(|e| anyhow::anyhow!("loading the level: {e}"))?;
+            // What the importer ignored, guessed or placed: the player
+            // (and the level's author) should see it.
+            for w in &loaded.warnings {
+                eprintln!("warning: {w}");
+            }
             for w in &loaded.art.warnings {
-                tracing::warn!("level art: {w}");
+                eprintln!("warning: level art: {w}");
             }
             (loaded.level, loaded.art)
         }
