@@ -10,7 +10,10 @@
 //!   the layer's (or chunk's) width x height. Totals are kept across the
 //!   documents of one load ([`Budget`]). Old files that lack attributes the
 //!   `tiled` crate requires (`tilecount`, `columns`, an image's `width` and
-//!   `height`) are patched when the value can be derived.
+//!   `height`) are patched when the value can be derived. Tile data the
+//!   `tiled` crate cannot read as built here (zstd-compressed base64, and the
+//!   oldest format, one `<tile gid=".."/>` element per cell) is decoded here,
+//!   under the same bounds, and handed to it rewritten as CSV.
 //! * OGMO: the JSON text is scanned ([`check_json`]) for its nesting depth
 //!   and its number of values before `serde_json` builds a tree of it.
 //!
@@ -171,14 +174,18 @@ pub(crate) fn check_tmx_resource(
     if patches.is_empty() {
         return Ok(bytes);
     }
-    patches.sort_by_key(|p| p.0);
-    let extra: usize = patches.iter().map(|p| p.1.len()).sum();
+    // Ranges never overlap (each is a start tag, an insertion point in one,
+    // or the content of one element); a stable sort keeps insertions at the
+    // same point in document order.
+    patches.sort_by_key(|p| p.start);
+    let extra: usize = patches.iter().map(|p| p.text.len()).sum();
     let mut out = Vec::with_capacity(bytes.len() + extra);
     let mut at = 0;
-    for (pos, text) in patches {
-        out.extend_from_slice(&bytes[at..pos]);
-        out.extend_from_slice(text.as_bytes());
-        at = pos;
+    for p in patches {
+        let start = p.start.max(at);
+        out.extend_from_slice(&bytes[at..start]);
+        out.extend_from_slice(p.text.as_bytes());
+        at = p.end.max(start);
     }
     out.extend_from_slice(&bytes[at..]);
     Ok(out)
@@ -228,6 +235,39 @@ struct DataScan {
     /// or the data of a finite one).
     decodes: bool,
     chunks: u64,
+    /// Where the element's content starts (just after its start tag), and
+    /// whether it has any (`<data/>` has none).
+    content_start: usize,
+    empty: bool,
+    /// XML tile data (no `encoding`): the `<tile>` children seen, and the
+    /// gids of the first of them (at most the cells the layer may have).
+    tiles: u64,
+    gids: Vec<u32>,
+}
+
+impl DataScan {
+    /// Tile data as `<tile gid=".."/>` children (the oldest TMX format).
+    fn is_xml(&self) -> bool {
+        self.encoding.is_none()
+    }
+
+    /// Tile data the `tiled` crate (built without zstd, and not reading
+    /// `<tile>` children) is handed rewritten as CSV.
+    fn rewritten(&self) -> bool {
+        self.is_xml()
+            || (self.encoding.as_deref() == Some("base64")
+                && self.compression.as_deref() == Some("zstd"))
+    }
+
+    /// Most gids kept for the rewrite: the cells the layer has, or, when its
+    /// size is not given, the cells the load may still have.
+    fn keep(&self, remaining: u64) -> usize {
+        self.expected
+            .unwrap_or(remaining)
+            .min(MAX_LEVEL_CELLS)
+            .try_into()
+            .unwrap_or(usize::MAX)
+    }
 }
 
 struct Frame {
@@ -244,8 +284,16 @@ struct Scan<'a> {
     /// How many objects use this document (a template), else 1.
     uses: u64,
     stack: Vec<Frame>,
-    patches: Vec<(usize, String)>,
+    /// Byte ranges of the document to replace (an empty range inserts).
+    patches: Vec<Patch>,
     root_seen: bool,
+}
+
+/// Replaces `bytes[start..end]` with `text` in what the Tiled reader sees.
+struct Patch {
+    start: usize,
+    end: usize,
+    text: String,
 }
 
 /// The attributes of an element, by local name, unescaped.
@@ -285,26 +333,28 @@ impl Scan<'_> {
         let mut buf = Vec::new();
         loop {
             buf.clear();
+            // The event's bytes are `start..end` of the document.
+            let start = reader.buffer_position();
             let ev = reader
                 .read_event_into(&mut buf)
                 .map_err(|e| self.syntax(&self.current_path(), e))?;
             let end = reader.buffer_position();
             match ev {
-                Event::Start(e) => self.open(&e, false, end)?,
+                Event::Start(e) => self.open(&e, false, start, end)?,
                 Event::Empty(e) => {
-                    self.open(&e, true, end)?;
-                    self.close()?;
+                    self.open(&e, true, start, end)?;
+                    self.close(end)?;
                 }
-                Event::End(_) => self.close()?,
+                Event::End(_) => self.close(start)?,
                 Event::Text(t) => {
                     let text = t
                         .unescape()
                         .map_err(|e| self.syntax(&self.current_path(), e))?;
-                    self.text(text.as_bytes())?;
+                    self.text(text.as_bytes(), start, end)?;
                 }
                 Event::CData(t) => {
                     let text = t.into_inner();
-                    self.text(&text)?;
+                    self.text(&text, start, end)?;
                 }
                 Event::Eof => break,
                 _ => {}
@@ -394,7 +444,13 @@ impl Scan<'_> {
         Ok(())
     }
 
-    fn open(&mut self, e: &BytesStart<'_>, empty: bool, end: usize) -> Result<(), LevelError> {
+    fn open(
+        &mut self,
+        e: &BytesStart<'_>,
+        empty: bool,
+        start: usize,
+        end: usize,
+    ) -> Result<(), LevelError> {
         let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
         let field = self.segment(&name);
         if self.stack.len() + 1 > MAX_XML_DEPTH {
@@ -536,6 +592,31 @@ impl Scan<'_> {
                     "MAX_TOTAL_TILESET_TILES",
                 )?;
             }
+            "tile"
+                if parent_is(
+                    self,
+                    |c| matches!(c, Ctx::Data(d) if d.decodes && d.is_xml()),
+                ) =>
+            {
+                let gid = match a.get("gid") {
+                    None => 0,
+                    Some(g) => g.trim().parse::<u32>().map_err(|e| LevelError::BadValue {
+                        file: file.clone(),
+                        field: format!("{field}.gid"),
+                        message: format!("{g:?} is not a tile gid: {e}"),
+                    })?,
+                };
+                let remaining = MAX_LEVEL_CELLS.saturating_sub(self.budget.cells);
+                if let Some(Frame {
+                    ctx: Ctx::Data(d), ..
+                }) = self.stack.last_mut()
+                {
+                    d.tiles += 1;
+                    if d.gids.len() < d.keep(remaining) {
+                        d.gids.push(gid);
+                    }
+                }
+            }
             "image" => {
                 let size = self.image(&a, &field, insert_at)?;
                 if let Some(Frame {
@@ -600,7 +681,7 @@ impl Scan<'_> {
                         "MAX_LEVEL_CELLS",
                     )?;
                 }
-                ctx = Ctx::Data(DataScan {
+                let d = DataScan {
                     field: field.clone(),
                     encoding: a.get("encoding").map(str::to_owned),
                     compression: a.get("compression").map(str::to_owned),
@@ -608,7 +689,21 @@ impl Scan<'_> {
                     done: false,
                     decodes: !infinite,
                     chunks: 0,
-                });
+                    content_start: end,
+                    empty,
+                    tiles: 0,
+                    gids: Vec::new(),
+                };
+                if d.rewritten() {
+                    // The content (or each chunk's) becomes CSV.
+                    let close = if empty { "/>" } else { ">" };
+                    self.patches.push(Patch {
+                        start,
+                        end,
+                        text: format!("<data encoding=\"csv\"{close}"),
+                    });
+                }
+                ctx = Ctx::Data(d);
             }
             "chunk" => {
                 let parent = self.stack.last_mut().map(|f| &mut f.ctx);
@@ -669,6 +764,10 @@ impl Scan<'_> {
                             done: false,
                             decodes: true,
                             chunks: 0,
+                            content_start: end,
+                            empty,
+                            tiles: 0,
+                            gids: Vec::new(),
                         });
                     }
                 }
@@ -759,8 +858,11 @@ impl Scan<'_> {
             if let Some(src) = a.get("source") {
                 let dir = self.path.parent().unwrap_or(Path::new(""));
                 if let Some((w, h)) = png_size(&dir.join(src)) {
-                    self.patches
-                        .push((insert_at, format!(" width=\"{w}\" height=\"{h}\"")));
+                    self.patches.push(Patch {
+                        start: insert_at,
+                        end: insert_at,
+                        text: format!(" width=\"{w}\" height=\"{h}\""),
+                    });
                     size = Some((w as u64, h as u64));
                 }
             }
@@ -792,16 +894,25 @@ impl Scan<'_> {
         Ok(size)
     }
 
-    fn text(&mut self, text: &[u8]) -> Result<(), LevelError> {
+    fn text(&mut self, text: &[u8], start: usize, end: usize) -> Result<(), LevelError> {
         let file = self.file.clone();
         let remaining = MAX_LEVEL_CELLS.saturating_sub(self.budget.cells);
         if let Some(Frame {
             ctx: Ctx::Data(d), ..
         }) = self.stack.last_mut()
         {
-            if d.decodes && !d.done {
+            // XML tile data: the text between the `<tile>` elements is
+            // checked like any other.
+            if d.decodes && !d.done && !d.is_xml() {
                 d.done = true;
-                return decode_data(&file, d, text, remaining);
+                if let Some(gids) = decode_data(&file, d, text, remaining)? {
+                    self.patches.push(Patch {
+                        start,
+                        end,
+                        text: csv_text(&gids),
+                    });
+                }
+                return Ok(());
             }
         }
         if text.len() > MAX_TEXT_BYTES {
@@ -817,11 +928,24 @@ impl Scan<'_> {
         Ok(())
     }
 
-    fn close(&mut self) -> Result<(), LevelError> {
+    /// Closes the innermost element; `content_end` is where its end tag
+    /// starts (or where its empty tag ends).
+    fn close(&mut self, content_end: usize) -> Result<(), LevelError> {
         let Some(frame) = self.stack.pop() else {
             return Ok(());
         };
         match frame.ctx {
+            Ctx::Data(d) if d.decodes && d.is_xml() => {
+                let remaining = MAX_LEVEL_CELLS.saturating_sub(self.budget.cells);
+                check_cells(&self.file, &d, d.tiles, remaining)?;
+                if !d.empty {
+                    self.patches.push(Patch {
+                        start: d.content_start,
+                        end: content_end,
+                        text: csv_text(&d.gids),
+                    });
+                }
+            }
             Ctx::Data(d) if d.decodes && !d.done => {
                 let remaining = MAX_LEVEL_CELLS.saturating_sub(self.budget.cells);
                 decode_data(&self.file, &d, b"", remaining)?;
@@ -887,14 +1011,25 @@ impl Scan<'_> {
         if !ts.has_columns {
             attrs.push_str(&format!(" columns=\"{columns}\""));
         }
-        self.patches.push((ts.insert_at, attrs));
+        self.patches.push(Patch {
+            start: ts.insert_at,
+            end: ts.insert_at,
+            text: attrs,
+        });
         Ok(())
     }
 }
 
 /// Counts the cells of one `<data>` (or `<chunk>`) text, never holding more
 /// than a small buffer, and checks the count against the layer's size.
-fn decode_data(file: &str, d: &DataScan, text: &[u8], remaining: u64) -> Result<(), LevelError> {
+/// zstd-compressed data is decoded: its gids are returned, to be handed to
+/// the `tiled` crate as CSV.
+fn decode_data(
+    file: &str,
+    d: &DataScan,
+    text: &[u8],
+    remaining: u64,
+) -> Result<Option<Vec<u32>>, LevelError> {
     let bad = |message: String| LevelError::Syntax {
         file: file.into(),
         field: d.field.clone(),
@@ -908,6 +1043,7 @@ fn decode_data(file: &str, d: &DataScan, text: &[u8], remaining: u64) -> Result<
         Some(n) => n.saturating_add(remaining).saturating_add(1),
         None => remaining.saturating_add(1),
     };
+    let mut gids = None;
     let got = match (d.encoding.as_deref(), d.compression.as_deref()) {
         (Some("csv"), None) => {
             let n = memchr_count(b',', text) + 1;
@@ -925,17 +1061,19 @@ fn decode_data(file: &str, d: &DataScan, text: &[u8], remaining: u64) -> Result<
                 Some("zlib") => count_bytes(flate2::read::ZlibDecoder::new(b64), byte_cap),
                 Some("gzip") => count_bytes(flate2::read::GzDecoder::new(b64), byte_cap),
                 Some("zstd") => {
-                    return Err(LevelError::BadValue {
-                        file: file.into(),
-                        field: format!("{}.compression", d.field),
-                        message: "zstd-compressed tile data is not supported: in Tiled, set Map > Map Properties > Tile Layer Format to Base64 (zlib compressed) or Base64 (gzip compressed) and save again".into(),
-                    })
+                    let mut cells = Cells::new(d.keep(remaining));
+                    zstd_cells(b64, byte_cap, &mut cells)
+                        .map_err(|e| bad(format!("cannot decode the tile data: {e}")))?;
+                    gids = Some(cells.gids);
+                    Ok(cells.bytes)
                 }
                 Some(other) => {
                     return Err(LevelError::BadValue {
                         file: file.into(),
                         field: format!("{}.compression", d.field),
-                        message: format!("unknown compression {other:?} (expected zlib or gzip)"),
+                        message: format!(
+                            "unknown compression {other:?} (expected zlib, gzip or zstd)"
+                        ),
                     })
                 }
             }
@@ -954,23 +1092,24 @@ fn decode_data(file: &str, d: &DataScan, text: &[u8], remaining: u64) -> Result<
                 message: format!("CSV tile data cannot be compressed, got {c:?}"),
             })
         }
-        (None, _) => {
-            return Err(LevelError::BadValue {
-                file: file.into(),
-                field: format!("{}.encoding", d.field),
-                message: "tile data as XML <tile> elements is not supported: in Tiled, set Map > Map Properties > Tile Layer Format to CSV or Base64 and save again".into(),
-            })
-        }
+        // XML tile data is counted as its `<tile>` elements come.
+        (None, _) => return Ok(None),
         (Some(e), _) => {
             return Err(LevelError::BadValue {
                 file: file.into(),
                 field: format!("{}.encoding", d.field),
-                message: format!(
-                    "unknown tile data encoding {e:?} (expected csv or base64)"
-                ),
+                message: format!("unknown tile data encoding {e:?} (expected csv or base64)"),
             })
         }
     };
+    check_cells(file, d, got, remaining)?;
+    Ok(gids)
+}
+
+/// Checks the `got` cells of one `<data>` (or `<chunk>`): within the load's
+/// remaining cells, and exactly the layer's (or chunk's) width x height.
+fn check_cells(file: &str, d: &DataScan, got: u64, remaining: u64) -> Result<(), LevelError> {
+    let expected = d.expected;
     let over = match expected {
         Some(n) => got > n.saturating_add(remaining),
         None => got > remaining,
@@ -996,6 +1135,88 @@ fn decode_data(file: &str, d: &DataScan, text: &[u8], remaining: u64) -> Result<
         }
     }
     Ok(())
+}
+
+/// Tile data decoded to 4-byte little-endian gids: the first `keep` are kept,
+/// the rest only counted.
+struct Cells {
+    keep: usize,
+    gids: Vec<u32>,
+    part: [u8; 4],
+    filled: usize,
+    bytes: u64,
+}
+
+impl Cells {
+    fn new(keep: usize) -> Self {
+        Cells {
+            keep,
+            gids: Vec::with_capacity(keep.min(1 << 16)),
+            part: [0; 4],
+            filled: 0,
+            bytes: 0,
+        }
+    }
+}
+
+impl io::Write for Cells {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        for &b in buf {
+            self.part[self.filled] = b;
+            self.filled += 1;
+            if self.filled == 4 {
+                self.filled = 0;
+                if self.gids.len() < self.keep {
+                    self.gids.push(u32::from_le_bytes(self.part));
+                }
+            }
+        }
+        self.bytes += buf.len() as u64;
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Smallest zstd window accepted whatever the cap (a streaming encoder
+/// that does not know the input's size announces its level's window, up to
+/// 8 MiB at level 19); the decoder reserves the window up front.
+const MIN_ZSTD_WINDOW: u64 = 8 << 20;
+
+/// Decodes the zstd frames of base64 text `b64` into `cells`, stopping after
+/// `cap + 1` bytes of output. The decoder's window (its memory) is at most
+/// the larger of the cap and [`MIN_ZSTD_WINDOW`].
+fn zstd_cells(b64: impl Read, cap: u64, cells: &mut Cells) -> io::Result<()> {
+    // The compressed bytes are at most 3/4 of the text, already held.
+    let mut data = Vec::new();
+    b64.take(MAX_FILE_BYTES).read_to_end(&mut data)?;
+    let max_window = cap.max(MIN_ZSTD_WINDOW);
+    let mut src = data.as_slice();
+    // A frame at least, then any frames concatenated after it.
+    loop {
+        let decoder =
+            ruzstd::decoding::StreamingDecoder::new_with_max_window_size(&mut src, max_window)
+                .map_err(io::Error::other)?;
+        let left = cap.saturating_add(1).saturating_sub(cells.bytes);
+        io::copy(&mut decoder.take(left), cells)?;
+        if src.is_empty() || cells.bytes > cap {
+            return Ok(());
+        }
+    }
+}
+
+/// The gids as the `tiled` crate reads CSV tile data.
+fn csv_text(gids: &[u32]) -> String {
+    use std::fmt::Write;
+    let mut s = String::with_capacity(gids.len() * 4);
+    for (i, g) in gids.iter().enumerate() {
+        if i > 0 {
+            s.push(',');
+        }
+        let _ = write!(s, "{g}");
+    }
+    s
 }
 
 /// Reads `r` to its end or to `cap + 1` bytes, whichever is first, into a

@@ -160,6 +160,9 @@ pub enum LayerContent {
 struct Cx<'a> {
     file: &'a str,
     warnings: std::cell::RefCell<Vec<String>>,
+    /// Cells of the tile and grid layers decoded so far in this document,
+    /// padded rows included (bounded by [`crate::limits::MAX_LEVEL_CELLS`]).
+    cells: std::cell::Cell<u64>,
 }
 
 fn join(parent: &str, key: &str) -> String {
@@ -305,11 +308,32 @@ impl Cx<'_> {
         }
     }
 
+    /// Adds a layer's `n` cells to the document's total, refused past
+    /// [`crate::limits::MAX_LEVEL_CELLS`] (before anything is allocated for
+    /// them: padded 2D rows make many cells of few JSON values).
+    fn add_cells(&self, field: &str, n: u64) -> Result<(), LevelError> {
+        use crate::limits::MAX_LEVEL_CELLS;
+        let total = self.cells.get().saturating_add(n);
+        self.cells.set(total);
+        if total > MAX_LEVEL_CELLS {
+            return Err(LevelError::Limit {
+                file: self.file.into(),
+                field: field.into(),
+                what: "tile and grid cells in all layers".into(),
+                limit: MAX_LEVEL_CELLS,
+                found: total,
+                bound: "MAX_LEVEL_CELLS",
+            });
+        }
+        Ok(())
+    }
+
     /// The cells of a 1D (`two_d == false`) or 2D array, row-major, each
     /// decoded by `f` with its field path. A 2D row shorter than the width
     /// (OGMO 3.2 writes such rows after a resize, as in the sample
     /// `uno.json`) is padded with `empty`, with a warning; every other
-    /// length mismatch is an error.
+    /// length mismatch is an error. Every layer's width x height counts
+    /// towards the document's [`crate::limits::MAX_LEVEL_CELLS`].
     fn cells<T>(
         &self,
         v: &Value,
@@ -325,6 +349,7 @@ impl Cx<'_> {
             if a.len() != h as usize {
                 return Err(self.len_err(field, h as u64, a.len()));
             }
+            self.add_cells(field, w as u64 * h as u64)?;
             out.reserve(w as usize * h as usize);
             for (r, row) in a.iter().enumerate() {
                 let rf = format!("{field}[{r}]");
@@ -348,6 +373,7 @@ impl Cx<'_> {
             if a.len() as u64 != n {
                 return Err(self.len_err(field, n, a.len()));
             }
+            self.add_cells(field, n)?;
             out.reserve(a.len());
             for (i, cell) in a.iter().enumerate() {
                 out.push(f(cell, &format!("{field}[{i}]"))?);
@@ -362,6 +388,7 @@ pub fn parse_project(file: &str, text: &str) -> Result<Project, LevelError> {
     let cx = Cx {
         file,
         warnings: Default::default(),
+        cells: Default::default(),
     };
     let root = cx.parse(text, "OGMO project JSON")?;
     let mut p = Project {
@@ -486,6 +513,7 @@ pub fn parse_level(
     let cx = Cx {
         file,
         warnings: Default::default(),
+        cells: Default::default(),
     };
     let root = cx.parse(text, "JSON")?;
     let offset = (

@@ -329,23 +329,467 @@ fn data_must_have_exactly_width_times_height_cells() {
     );
 }
 
+/// Base64 of `bytes` compressed by the pure-Rust zstd encoder.
+fn zstd(bytes: &[u8]) -> String {
+    use base64::Engine;
+    let z = ruzstd::encoding::compress_to_vec(bytes, ruzstd::encoding::CompressionLevel::Fastest);
+    base64::engine::general_purpose::STANDARD.encode(z)
+}
+
+/// A zstd frame (no content size, a 128 KiB window) of `blocks` RLE blocks
+/// of 128 KiB zero bytes each: 4 bytes of input per 128 KiB of output.
+fn zstd_rle_zeros(blocks: usize) -> Vec<u8> {
+    let mut f = vec![0x28, 0xb5, 0x2f, 0xfd, 0x00, 0x38];
+    for i in 0..blocks {
+        let last = (i + 1 == blocks) as u32;
+        let header = (128 << 10) << 3 | 1 << 1 | last;
+        f.extend_from_slice(&header.to_le_bytes()[..3]);
+        f.push(0);
+    }
+    f
+}
+
+fn le_bytes(gids: &[u32]) -> Vec<u8> {
+    gids.iter().flat_map(|g| g.to_le_bytes()).collect()
+}
+
+/// Tile data as CSV, zstd and XML (`<tile/>` for an empty cell).
+fn csv_data(gids: &[u32]) -> String {
+    let v: Vec<String> = gids.iter().map(u32::to_string).collect();
+    v.join(",")
+}
+
+fn xml_tiles(gids: &[u32]) -> String {
+    gids.iter()
+        .map(|&g| match g {
+            0 => "\n   <tile/>".to_owned(),
+            g => format!("\n   <tile gid=\"{g}\"/>"),
+        })
+        .collect()
+}
+
+/// Every tile of layer `L` collides, a kind per tile id (so the level's
+/// grid tells the gids apart).
+fn kinds_opts() -> LoadOptions {
+    use ledge_shared::tilemap::Tile;
+    let mut o = opts();
+    o.collision_layers = Some(vec!["L".into()]);
+    for (id, t) in [
+        (0, Tile::Solid),
+        (1, Tile::OneWay),
+        (2, Tile::Hazard),
+        (3, Tile::Solid),
+    ] {
+        o.tile_kinds.insert(("ledge".into(), id), t);
+    }
+    o
+}
+
+/// A PNG of `w` x `h` grey pixels.
+fn png(w: u32, h: u32) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, w, h);
+    enc.set_color(png::ColorType::Grayscale);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut wr = enc.write_header().unwrap();
+    wr.write_image_data(&vec![128; (w * h) as usize]).unwrap();
+    wr.finish().unwrap();
+    out
+}
+
+/// `text` with the tileset of [`map`] drawn from `t.png` (2 x 2 tiles, in
+/// `dir`), so that the level's art holds every cell.
+fn with_atlas(dir: &Path, text: &str) -> String {
+    std::fs::write(dir.join("t.png"), png(32, 32)).unwrap();
+    text.replace(
+        r#"tilecount="4" columns="2"/>"#,
+        r#"tilecount="4" columns="2"><image source="t.png" width="32" height="32"/></tileset>"#,
+    )
+}
+
+#[track_caller]
+fn same_level(what: &str, got: &ledge_levels::LoadedLevel, want: &ledge_levels::LoadedLevel) {
+    assert_eq!(got.art, want.art, "{what}: art");
+    assert_eq!(
+        format!("{:?}", got.level),
+        format!("{:?}", want.level),
+        "{what}: level"
+    );
+}
+
 #[test]
-fn zstd_and_xml_tile_data_are_refused_with_a_way_out() {
+fn zstd_and_xml_tile_data_load_like_csv() {
     let _s = serial();
-    let body = r#"<layer id="1" name="L" width="2" height="2"><data encoding="base64" compression="zstd">KLUv/SAQgQAAAAAAAA==</data></layer>"#;
-    let e = load_tmx("z.tmx", &map(2, 2, body)).unwrap_err();
+    const H: u32 = 0x8000_0000;
+    const V: u32 = 0x4000_0000;
+    const D: u32 = 0x2000_0000;
+    // A 4 x 3 layer: every tile, every flip bit, empty cells.
+    let gids = [1, 2, 0, 3, 4 | H, 0, 2 | V, 1 | D, 3 | H | V | D, 0, 0, 4];
+    let dir = temp_dir("encodings");
+    let layer = |data: String| {
+        with_atlas(
+            &dir,
+            &map(
+                4,
+                3,
+                &format!(
+                    "<layer id=\"1\" name=\"L\" width=\"4\" height=\"3\">\n  {data}\n </layer>"
+                ),
+            ),
+        )
+    };
+    let o = kinds_opts();
+    let load = |file: &str, text: &str| {
+        let file = dir.join(file).display().to_string();
+        measured(|| tmx::load_str(&file, text, &o)).0
+    };
+    let want = load(
+        "map.tmx",
+        &layer(format!(
+            r#"<data encoding="csv">{}</data>"#,
+            csv_data(&gids)
+        )),
+    )
+    .unwrap();
+    // The flips are in the art (so the comparison sees them).
+    let ledge_levels::art::ArtContent::Tiles(grid) = &want.art.layers[0].content else {
+        panic!("{:?}", want.art.layers)
+    };
+    let c = grid.get(0, 1).unwrap();
+    assert!(
+        (c.tile, c.flip_h, c.flip_v, c.flip_d) == (3, true, false, false),
+        "{c:?}"
+    );
+    let c = grid.get(0, 2).unwrap();
+    assert!(
+        (c.tile, c.flip_h, c.flip_v, c.flip_d) == (2, true, true, true),
+        "{c:?}"
+    );
+    for (what, data) in [
+        (
+            "zstd",
+            format!(
+                "<data encoding=\"base64\" compression=\"zstd\">\n   {}\n  </data>",
+                zstd(&le_bytes(&gids))
+            ),
+        ),
+        (
+            "zstd in CDATA",
+            format!(
+                r#"<data encoding="base64" compression="zstd"><![CDATA[{}]]></data>"#,
+                zstd(&le_bytes(&gids))
+            ),
+        ),
+        (
+            "zstd, two frames",
+            format!(r#"<data encoding="base64" compression="zstd">{}</data>"#, {
+                use base64::Engine;
+                let c = |b: &[u8]| {
+                    ruzstd::encoding::compress_to_vec(
+                        b,
+                        ruzstd::encoding::CompressionLevel::Uncompressed,
+                    )
+                };
+                let bytes = le_bytes(&gids);
+                let mut z = c(&bytes[..20]);
+                z.extend(c(&bytes[20..]));
+                base64::engine::general_purpose::STANDARD.encode(z)
+            }),
+        ),
+        ("xml", format!("<data>{}\n  </data>", xml_tiles(&gids))),
+    ] {
+        let got = load("map.tmx", &layer(data)).unwrap_or_else(|e| panic!("{what}: {e}"));
+        same_level(what, &got, &want);
+    }
+
+    // An infinite map: two 16 x 16 chunks (one left of the origin), each
+    // zstd-compressed, or as <tile> elements.
+    let chunk_gids = |k: u32| -> Vec<u32> {
+        (0..256u32)
+            .map(|i| match (i * 7 + k) % 6 {
+                0 | 1 => 0,
+                n => (n - 1) | [0, H, V, D][(i % 4) as usize],
+            })
+            .collect()
+    };
+    let infinite = |enc: &str, chunk: &dyn Fn(u32) -> String| {
+        let chunks: String = [(-16, 0u32), (0, 1)]
+            .iter()
+            .map(|&(x, k)| {
+                format!(
+                    "\n   <chunk x=\"{x}\" y=\"0\" width=\"16\" height=\"16\">{}</chunk>",
+                    chunk(k)
+                )
+            })
+            .collect();
+        map(
+            4,
+            3,
+            &format!(
+                "<layer id=\"1\" name=\"L\" width=\"32\" height=\"16\">\n  <data{enc}>{chunks}\n  </data>\n </layer>"
+            ),
+        )
+        .replace(r#"infinite="0""#, r#"infinite="1""#)
+    };
+    let want = load(
+        "map.tmx",
+        &infinite(r#" encoding="csv""#, &|k| csv_data(&chunk_gids(k))),
+    )
+    .unwrap();
+    assert!(format!("{:?}", want.level).contains("OneWay"));
+    for (what, text) in [
+        (
+            "infinite zstd",
+            infinite(r#" encoding="base64" compression="zstd""#, &|k| {
+                zstd(&le_bytes(&chunk_gids(k)))
+            }),
+        ),
+        (
+            "infinite xml",
+            infinite("", &|k| format!("{}\n   ", xml_tiles(&chunk_gids(k)))),
+        ),
+    ] {
+        let got = load("map.tmx", &text).unwrap_or_else(|e| panic!("{what}: {e}"));
+        same_level(what, &got, &want);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The `tiled` crate's own test map `assets/tiled_base64_zstandard.tmx`
+/// (saved by Tiled 1.4, compressed by the reference zstd library): its
+/// 100 x 100 layer, and the same layer from `tiled_base64_zlib.tmx`.
+const TILED_ZSTD: &str = "KLUv/WBAm6UFAPgjAAAAIREtLgAAAC8RACMfHy0tLi0tLSMjIyMjIyMjSaBguwAAg0JmtQEFA2qvb+Al6lHUO91VvxpMveegXVabfkkjaEj1wZVZeNWPbSrdISdZk1b145uYEEFAvQmwiF5zTMi2QsOb9Vhv7ZxsK27ZJBXC9lYf2mVdhuqWjb8/hITgZAMw1ctxfXIOXBaofKbranfWDTtJ/Xyz7E2ZNWzVKauthC4r26Ry1TnnDqtmvUfyDw==";
+const TILED_ZLIB: &str = "eJzt1zEKwzAMBVBdIScIJXPS+9+uDY1BuHbpULvLeyDIkEkfIXmLiK2qW6cYb7lqv+p41r1TcpmjZFLPyamVEXOcGSzpu66SixkZb41Xz9dO7fE+O4yR+703KmdyhExGK32v+1zv+rxLZDJO7vO5G3KvSyY1eYxT31Dlrm3t9AhZzNC6a+v3RsmhNzP83qdc8ttdHuO07thWLlt4E87w7S6wM+bo7e3ef8z1KRt5/N+388N88gAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAIHsArPIXTA==";
+
+#[test]
+fn a_zstd_layer_saved_by_tiled_loads() {
+    let _s = serial();
+    let text = |enc: &str, b64: &str| {
+        format!(
+            r##"<?xml version="1.0" encoding="UTF-8"?>
+<map version="1.4" tiledversion="1.4.0" orientation="orthogonal" renderorder="right-down" width="100" height="100" tilewidth="32" tileheight="32" infinite="0" backgroundcolor="#ff00ff" nextlayerid="3" nextobjectid="5">
+ <tileset firstgid="1" name="tilesheet" tilewidth="32" tileheight="32" tilecount="84" columns="14">
+  <image source="tilesheet.png" width="448" height="192"/>
+  <tile id="1">
+   <properties>
+    <property name="a tile property" value="123"/>
+   </properties>
+  </tile>
+ </tileset>
+ <layer id="1" name="L" width="100" height="100">
+  <data encoding="base64" compression="{enc}">
+   {b64}
+  </data>
+ </layer>
+</map>
+"##
+        )
+    };
+    let dir = temp_dir("tiled-zstd");
+    std::fs::write(dir.join("tilesheet.png"), png(448, 192)).unwrap();
+    let file = dir.join("tiled.tmx").display().to_string();
+    let mut o = opts();
+    o.collision_layers = Some(vec!["L".into()]);
+    let zlib = measured(|| tmx::load_str(&file, &text("zlib", TILED_ZLIB), &o))
+        .0
+        .unwrap();
+    let zstd = measured(|| tmx::load_str(&file, &text("zstd", TILED_ZSTD), &o))
+        .0
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    same_level("Tiled's zstd", &zstd, &zlib);
+    // Its first row: 35,35,35,35,35,33,33,33,33,33,33,0,...
+    let ledge_levels::art::ArtContent::Tiles(grid) = &zstd.art.layers[0].content else {
+        panic!("{:?}", zstd.art.layers)
+    };
+    let row: Vec<Option<u32>> = (0..12).map(|x| grid.get(x, 0).map(|c| c.tile)).collect();
+    let (a, b) = (Some(34), Some(32));
+    assert_eq!(row, [a, a, a, a, a, b, b, b, b, b, b, None]);
+}
+
+#[test]
+fn zstd_bombs_stop_at_the_cell_bound_while_decoding() {
+    let _s = serial();
+    use base64::Engine;
+    let b64 = |b: &[u8]| base64::engine::general_purpose::STANDARD.encode(b);
+    // 44 KB of zstd (RLE blocks) that decodes to 1.4 GB.
+    let rle = zstd_rle_zeros(11_200);
+    // The encoder's own output for 64 MiB of zeros.
+    let zeros = zstd(&vec![0u8; 64 << 20]);
+    for (what, data) in [("RLE", b64(&rle)), ("encoder", zeros)] {
+        let body = format!(
+            r#"<layer id="1" name="L" width="2" height="2"><data encoding="base64" compression="zstd">{data}</data></layer>"#
+        );
+        let text = map(2, 2, &body);
+        let t = Instant::now();
+        let (r, peak) = measured(|| tmx::load_str("bomb.tmx", &text, &opts()));
+        let secs = t.elapsed().as_secs_f64();
+        eprintln!(
+            "zstd bomb ({what}, {} bytes of TMX): refused in {secs:.2} s, peak heap {peak} bytes",
+            text.len()
+        );
+        expect_limit(
+            r,
+            "bomb.tmx",
+            "map.layers[0].data",
+            "MAX_LEVEL_CELLS",
+            MAX_LEVEL_CELLS,
+        );
+        assert!(peak < 64 << 20, "peak {peak}");
+        assert!(secs < 10.0, "{secs} s");
+    }
+    // A frame asking for a huge window (a 2 GiB one, then a 1 TiB single
+    // segment) is refused before the decoder reserves it.
+    let mut huge_window = vec![0x28, 0xb5, 0x2f, 0xfd, 0x00, 0xa8];
+    huge_window.extend_from_slice(&[0x01, 0x00, 0x00]);
+    let mut huge_segment = vec![0x28, 0xb5, 0x2f, 0xfd, 0xe0];
+    huge_segment.extend_from_slice(&(1u64 << 40).to_le_bytes());
+    huge_segment.extend_from_slice(&[0x01, 0x00, 0x00]);
+    for frame in [huge_window, huge_segment] {
+        let body = format!(
+            r#"<layer id="1" name="L" width="2" height="2"><data encoding="base64" compression="zstd">{}</data></layer>"#,
+            b64(&frame)
+        );
+        let (r, peak) = measured(|| tmx::load_str("window.tmx", &map(2, 2, &body), &opts()));
+        let e = r.unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            matches!(e, LevelError::Syntax { .. })
+                && msg.starts_with("window.tmx: map.layers[0].data")
+                && msg.contains("cannot decode the tile data"),
+            "{msg}"
+        );
+        assert!(peak < 1 << 20, "peak {peak}: {msg}");
+    }
+}
+
+#[test]
+fn xml_and_zstd_tile_data_are_checked_like_the_others() {
+    let _s = serial();
+    let layer = |data: &str| {
+        map(
+            2,
+            2,
+            &format!(r#"<layer id="1" name="L" width="2" height="2">{data}</layer>"#),
+        )
+    };
+    for (what, data, got) in [
+        (
+            "xml short",
+            "<data><tile/><tile/><tile/></data>".to_owned(),
+            3,
+        ),
+        (
+            "xml long",
+            format!("<data>{}</data>", r#"<tile gid="1"/>"#.repeat(5)),
+            5,
+        ),
+        ("xml empty", "<data/>".to_owned(), 0),
+        (
+            "zstd short",
+            format!(
+                r#"<data encoding="base64" compression="zstd">{}</data>"#,
+                zstd(&[0u8; 12])
+            ),
+            3,
+        ),
+    ] {
+        let e = load_tmx("n.tmx", &layer(&data)).expect_err(what);
+        assert_eq!(
+            e,
+            LevelError::Length {
+                file: "n.tmx".into(),
+                field: "map.layers[0].data".into(),
+                expected: 4,
+                got,
+            },
+            "{what}: {e}"
+        );
+    }
+    let e = load_tmx(
+        "g.tmx",
+        &layer(r#"<data><tile gid="1"/><tile gid="x"/><tile/><tile/></data>"#),
+    )
+    .unwrap_err();
     let msg = e.to_string();
     assert!(
-        msg.starts_with("z.tmx: map.layers[0].data.compression: zstd")
-            && msg.contains("zlib")
-            && msg.contains("gzip"),
+        matches!(e, LevelError::BadValue { .. })
+            && msg.starts_with("g.tmx: map.layers[0].data.tile[1].gid"),
         "{msg}"
     );
-    let body = r#"<layer id="1" name="L" width="2" height="2"><data><tile gid="1"/><tile/><tile/><tile/></data></layer>"#;
-    let msg = load_tmx("x.tmx", &map(2, 2, body)).unwrap_err().to_string();
+    let e = load_tmx(
+        "z.tmx",
+        &layer(r#"<data encoding="base64" compression="zstd">AAAA</data>"#),
+    )
+    .unwrap_err();
+    let msg = e.to_string();
     assert!(
-        msg.starts_with("x.tmx: map.layers[0].data.encoding:") && msg.contains("CSV"),
+        msg.starts_with("z.tmx: map.layers[0].data: ")
+            && msg.contains("cannot decode the tile data"),
         "{msg}"
+    );
+    // XML data is one element per cell: the element bound holds.
+    let body = format!(
+        r#"<layer id="1" name="L" width="1024" height="1025"><data>{}</data></layer>"#,
+        "<tile/>".repeat(1024 * 1025)
+    );
+    let (r, peak) = measured(|| tmx::load_str("xml.tmx", &map(1024, 1025, &body), &opts()));
+    expect_limit(
+        r,
+        "xml.tmx",
+        "map.layers[0].data.tile",
+        "MAX_ELEMENTS",
+        MAX_ELEMENTS,
+    );
+    assert!(peak < 32 << 20, "peak {peak}");
+}
+
+#[test]
+fn ogmo_padded_rows_count_towards_the_cell_bound() {
+    let _s = serial();
+    let opts = opts();
+    let layer = |i: usize, side: usize| {
+        format!(
+            r#"{{"name": "t{i}", "gridCellWidth": 16, "gridCellHeight": 16, "gridCellsX": {side}, "gridCellsY": {side}, "tileset": "t", "data2D": [{}]}}"#,
+            vec!["[]"; side].join(",")
+        )
+    };
+    let level = |layers: Vec<String>| {
+        format!(
+            r#"{{"width": 64, "height": 64, "layers": [{}]}}"#,
+            layers.join(",")
+        )
+    };
+    // The bomb: 1000 layers of 4096 empty rows (16 Mi cells each) from
+    // 4 Mi JSON values; refused at the first, before allocating it.
+    let text = level((0..1000).map(|i| layer(i, 4096)).collect());
+    let (r, peak) = measured(|| ogmo::load_str("pad.json", &text, None, &opts));
+    let msg = expect_limit(
+        r,
+        "pad.json",
+        "layers[0].data2D",
+        "MAX_LEVEL_CELLS",
+        MAX_LEVEL_CELLS,
+    );
+    // As docs/LEVELS.md shows it.
+    assert_eq!(
+        msg,
+        "pad.json: layers[0].data2D: 16777216 tile and grid cells in all layers is more than the limit of 4194304 (MAX_LEVEL_CELLS)"
+    );
+    eprintln!(
+        "OGMO padding bomb ({} bytes): peak heap {peak} bytes",
+        text.len()
+    );
+    // The bound is on the document's total: four 1024 x 1024 layers fit,
+    // the fifth does not.
+    let text = level((0..5).map(|i| layer(i, 1024)).collect());
+    let (r, _) = measured(|| ogmo::load_str("pad.json", &text, None, &opts));
+    expect_limit(
+        r,
+        "pad.json",
+        "layers[4].data2D",
+        "MAX_LEVEL_CELLS",
+        MAX_LEVEL_CELLS,
     );
 }
 
