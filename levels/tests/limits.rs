@@ -1160,3 +1160,54 @@ fn text_beyond_the_file_size_bound_is_refused() {
         ledge_levels::MAX_FILE_BYTES,
     );
 }
+
+/// Loads `text` as `file`, returning the level and the extra peak heap
+/// (not bounded: a level of the most cells peaks at hundreds of MiB in the
+/// Tiled reader and the importer).
+fn load_peak(file: &str, text: &str, o: &LoadOptions) -> (ledge_levels::LoadedLevel, usize) {
+    let base = CURRENT.load(Ordering::SeqCst);
+    PEAK.store(base, Ordering::SeqCst);
+    let l = tmx::load_str(file, text, o).unwrap();
+    (l, PEAK.load(Ordering::SeqCst).saturating_sub(base))
+}
+
+#[test]
+fn a_zstd_layer_of_the_most_cells_loads_with_no_extra_peak() {
+    let _s = serial();
+    // 2048 x 2048 = MAX_LEVEL_CELLS cells, every tile and flip.
+    let gids: Vec<u32> = (0..MAX_LEVEL_CELLS as u32)
+        .map(|i| match i % 7 {
+            0..=2 => 0,
+            n => (n - 2) | (i % 8) << 29,
+        })
+        .collect();
+    let mut o = opts();
+    o.collision_layers = Some(vec!["L".into()]);
+    let dir = temp_dir("most");
+    let file = dir.join("big.tmx").display().to_string();
+    let text = |enc: &str, b64: String| {
+        let body = format!(
+            r#"<layer id="1" name="L" width="2048" height="2048"><data encoding="base64" compression="{enc}">{b64}</data></layer>"#
+        );
+        with_atlas(&dir, &map(2048, 2048, &body))
+    };
+    let bytes = le_bytes(&gids);
+    let (zlib_text, zstd_text) = (text("zlib", zlib(&bytes)), text("zstd", zstd(&bytes)));
+    drop((gids, bytes));
+    let (want, zlib_peak) = load_peak(&file, &zlib_text, &o);
+    drop(want.art);
+    let t = Instant::now();
+    let (got, zstd_peak) = load_peak(&file, &zstd_text, &o);
+    let secs = t.elapsed().as_secs_f64();
+    eprintln!(
+        "2048 x 2048 zstd layer ({} bytes of TMX): loaded in {secs:.2} s, peak heap {zstd_peak} bytes (zlib: {zlib_peak})",
+        zstd_text.len()
+    );
+    assert!(got.level == want.level);
+    // The CSV rewrite is not what the peak is made of.
+    assert!(
+        zstd_peak <= zlib_peak + (32 << 20),
+        "{zstd_peak} vs {zlib_peak}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
