@@ -154,14 +154,15 @@ fn unknown_layer_kinds() {
     );
     let msg = check(r, "l.json", "layers[0]: unknown layer kind \"hologram\"");
     assert!(!msg.is_empty());
-    // Tiled: an infinite tile layer (refused as a map first).
-    let file = format!("{TILED_DIR}/infinite.tmx");
+    // Tiled: a map that is not orthogonal.
+    let file = format!("{TILED_DIR}/iso.tmx");
     let r = tmx::load_str(
         &file,
-        r#"<map version="1.10" orientation="orthogonal" width="4" height="4" tilewidth="16" tileheight="16" infinite="1"></map>"#,
+        r#"<map version="1.10" orientation="isometric" width="4" height="4" tilewidth="16" tileheight="16" infinite="0"></map>"#,
         &LoadOptions::default(),
     );
-    check(r, &file, "map.infinite");
+    let msg = check(r, &file, "map.orientation");
+    assert!(msg.contains("Isometric maps are not supported"), "{msg}");
 }
 
 #[test]

@@ -4,7 +4,7 @@
 mod platformer_kit;
 
 use glam::IVec2;
-use ledge_shared::game::{EntityType, GameEvent, HurtCause, ENTITY_ID_BASE};
+use ledge_shared::game::{EntityType, GameEvent, HurtCause, ENTITY_ID_BASE, FALL_MARGIN};
 use ledge_shared::level::{EntityDef, EntityKind, Level};
 use ledge_shared::protocol::PlayerId;
 use platformer_kit::*;
@@ -361,4 +361,47 @@ fn reaching_the_goal_raises_the_win_event_once() {
     assert_eq!(wins, 1);
     assert!(s.view().won);
     assert_eq!(s.game.entities().next().unwrap().ty, EntityType::Goal);
+}
+
+#[test]
+fn a_player_who_falls_out_of_the_level_respawns() {
+    // A ledge with nothing below or beside it: walk off its right end.
+    let lv = level(
+        &["..........", "..........", "######....", ".........."],
+        vec![ent(EntityKind::PlayerSpawn, 1, 1)],
+    );
+    let (_, hi) = lv.bounds().unwrap();
+    assert_eq!(hi, IVec2::new(10 * T, 4 * T));
+    let mut s = Sim::new(&lv);
+    s.land(5);
+    let spawn = s.pos();
+    let mut lowest = i32::MIN;
+    for t in 0..2000 {
+        s.step(RIGHT);
+        if s.saw(|e| matches!(e, GameEvent::Hurt { .. })) {
+            assert_eq!(
+                s.events,
+                vec![
+                    GameEvent::Hurt {
+                        player: P1,
+                        cause: HurtCause::Fell
+                    },
+                    GameEvent::Respawned {
+                        player: P1,
+                        pos: spawn
+                    }
+                ],
+                "tick {t}"
+            );
+            // Not before its top passed the margin below the level: the
+            // tick before, its top (8 px above its centre) was still above
+            // the line, and less than one fall step (32 px) from it.
+            let line = hi.y + FALL_MARGIN;
+            let top = lowest - 8 * 256;
+            assert!(top <= line && top > line - 32 * 256, "{top} vs {line}");
+            return;
+        }
+        lowest = lowest.max(s.pos().y);
+    }
+    panic!("never fell out, at {}", s.pos());
 }

@@ -108,7 +108,13 @@ pub enum HurtCause {
     HazardTile,
     /// A hazard volume (entity id).
     Hazard(u32),
+    /// Fell out of the level: [`FALL_MARGIN`] below everything in it.
+    Fell,
 }
+
+/// How far below the lowest thing in a level ([`Level::bounds`]) a player
+/// falls before it respawns: 16 tiles of 16 px, in units.
+pub const FALL_MARGIN: i32 = 256 * crate::fixed::UNITS_PER_PX;
 
 /// Something that happened in a tick, for the server, the HUD and tests.
 /// Entity ids are [`ENTITY_ID_BASE`] plus the entity's index in the level.
@@ -324,6 +330,9 @@ pub struct Game {
     tile_scratch: Vec<crate::tilemap::TileContact>,
     /// The polygon blocks, for the slope rules (`polygon_ground`).
     polygons: Vec<polygon_ground::PolygonSolid>,
+    /// A player whose top passes below this y (units) fell out of the
+    /// level ([`HurtCause::Fell`]); derived from the level.
+    fall_y: i32,
 }
 
 impl Game {
@@ -368,6 +377,9 @@ impl Game {
             in_hazard_tile: Vec::new(),
             tile_scratch: Vec::new(),
             polygons: Vec::new(),
+            fall_y: level
+                .bounds()
+                .map_or(i32::MAX, |(_, hi)| hi.y.saturating_add(FALL_MARGIN)),
         };
         for (i, def) in level.entities.iter().enumerate() {
             let half = def.size / 2;

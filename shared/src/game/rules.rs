@@ -333,6 +333,8 @@ impl Game {
         }
         let hazard = if self.in_hazard_tile.contains(&p.body.0) {
             Some(HurtCause::HazardTile)
+        } else if pos.y - cfg.half.y > self.fall_y {
+            Some(HurtCause::Fell)
         } else {
             let r = Rect::new(pos, cfg.half);
             self.hazards

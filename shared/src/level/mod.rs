@@ -70,6 +70,41 @@ pub struct LevelFeatures {
 }
 
 impl Level {
+    /// The box holding everything in the level (units, `(top-left,
+    /// bottom-right)`): the tile grid and every entity's box, moving
+    /// platforms over their whole path. `None` for a level with nothing in
+    /// it. What the camera stays inside, and what a falling player falls
+    /// out of.
+    pub fn bounds(&self) -> Option<(IVec2, IVec2)> {
+        let mut b: Option<(IVec2, IVec2)> = None;
+        let mut add = |lo: IVec2, hi: IVec2| {
+            b = Some(match b {
+                None => (lo, hi),
+                Some((a, c)) => (a.min(lo), c.max(hi)),
+            });
+        };
+        let m = &self.tilemap;
+        if m.width() > 0 && m.height() > 0 {
+            let size = IVec2::new(m.width() as i32, m.height() as i32) * m.tile_size();
+            add(m.origin(), m.origin() + size);
+        }
+        for e in &self.entities {
+            let half = e.size / 2;
+            add(e.pos - half, e.pos + half);
+            if let EntityKind::MovingPlatform { motion, .. } = &e.kind {
+                for &n in &motion.path {
+                    add(n - half, n + half);
+                }
+            }
+            if let EntityKind::PolygonBlock { vertices } = &e.kind {
+                for &v in vertices {
+                    add(e.pos + v, e.pos + v);
+                }
+            }
+        }
+        b
+    }
+
     /// Which features the level uses.
     pub fn features(&self) -> LevelFeatures {
         let mut f = LevelFeatures::default();

@@ -70,6 +70,12 @@ impl ArtView {
             .map(|[r, g, b, a]| Color::from_rgba(r, g, b, a))
     }
 
+    /// Whether the level has no art to draw (ledge then draws its static
+    /// blocks and polygons itself).
+    pub fn is_empty(&self) -> bool {
+        self.art.layers.is_empty()
+    }
+
     /// The art's extent (world pixels from the origin), if any.
     pub fn extent(&self) -> Option<Rect> {
         let (w, h) = self.art.size;

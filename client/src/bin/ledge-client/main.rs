@@ -353,16 +353,18 @@ async fn game(mut setup: Setup) {
 
         // What to draw, and from where.
         let level = setup.play.level();
+        // The camera stays inside everything in the level (grid, entities,
+        // platform paths) and everything its art draws.
         let level_px = {
-            let map = &level.tilemap;
-            let o = px2(map.origin());
-            let t = map.tile_size() as f32 / UNITS_PER_PX as f32;
-            let grid = Rect::new(o.x, o.y, map.width() as f32 * t, map.height() as f32 * t);
-            // A map drawn beyond its collision grid (or without one).
-            match art.extent() {
-                Some(e) if grid.w <= 0.0 || grid.h <= 0.0 => e,
-                Some(e) => grid.combine_with(e),
-                None => grid,
+            let things = level.bounds().map(|(lo, hi)| {
+                let (lo, hi) = (px2(lo), px2(hi));
+                Rect::new(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y)
+            });
+            match (things, art.extent()) {
+                (Some(a), Some(e)) => a.combine_with(e),
+                (Some(a), None) => a,
+                (None, Some(e)) => e,
+                (None, None) => Rect::new(0.0, 0.0, 1.0, 1.0),
             }
         };
         let frame_view = setup.play.view().unwrap_or_default();
@@ -389,12 +391,17 @@ async fn game(mut setup: Setup) {
         }
         art.draw(&view);
         render::draw_tilemap(&level.tilemap, &view, art.covered());
-        render::draw_polygon_blocks(level, &view);
+        // A level's own art draws its solids; ledge draws them otherwise.
+        let statics = art.is_empty();
+        if statics {
+            render::draw_polygon_blocks(level, &view);
+        }
         render::draw_entities(
             &entities,
             &view,
             me.as_ref().and_then(|m| m.checkpoint),
             time,
+            statics,
         );
         // Remote players wear their names (from the server's roster).
         let labels: Vec<String> = remotes

@@ -378,8 +378,16 @@ fn spikes(view: &View, area: Rect) {
 }
 
 /// Draws the level's entities. `checkpoint`: the local player's respawn
-/// checkpoint (drawn raised); `time`: seconds, for small animations.
-pub fn draw_entities(entities: &[EntitySprite], view: &View, checkpoint: Option<u32>, time: f32) {
+/// checkpoint (drawn raised); `time`: seconds, for small animations;
+/// `statics`: draw static blocks too (not when the level's own art draws
+/// them).
+pub fn draw_entities(
+    entities: &[EntitySprite],
+    view: &View,
+    checkpoint: Option<u32>,
+    time: f32,
+    statics: bool,
+) {
     let seen = view.visible();
     for e in entities {
         let tl = e.top_left();
@@ -391,7 +399,8 @@ pub fn draw_entities(entities: &[EntitySprite], view: &View, checkpoint: Option<
         }
         match e.kind {
             EntityType::Spawn => {}
-            EntityType::Block => crate_box(view, area),
+            EntityType::Block if statics => crate_box(view, area),
+            EntityType::Block => {}
             // Drawn from the level's vertices by `draw_polygon_blocks`.
             EntityType::PolygonBlock => {}
             EntityType::Platform if e.one_way => {
