@@ -464,7 +464,7 @@ fn tilemap_error(file: &str, field: &str, e: TilemapError) -> LevelError {
             file: file.into(),
             field: format!("{field} (cell size)"),
             message: format!(
-                "cell size {} px is not a power of two number of pixels",
+                "cell size {} px is not a tile size (whole pixels, at least 1 px)",
                 value as f64 / UNITS_PER_PX as f64
             ),
         },

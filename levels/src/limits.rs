@@ -2,19 +2,19 @@
 //! allocated for it.
 //!
 //! * Tiled: every TMX, TSX and template (`.tx`) document is scanned with a
-//!   streaming XML reader ([`check_tmx_resource`]) before the `tiled` crate
+//!   streaming XML reader (`check_tmx_resource`) before the `tiled` crate
 //!   sees it: nesting depth, counts (layers, tilesets, tiles, objects,
 //!   points, properties, elements, attributes), sizes (attributes, text,
 //!   images) and every tile layer's `<data>`, decoded and inflated with the
 //!   output bound enforced while inflating, whose cell count must be exactly
 //!   the layer's (or chunk's) width x height. Totals are kept across the
-//!   documents of one load ([`Budget`]). Old files that lack attributes the
+//!   documents of one load (`Budget`). Old files that lack attributes the
 //!   `tiled` crate requires (`tilecount`, `columns`, an image's `width` and
 //!   `height`) are patched when the value can be derived. Tile data the
 //!   `tiled` crate cannot read as built here (zstd-compressed base64, and the
 //!   oldest format, one `<tile gid=".."/>` element per cell) is decoded here,
 //!   under the same bounds, and handed to it rewritten as CSV.
-//! * OGMO: the JSON text is scanned ([`check_json`]) for its nesting depth
+//! * OGMO: the JSON text is scanned (`check_json`) for its nesting depth
 //!   and its number of values before `serde_json` builds a tree of it.
 //!
 //! Every refusal is a [`LevelError`] naming the file, the element path (like

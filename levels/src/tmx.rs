@@ -1,28 +1,28 @@
 //! Tiled maps (`.tmx`, with embedded or external `.tsx` tilesets), read
-//! with the `tiled` crate.
+//! with the `tiled` crate after the bounded pre-scan of [`crate::limits`].
 //!
-//! * The map must be orthogonal and finite, with square tiles of a power of
-//!   two pixels, at most [`MAX_LEVEL_TILES`] per side.
-//! * **Tile layers** (also inside group layers) are collision layers, not
-//!   offset. A tile's kind is its tileset tile's `kind` property
-//!   ([`parse_tile_kind`]: `solid`, `one_way`, `hazard`, `slope_45_right`,
-//!   ...) or else the [`super::TileMapping`] table of its tileset's name. A
-//!   horizontally flipped slope is mirrored; a vertically or diagonally
-//!   flipped slope is an error.
-//! * **Object layers**: each object's class (Tiled 1.9+; `type` before) or,
-//!   when empty, its name goes through the entity table
-//!   ([`super::ENTITY_NAMES`]); custom properties are the parameters.
+//! * The map must be orthogonal, with square tiles of 1 to 4096 px, at most
+//!   [`MAX_LEVEL_TILES`] per side; an infinite map's grid spans the chunks
+//!   holding tiles.
+//! * **Tile layers** (also inside group layers; hidden ones never) collide
+//!   by the map's own data (the `collision` module): the settings' tile kinds,
+//!   tile properties and classes, tile collision outlines (full squares and
+//!   slopes become tiles, anything else static geometry), layer properties
+//!   and classes; a map with no collision data at all collides its
+//!   collision-named layers (else every visible one), and says so.
+//! * **Object layers**: each object's class (Tiled 1.9+; `type` before) or
+//!   its name goes through the entity table ([`super::ENTITY_NAMES`]) and
+//!   the settings' aliases; custom properties are the parameters.
 //!   Rectangles, ellipses and tile objects use their bounds; a point object
-//!   is a box of one tile centred on it. A polygon object (not a path) is a
-//!   convex polygon solid ([`super::EntityKind::PolygonBlock`], its points
-//!   rotated by the object's rotation): its name must be a block or polygon
-//!   name, or empty. A moving platform's `path`
-//!   property (type object) names a polyline or polygon object whose points
-//!   are the centres the platform passes through (a polygon loops unless
-//!   `loop` says otherwise); those path objects are not entities, and a
-//!   polyline that is not a path is an error. Layer and group offsets shift
-//!   objects.
-//! * Image layers are ignored.
+//!   is a box of one tile centred on it. A polygon entity is a convex
+//!   polygon solid ([`super::EntityKind::PolygonBlock`], rotated by the
+//!   object's rotation). Objects that are no entity are solid geometry when
+//!   marked solid or unnamed shapes, hazards when marked so, else skipped
+//!   with a warning. A moving platform's `path` property (type object) names
+//!   a polyline or polygon object whose points are the centres the platform
+//!   passes through (a polygon loops unless `loop` says otherwise); those
+//!   path objects are not entities. Layer and group offsets shift objects.
+//! * Image layers are art only ([`crate::art`]).
 
 use std::cell::RefCell;
 use std::collections::{BTreeMap, BTreeSet};
