@@ -551,6 +551,19 @@ fn crosses_itself(p: &[(f64, f64)]) -> bool {
     false
 }
 
+/// The line from `a` to `b` as a quad `thickness` pixels thick on its
+/// right-hand side on screen (below a line drawn left to right); `None`
+/// for a zero-length line.
+pub(crate) fn thick_line(a: (f64, f64), b: (f64, f64), thickness: f64) -> Option<Outline> {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let len = (dx * dx + dy * dy).sqrt();
+    if len < 1e-9 {
+        return None;
+    }
+    let n = (-dy / len * thickness, dx / len * thickness);
+    Some(vec![a, b, (b.0 + n.0, b.1 + n.1), (a.0 + n.0, a.1 + n.1)])
+}
+
 /// An ellipse inside the box `(x, y, w, h)` as an outline of 8 points (the
 /// regular octagon's corners on the ellipse): what ledge collides with for
 /// an ellipse shape.
@@ -615,6 +628,16 @@ mod tests {
             classify_outlines(vec![half.clone()], 16.0),
             TileShape::Geometry(vec![half])
         );
+    }
+
+    #[test]
+    fn thick_lines_lie_below_lines_drawn_left_to_right() {
+        let q = thick_line((0.0, 0.0), (10.0, 0.0), 2.0).unwrap();
+        assert_eq!(q, vec![(0.0, 0.0), (10.0, 0.0), (10.0, 2.0), (0.0, 2.0)]);
+        assert!(is_convex(&q));
+        let q = thick_line((0.0, 0.0), (0.0, 10.0), 2.0).unwrap();
+        assert_eq!(q[2], (-2.0, 10.0));
+        assert!(thick_line((1.0, 1.0), (1.0, 1.0), 2.0).is_none());
     }
 
     #[test]

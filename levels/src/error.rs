@@ -162,7 +162,7 @@ pub enum LevelError {
         bound: &'static str,
     },
     /// No entity is a player spawn.
-    #[error("{file}: {field}: no player spawn, and no free spot to stand on for one (add an entity named \"player\" or \"spawn\")")]
+    #[error("{file}: {field}: no player spawn, and nothing in the level to place one on (add an entity named \"player\" or \"spawn\")")]
     MissingSpawn {
         /// The file.
         file: String,

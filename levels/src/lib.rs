@@ -441,15 +441,24 @@ pub(crate) fn assemble(
             .any(|e| e.kind == EntityKind::PlayerSpawn)
     {
         let player = ledge_shared::game::PlayerConfig::default();
-        let Some(spawn) = spawn::find(&out.level, &player) else {
-            return Err(LevelError::MissingSpawn {
-                file: file.into(),
-                field: "entities".into(),
-            });
-        };
         let px = |u: i32| u as f64 / UNITS_PER_PX as f64;
+        let (spawn, where_) = match spawn::find(&out.level, &player) {
+            Some(s) => (s, "the first free standing spot from the left"),
+            None => match spawn::above(&out.level, &player) {
+                Some(s) => (
+                    s,
+                    "on top of the level at its left edge: there is no free spot to stand on inside it",
+                ),
+                None => {
+                    return Err(LevelError::MissingSpawn {
+                        file: file.into(),
+                        field: "entities".into(),
+                    })
+                }
+            },
+        };
         out.warnings.push(format!(
-            "{file}: no player spawn: players start at ({}, {}) px, the first free standing spot from the left (add an object or entity named \"player\" or \"spawn\" to choose)",
+            "{file}: no player spawn: players start at ({}, {}) px, {where_} (add an object or entity named \"player\" or \"spawn\" to choose)",
             px(spawn.pos.x),
             px(spawn.pos.y + spawn.size.y / 2)
         ));

@@ -23,6 +23,19 @@ enum Cell {
     Hazard,
 }
 
+/// A spawn for `level` when [`find`] finds no free standing spot: standing
+/// on top of everything in the level, at its left edge (the player lands on
+/// whatever is below). `None` for a level with nothing in it.
+pub(crate) fn above(level: &Level, player: &PlayerConfig) -> Option<EntityDef> {
+    let (lo, _) = level.bounds()?;
+    let half = player.half.max(IVec2::ONE);
+    Some(EntityDef {
+        kind: EntityKind::PlayerSpawn,
+        pos: IVec2::new(lo.x.saturating_add(half.x), lo.y.saturating_sub(half.y)),
+        size: half * 2,
+    })
+}
+
 /// A spawn for `level` on the first spot (leftmost column, then topmost)
 /// where a player of `player` size stands on a solid or one-way floor with
 /// room above and no hazard; `None` when there is no such spot.

@@ -882,7 +882,10 @@ impl Conv<'_> {
                     && tile.is_none()
                     && matches!(
                         o.shape,
-                        ObjectShape::Rect { .. } | ObjectShape::Ellipse { .. }
+                        ObjectShape::Rect { .. }
+                            | ObjectShape::Ellipse { .. }
+                            | ObjectShape::Polygon { .. }
+                            | ObjectShape::Polyline { .. }
                     );
                 match said {
                     Some(Tile::Solid) | Some(Tile::Slope(_)) => {}
@@ -907,11 +910,16 @@ impl Conv<'_> {
                     }
                     Some(Tile::Empty) => continue,
                     None if name.trim().is_empty() => {
-                        // Decoration (tile objects), markers (points),
-                        // labels (text): nothing to collide with.
-                        if !matches!(o.shape, ObjectShape::Polygon { .. }) {
-                            continue;
+                        // Decoration (tile objects, drawn), markers
+                        // (points), labels (text): nothing to collide
+                        // with; said for the ones that are not drawn.
+                        if tile.is_none() {
+                            self.notes.borrow_mut().add(
+                                "unnamed points, text and capsules are markers and labels: not used (name a point \"spawn\", \"coin\", ... to make it an entity)".into(),
+                                at,
+                            );
                         }
+                        continue;
                     }
                     None => {
                         if !self.options.skip_unknown_entities {
@@ -1096,6 +1104,27 @@ impl Conv<'_> {
                 let e = collision::ellipse_outline(0.0, 0.0, *width as f64, *height as f64);
                 vec![collision::rotate_about(&e, (x, y), r)]
             }
+            (ObjectShape::Polyline { points }, _) => {
+                // A chain of solid lines: each leg a quad 2 px thick on its
+                // right-hand side (below a line drawn left to right, as
+                // Box2D chains are drawn over the ground).
+                if points.len() > super::MAX_PATH_NODES {
+                    return Err(LevelError::BadPolygon {
+                        file: self.file.into(),
+                        field: format!("{f}.polyline"),
+                        message: format!(
+                            "polyline has {} points; at most {} are read",
+                            points.len(),
+                            super::MAX_PATH_NODES
+                        ),
+                    });
+                }
+                let pts: Vec<_> = points.iter().map(|&(a, b)| (a as f64, b as f64)).collect();
+                let abs = collision::rotate_about(&pts, (x, y), r);
+                abs.windows(2)
+                    .filter_map(|w| collision::thick_line(w[0], w[1], POLYLINE_THICKNESS))
+                    .collect()
+            }
             (ObjectShape::Polygon { points }, _) => {
                 if points.len() > super::MAX_PATH_NODES {
                     return Err(LevelError::BadPolygon {
@@ -1174,6 +1203,9 @@ impl Conv<'_> {
         Ok(out)
     }
 }
+
+/// How thick a solid polyline's legs are, in pixels.
+const POLYLINE_THICKNESS: f64 = 2.0;
 
 /// Deepest nesting of group layers.
 const MAX_GROUP_DEPTH: usize = 64;

@@ -384,20 +384,15 @@ fn unknown_tiles() {
 
 #[test]
 fn unknown_entities_name_file_layer_and_entity() {
-    // uno.json (a format sample, not a game) has nothing to stand on but
-    // a 2 x 2 corner of grid value "3" (hazard): refused for want of a
-    // spawn. Without that requirement it loads, and says what it did not
-    // use: its tile layers (a foreign tileset), the grid layer that does
-    // not line up, the unknown entity "Dude".
-    let e = load_file_with(UNO, &LoadOptions::default()).unwrap_err();
-    assert!(matches!(e, LevelError::MissingSpawn { .. }), "{e}");
-    let lenient = LoadOptions {
-        require_spawn: false,
-        ..LoadOptions::default()
-    };
-    let l = load_file_with(UNO, &lenient).unwrap();
+    // uno.json (a format sample, not a game) loads, and says what it did
+    // not use: its tile layers (a foreign tileset), the grid layer that
+    // does not line up, the unknown entity "Dude"; it has nothing to stand
+    // on but a 2 x 2 corner of grid value "3" (hazard), so its spawn is
+    // placed on top.
+    let l = load_file_with(UNO, &LoadOptions::default()).unwrap();
     let all = l.warnings.join("\n");
     for needle in [
+        "on top of the level at its left edge",
         "tile layer \"tile_1D\" does not collide",
         "layers[5]: this collision layer of 40 x 30 cells of 8 x 8 px",
         "skipped unknown entity \"Dude\" in layer \"entity_layer\"",
@@ -520,10 +515,24 @@ fn degenerate_platform_paths() {
 
 #[test]
 fn missing_spawn() {
-    let e = load(&level(TILES, "")).unwrap_err();
+    // Nothing in the level at all: nowhere to place one.
+    let e = load(r#"{"layers": []}"#).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "levels/test.json: entities: no player spawn, and no free spot to stand on for one (add an entity named \"player\" or \"spawn\")"
+        "levels/test.json: entities: no player spawn, and nothing in the level to place one on (add an entity named \"player\" or \"spawn\")"
+    );
+    // No free spot to stand on inside (the floor row is at the top): on
+    // top of the level at its left edge, and said.
+    let l = load(&level(TILES, "")).unwrap();
+    let spawn = l.level.entities.last().unwrap();
+    assert_eq!(spawn.kind, EntityKind::PlayerSpawn);
+    assert_eq!(spawn.pos.y + spawn.size.y / 2, 0);
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.contains("on top of the level at its left edge")),
+        "{:?}",
+        l.warnings
     );
     // With a floor and room above it, one is placed on the first free
     // spot from the left, and said.

@@ -167,15 +167,21 @@ fn entity_aliases_speed_units_and_unknown_entities() {
 #[test]
 fn require_spawn() {
     let dir = tempfile::tempdir().unwrap();
-    // No spawn, and every visible tile solid with no room to stand: refused
-    // by default, loaded when the settings say a spawn is not required.
+    // No spawn, and every visible tile solid with no room to stand: one is
+    // placed on top by default, none when the settings say a spawn is not
+    // required.
     let map = write_map(dir.path(), "");
     let full = std::fs::read_to_string(&map)
         .unwrap()
         .replace("0,0,0,0,\n0,0,0,0,\n2,2,3,2", "2,2,2,2,\n2,2,2,2,\n2,2,2,2");
     std::fs::write(&map, full).unwrap();
-    let e = with_settings(&map, "").unwrap_err();
-    assert!(matches!(e, LevelError::MissingSpawn { .. }), "{e}");
+    let l = with_settings(&map, "").unwrap();
+    assert_eq!(l.level.entities.len(), 1);
+    assert!(
+        l.warnings.iter().any(|w| w.contains("on top of the level")),
+        "{:?}",
+        l.warnings
+    );
     let l = with_settings(&map, "require_spawn = false\n").unwrap();
     assert!(l.level.entities.is_empty());
 }

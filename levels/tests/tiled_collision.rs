@@ -273,3 +273,36 @@ fn infinite_maps_take_the_chunks_extent() {
     assert_eq!(m.tile(IVec2::new(15, 15)), Tile::Solid);
     assert_eq!(m.tiles().iter().filter(|t| **t != Tile::Empty).count(), 2);
 }
+
+#[test]
+fn unnamed_shapes_are_solid_and_markers_are_said() {
+    // An unnamed polyline (a chain over the ground, drawn left to right),
+    // an unnamed ellipse, and an unnamed point.
+    let objects = r#"<object id="2" x="0" y="32"><polyline points="0,0 32,0 48,-16"/></object>
+  <object id="3" x="64" y="0" width="16" height="16"><ellipse/></object>
+  <object id="4" x="100" y="10"><point/></object>"#;
+    let text = map(8, 4, &[], &[("Ground", "", csv(&[0; 32]))], None).replace(
+        "</objectgroup>\n</map>",
+        &format!("{objects}</objectgroup>\n</map>"),
+    );
+    let l = load(&text);
+    let s = solids(&l);
+    // Two legs, each a quad 2 px thick below the line; the ellipse an
+    // octagon (one convex polygon of 8 points).
+    assert_eq!(s.len(), 3, "{s:?}");
+    let p = |x: i32, y: i32| IVec2::new(x, y) * PX;
+    assert!(
+        s.contains(&vec![p(0, 32), p(0, 34), p(32, 32), p(32, 34)]),
+        "{s:?}"
+    );
+    assert!(s.iter().any(|v| v.len() == 8
+        && v.iter()
+            .all(|q| (64 * PX..=80 * PX).contains(&q.x) && (0..=16 * PX).contains(&q.y))));
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.contains("object 4") && w.contains("markers and labels")),
+        "{:?}",
+        l.warnings
+    );
+}
