@@ -132,6 +132,12 @@ pub(crate) fn is_polygon_name(name: &str) -> bool {
     matches!(class_of(name), Some(Class::Polygon))
 }
 
+/// Whether `name` is a block name of [`ENTITY_NAMES`] (`block`, `solid`,
+/// `crate`).
+pub(crate) fn is_block_name(name: &str) -> bool {
+    matches!(class_of(name), Some(Class::Block))
+}
+
 /// Whether `name` is in the entity table ([`ENTITY_NAMES`]).
 pub(crate) fn is_entity_name(name: &str) -> bool {
     class_of(name).is_some()

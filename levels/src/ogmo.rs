@@ -825,6 +825,45 @@ fn parse_entity(
     };
     let (left, top) = corner(x, y, f)?;
     let (centre, size) = place_box(cx.file, f, left, top, w, h)?;
+    // OGMO turns an entity about its origin. A block turns into a polygon
+    // block of its outline; the other entities are upright boxes.
+    let rotation = cx.opt_num(o, "rotation", f)?.unwrap_or(0.0);
+    let mut polygon = None;
+    if rotation.is_finite() && rotation % 360.0 != 0.0 {
+        if crate::entities::is_block_name(&name) {
+            let corners = [
+                (-origin_x, -origin_y),
+                (w - origin_x, -origin_y),
+                (w - origin_x, h - origin_y),
+                (-origin_x, h - origin_y),
+            ];
+            let pf = join(f, "rotation");
+            let mut poly = PlacedPolygon {
+                field: pf.clone(),
+                points: Vec::with_capacity(4),
+                point_fields: Vec::with_capacity(4),
+            };
+            for (i, (px, py)) in crate::collision::rotate_about(&corners, (x, y), rotation)
+                .into_iter()
+                .enumerate()
+            {
+                let cf = format!("{pf} (corner {i})");
+                let ux = layer.origin.x as i64 + px_to_units(cx.file, &join(&cf, "x"), px)?;
+                let uy = layer.origin.y as i64 + px_to_units(cx.file, &join(&cf, "y"), py)?;
+                check_coord_field(cx.file, &join(&cf, "x"), ux)?;
+                check_coord_field(cx.file, &join(&cf, "y"), uy)?;
+                poly.points.push(IVec2::new(ux as i32, uy as i32));
+                poly.point_fields.push(cf);
+            }
+            polygon = Some(poly);
+        } else {
+            cx.warnings.borrow_mut().push(format!(
+                "{}: {}: entity {name:?} is turned by {rotation} degrees: only blocks turn in ledge; it stands upright",
+                cx.file,
+                join(f, "rotation")
+            ));
+        }
+    }
     let mut nodes = Vec::new();
     if let Some(v) = o.get("nodes") {
         let nf = join(f, "nodes");
@@ -844,7 +883,7 @@ fn parse_entity(
         size,
         nodes,
         values,
-        polygon: None,
+        polygon,
     })
 }
 
