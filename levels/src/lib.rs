@@ -211,6 +211,50 @@ pub struct LoadedLevel {
     pub warnings: Vec<String>,
     /// What a client draws: the editor's tile layers and tileset images.
     pub art: art::LevelArt,
+    /// What each editor layer became, in file order (layers that gave
+    /// nothing are left out).
+    pub layers: Vec<LayerStats>,
+}
+
+/// What one editor layer became: for `ledge-level check` and the author.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct LayerStats {
+    /// The layer's name.
+    pub name: String,
+    /// Its path in the file (`layers[2]`), when it is a tile or grid layer.
+    pub field: String,
+    /// A tile/grid layer whose cells are in the level's grid (false: it did
+    /// not line up with the grid, see the warnings).
+    pub on_grid: bool,
+    /// Tiles by kind: solid, one-way, hazard, slope.
+    pub solid: usize,
+    /// One-way tiles.
+    pub one_way: usize,
+    /// Hazard tiles.
+    pub hazard: usize,
+    /// Slope tiles.
+    pub slopes: usize,
+    /// Entities from this layer (static geometry from its tiles included),
+    /// by [`entity_kind_name`].
+    pub entities: BTreeMap<&'static str, usize>,
+}
+
+/// A short name of an entity kind, for reports: `spawn`, `block`,
+/// `polygon`, `moving platform`, `walker`, `springboard`, `coin`,
+/// `checkpoint`, `goal`, `hazard`.
+pub fn entity_kind_name(kind: &EntityKind) -> &'static str {
+    match kind {
+        EntityKind::PlayerSpawn => "spawn",
+        EntityKind::Block => "block",
+        EntityKind::PolygonBlock { .. } => "polygon",
+        EntityKind::MovingPlatform { .. } => "moving platform",
+        EntityKind::Walker { .. } => "walker",
+        EntityKind::Springboard { .. } => "springboard",
+        EntityKind::Coin => "coin",
+        EntityKind::Checkpoint => "checkpoint",
+        EntityKind::Goal => "goal",
+        EntityKind::Hazard => "hazard",
+    }
 }
 
 /// Loads a level file with the default options; see [`load_file_with`].
@@ -320,6 +364,8 @@ fn find_project(level: &Path) -> Option<std::path::PathBuf> {
 pub(crate) struct GridLayer {
     /// Path of the layer (`layers[0]`).
     pub field: String,
+    /// The layer's name.
+    pub name: String,
     /// Top-left corner in units.
     pub origin: IVec2,
     /// Cell width and height, pixels.
@@ -340,6 +386,26 @@ pub(crate) fn assemble(
     options: &LoadOptions,
 ) -> Result<LoadedLevel, LevelError> {
     let mut mismatched = Vec::new();
+    let mut layers: Vec<LayerStats> = Vec::new();
+    for (i, g) in grids.iter().enumerate() {
+        let mut st = LayerStats {
+            name: g.name.clone(),
+            field: g.field.clone(),
+            on_grid: i == 0
+                || (g.cell, g.cells, g.origin) == (grids[0].cell, grids[0].cells, grids[0].origin),
+            ..LayerStats::default()
+        };
+        for t in &g.tiles {
+            match t {
+                Tile::Empty => {}
+                Tile::Solid => st.solid += 1,
+                Tile::OneWay => st.one_way += 1,
+                Tile::Hazard => st.hazard += 1,
+                Tile::Slope(_) => st.slopes += 1,
+            }
+        }
+        layers.push(st);
+    }
     let tilemap = match grids.split_first() {
         None => Tilemap::new(IVec2::ZERO, 16 * UNITS_PER_PX, 0, 0, Vec::new())
             .map_err(|e| tilemap_error(file, "layers", e))?,
@@ -402,6 +468,7 @@ pub(crate) fn assemble(
         route: Vec::new(),
         warnings: mismatched,
         art: art::LevelArt::default(),
+        layers,
     };
     let scale = options.speed_unit;
     for e in &entities {
@@ -417,7 +484,21 @@ pub(crate) fn assemble(
             _ => e,
         };
         match entities::classify(file, e, scale)? {
-            Classified::Entity(d) => out.level.entities.push(d),
+            Classified::Entity(d) => {
+                let kind = entity_kind_name(&d.kind);
+                let st = match out.layers.iter().position(|l| l.name == e.layer) {
+                    Some(i) => &mut out.layers[i],
+                    None => {
+                        out.layers.push(LayerStats {
+                            name: e.layer.clone(),
+                            ..LayerStats::default()
+                        });
+                        out.layers.last_mut().expect("just pushed")
+                    }
+                };
+                *st.entities.entry(kind).or_default() += 1;
+                out.level.entities.push(d)
+            }
             Classified::Waypoint(w) => out.route.push(w),
             Classified::Unknown if options.skip_unknown_entities => out.warnings.push(format!(
                 "{file}: {}: skipped unknown entity {:?} in layer {:?}",

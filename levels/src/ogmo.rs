@@ -1066,6 +1066,7 @@ pub fn load_str(
         };
         grids.push(GridLayer {
             field: l.field,
+            name: l.name,
             origin: l.origin,
             cell: l.cell,
             cells: l.cells,

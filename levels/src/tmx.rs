@@ -697,6 +697,7 @@ impl Conv<'_> {
         }
         Ok(Some(GridLayer {
             field: field.into(),
+            name: info.name.into(),
             origin: IVec2::new(origin[0] as i32, origin[1] as i32),
             cell: (ts, ts),
             cells: (w, h),

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use ledge_levels::{load_level, settings_path_for, LoadedLevel};
+use ledge_levels::{entity_kind_name, load_level, settings_path_for, LoadedLevel};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::level::EntityKind;
 use ledge_shared::tilemap::Tile;
@@ -85,15 +85,19 @@ fn describe(file: &str, loaded: &LoadedLevel) -> String {
     let px = |u: i32| u as f64 / UNITS_PER_PX as f64;
     let mut out = String::new();
     let _ = writeln!(out, "{file}: ok, level {:?}", level.name);
-    let _ = writeln!(
-        out,
-        "  grid: {} x {} tiles of {} px at ({}, {}) px",
-        map.width(),
-        map.height(),
-        px(map.tile_size()),
-        px(map.origin().x),
-        px(map.origin().y)
-    );
+    if map.width() == 0 || map.height() == 0 {
+        let _ = writeln!(out, "  grid: none (no tile or grid layer collides)");
+    } else {
+        let _ = writeln!(
+            out,
+            "  grid: {} x {} tiles of {} px at ({}, {}) px",
+            map.width(),
+            map.height(),
+            px(map.tile_size()),
+            px(map.origin().x),
+            px(map.origin().y)
+        );
+    }
     let mut tiles: BTreeMap<&str, usize> = BTreeMap::new();
     for t in map.tiles() {
         let name = match t {
@@ -108,9 +112,32 @@ fn describe(file: &str, loaded: &LoadedLevel) -> String {
     let _ = writeln!(out, "  tiles: {}", counts(&tiles));
     let mut kinds: BTreeMap<&str, usize> = BTreeMap::new();
     for e in &level.entities {
-        *kinds.entry(kind_name(&e.kind)).or_default() += 1;
+        *kinds.entry(entity_kind_name(&e.kind)).or_default() += 1;
     }
     let _ = writeln!(out, "  entities: {}", counts(&kinds));
+    for l in &loaded.layers {
+        let mut what: BTreeMap<&str, usize> = BTreeMap::new();
+        for (k, n) in [
+            ("solid", l.solid),
+            ("one-way", l.one_way),
+            ("hazard", l.hazard),
+            ("slope", l.slopes),
+        ] {
+            if n > 0 {
+                what.insert(k, n);
+            }
+        }
+        let tiles = counts(&what);
+        let ents = counts(&l.entities.iter().map(|(k, n)| (*k, *n)).collect());
+        let grid = if l.field.is_empty() {
+            String::new()
+        } else if l.on_grid {
+            format!(" ({}), tiles: {tiles};", l.field)
+        } else {
+            format!(" ({}), not on the level's grid: does not collide;", l.field)
+        };
+        let _ = writeln!(out, "  layer {:?}{grid} entities: {ents}", l.name);
+    }
     match level
         .entities
         .iter()
@@ -145,19 +172,4 @@ fn counts(map: &BTreeMap<&str, usize>) -> String {
         .map(|(k, n)| format!("{n} {k}"))
         .collect::<Vec<_>>()
         .join(", ")
-}
-
-fn kind_name(kind: &EntityKind) -> &'static str {
-    match kind {
-        EntityKind::PlayerSpawn => "spawn",
-        EntityKind::Block => "block",
-        EntityKind::PolygonBlock { .. } => "polygon",
-        EntityKind::MovingPlatform { .. } => "moving platform",
-        EntityKind::Walker { .. } => "walker",
-        EntityKind::Springboard { .. } => "springboard",
-        EntityKind::Coin => "coin",
-        EntityKind::Checkpoint => "checkpoint",
-        EntityKind::Goal => "goal",
-        EntityKind::Hazard => "hazard",
-    }
 }
