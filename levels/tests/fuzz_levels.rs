@@ -4,65 +4,17 @@
 //! fixtures, the default OGMO level and project, and the OGMO files of
 //! `shared/testdata/levels` when that folder is there.
 
-use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::Path;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Mutex, MutexGuard, Once};
 
 use ledge_levels::{ogmo, tmx, LoadOptions};
 use proptest::prelude::*;
 
-struct Counting;
-
-static CURRENT: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        let p = unsafe { System.alloc(l) };
-        if !p.is_null() {
-            let now = CURRENT.fetch_add(l.size(), Ordering::Relaxed) + l.size();
-            PEAK.fetch_max(now, Ordering::Relaxed);
-        }
-        p
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) };
-        CURRENT.fetch_sub(l.size(), Ordering::Relaxed);
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, new: usize) -> *mut u8 {
-        let q = unsafe { System.realloc(p, l, new) };
-        if !q.is_null() {
-            if new >= l.size() {
-                let now = CURRENT.fetch_add(new - l.size(), Ordering::Relaxed) + new - l.size();
-                PEAK.fetch_max(now, Ordering::Relaxed);
-            } else {
-                CURRENT.fetch_sub(l.size() - new, Ordering::Relaxed);
-            }
-        }
-        q
-    }
-}
+mod peak;
 
 #[global_allocator]
-static ALLOC: Counting = Counting;
+static ALLOC: peak::Counting = peak::Counting;
 
-const PEAK_BYTES: usize = 256 << 20;
-
-static PANICS: AtomicUsize = AtomicUsize::new(0);
-static SERIAL: Mutex<()> = Mutex::new(());
-
-fn serial() -> MutexGuard<'static, ()> {
-    static HOOK: Once = Once::new();
-    HOOK.call_once(|| {
-        let default = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            PANICS.fetch_add(1, Ordering::SeqCst);
-            default(info);
-        }));
-    });
-    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
-}
+use peak::{measured, serial};
 
 const TILED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/levels/tiled");
 const DEFAULT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/default");
@@ -180,15 +132,13 @@ fn mutate(text: &str, edits: &[(u32, u8, u8)], tokens: &[&str]) -> String {
     String::from_utf8_lossy(&b).into_owned()
 }
 
-/// Runs `f`, checks no panic and the peak heap.
+/// Runs `f` under [`peak::measured`] (no panic, bounded peak heap),
+/// naming the seed when it fails.
 fn guarded(what: &str, f: impl FnOnce()) {
-    let panics = PANICS.load(Ordering::SeqCst);
-    let base = CURRENT.load(Ordering::SeqCst);
-    PEAK.store(base, Ordering::SeqCst);
-    f();
-    let peak = PEAK.load(Ordering::SeqCst).saturating_sub(base);
-    assert_eq!(PANICS.load(Ordering::SeqCst), panics, "{what}: a panic");
-    assert!(peak < PEAK_BYTES, "{what}: peak heap {peak} bytes");
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| measured(f)));
+    if let Err(e) = r {
+        panic!("{what}: {e:?}");
+    }
 }
 
 fn opts() -> LoadOptions {
