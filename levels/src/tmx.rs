@@ -594,16 +594,7 @@ impl Conv<'_> {
                     ),
                 ));
             }
-            // The tiled crate does not check the data length against the
-            // size, and indexing past short data panics: the pre-scan
-            // refuses such data; probe the last cell all the same.
-            if w > 0
-                && h > 0
-                && catch_unwind(AssertUnwindSafe(|| {
-                    fl.get_tile_data(w as i32 - 1, h as i32 - 1).is_some()
-                }))
-                .is_err()
-            {
+            if short_data(fl) {
                 return Err(self.bad(
                     format!("{field}.data"),
                     format!(
@@ -1203,6 +1194,20 @@ impl Conv<'_> {
         }
         Ok(out)
     }
+}
+
+/// Whether a finite layer has fewer cells of data than its size: the tiled
+/// crate does not check, and indexing past short data panics. The pre-scan
+/// ([`crate::limits`]) refuses such data; this probe of the last cell is
+/// the second line, for every reader of a layer's cells.
+pub(crate) fn short_data(fl: &::tiled::FiniteTileLayer<'_>) -> bool {
+    let (w, h) = (fl.width(), fl.height());
+    w > 0
+        && h > 0
+        && catch_unwind(AssertUnwindSafe(|| {
+            fl.get_tile_data(w as i32 - 1, h as i32 - 1).is_some()
+        }))
+        .is_err()
 }
 
 /// How thick a solid polyline's legs are, in pixels.

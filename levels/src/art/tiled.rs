@@ -1,7 +1,6 @@
 //! The art of a Tiled map.
 
 use std::collections::{BTreeMap, HashMap};
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Component, Path, PathBuf};
 
 use ::tiled::{
@@ -182,15 +181,7 @@ impl<'m> Build<'m> {
         };
         let (w, h) = (fl.width(), fl.height());
         self.budget.cells(self.file, field, w as u64 * h as u64)?;
-        // The tiled crate does not check the data length against the size:
-        // probe the last cell first (see tmx.rs).
-        if w > 0
-            && h > 0
-            && catch_unwind(AssertUnwindSafe(|| {
-                fl.get_tile_data(w as i32 - 1, h as i32 - 1).is_some()
-            }))
-            .is_err()
-        {
+        if crate::tmx::short_data(fl) {
             return Err(self.bad(
                 format!("{field}.data"),
                 format!("fewer entries than the layer's {w} x {h} cells"),
