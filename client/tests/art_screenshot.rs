@@ -148,6 +148,90 @@ fn pair(v: &Value) -> (f64, f64) {
     (a[0].as_f64().unwrap(), a[1].as_f64().unwrap())
 }
 
+/// Runs the real client under Xvfb offline on `map`, the camera on
+/// `look_at` (world pixels), and returns its screenshot and the JSON beside
+/// it. `LEDGE_SCREENSHOT_DIR` keeps the pictures (to look at them).
+fn run_client(xvfb: &Path, map: &Path, look_at: (f64, f64), name: &str) -> (Png, Value) {
+    let out = tempfile::tempdir().unwrap();
+    let dir = std::env::var_os("LEDGE_SCREENSHOT_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| out.path().to_owned());
+    std::fs::create_dir_all(&dir).unwrap();
+    let png_path = dir.join(name);
+    let mut child = Command::new(xvfb)
+        .args(["-a", "-s", "-screen 0 1280x720x24"])
+        .arg(env!("CARGO_BIN_EXE_ledge-client"))
+        .arg("--level")
+        .arg(map)
+        .args(["--exit-after-ticks", "10"])
+        .arg("--screenshot")
+        .arg(&png_path)
+        .args(["--look-at", &format!("{},{}", look_at.0, look_at.1)])
+        .args(["--window", "960x540"])
+        .env("LIBGL_ALWAYS_SOFTWARE", "1")
+        .stdin(Stdio::null())
+        .spawn()
+        .expect("xvfb-run starts");
+    let deadline = Instant::now() + CLIENT_TIMEOUT;
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("the client did not exit within {CLIENT_TIMEOUT:?}");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    assert!(status.success(), "the client failed: {status}");
+    let json: Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join(format!("{name}.json"))).expect("the screenshot's JSON"),
+    )
+    .expect("valid JSON");
+    (Png::load(&png_path), json)
+}
+
+/// How many of the sampled texels of cell `(c, r)` show `stack` (gids,
+/// bottom first) as the tileset has them, and a few that do not.
+fn cell_matches(
+    shot: &Png,
+    json: &Value,
+    tiles: &Png,
+    stack: &[u32],
+    (c, r): (u32, u32),
+) -> (usize, usize, Vec<String>) {
+    let zoom = json["camera"]["zoom"].as_f64().unwrap();
+    let (ox, oy) = pair(&json["camera"]["offset"]);
+    // The centre of every third texel's screen square.
+    let samples: Vec<(u32, u32)> = (0..T)
+        .step_by(3)
+        .flat_map(|v| (0..T).step_by(3).map(move |u| (u, v)))
+        .collect();
+    let mut ok = 0;
+    let mut bad = Vec::new();
+    for &(u, v) in &samples {
+        let mut want = [0u8; 3];
+        for &gid in stack {
+            let t = texel(tiles, gid, u, v);
+            want = over(t, [want[0], want[1], want[2], 255]);
+        }
+        let wx = (c * T + u) as f64 + 0.5;
+        let wy = (r * T + v) as f64 + 0.5;
+        let (sx, sy) = (wx * zoom + ox, wy * zoom + oy);
+        let got = shot.at(sx as u32, sy as u32);
+        if got[..3].iter().zip(want).all(|(&g, w)| g.abs_diff(w) <= 6) {
+            ok += 1;
+        } else if bad.len() < 5 {
+            bad.push(format!(
+                "texel ({u}, {v}) at screen ({sx}, {sy}): got {:?}, want {want:?}",
+                &got[..3]
+            ));
+        }
+    }
+    (ok, samples.len(), bad)
+}
+
 #[test]
 fn the_client_draws_a_tiled_map_with_its_own_tileset() {
     let Some(xvfb) = xvfb_run() else {
@@ -169,54 +253,13 @@ fn the_client_draws_a_tiled_map_with_its_own_tileset() {
     std::fs::copy(&fixture, &map).unwrap();
     std::fs::copy(&image, level_dir.path().join("tmw_desert_spacing.png")).unwrap();
 
-    // LEDGE_SCREENSHOT_DIR keeps the picture (to look at it).
-    let out = tempfile::tempdir().unwrap();
-    let dir = std::env::var_os("LEDGE_SCREENSHOT_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| out.path().to_owned());
-    std::fs::create_dir_all(&dir).unwrap();
-    let png_path = dir.join("art.png");
-    let mut child = Command::new(xvfb)
-        .args(["-a", "-s", "-screen 0 1280x720x24"])
-        .arg(env!("CARGO_BIN_EXE_ledge-client"))
-        .arg("--level")
-        .arg(&map)
-        .args(["--exit-after-ticks", "10"])
-        .arg("--screenshot")
-        .arg(&png_path)
-        .args(["--look-at", &format!("{},{}", LOOK_AT.0, LOOK_AT.1)])
-        .args(["--window", "960x540"])
-        .env("LIBGL_ALWAYS_SOFTWARE", "1")
-        .stdin(Stdio::null())
-        .spawn()
-        .expect("xvfb-run starts");
-    let deadline = Instant::now() + CLIENT_TIMEOUT;
-    let status = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break status;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("the client did not exit within {CLIENT_TIMEOUT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    };
-    assert!(status.success(), "the client failed: {status}");
-
-    let json: Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.join("art.png.json")).expect("the screenshot's JSON"),
-    )
-    .expect("valid JSON");
-    let shot = Png::load(&png_path);
+    let (shot, json) = run_client(&xvfb, &map, LOOK_AT, "art.png");
     let tiles = Png::load(&image);
     assert_eq!(
         (tiles.width, tiles.height),
         (265, 199),
         "the Desert tileset"
     );
-    let zoom = json["camera"]["zoom"].as_f64().unwrap();
-    let (ox, oy) = pair(&json["camera"]["offset"]);
     let solid = json["colors"]["solid"].clone();
 
     // Cells (column, row) and what is drawn there, bottom layer first: the
@@ -234,56 +277,20 @@ fn the_client_draws_a_tiled_map_with_its_own_tileset() {
         ((16, 8), &[sand, 32 | D]),
         ((17, 8), &[sand, 32]),
     ];
-    // The centre of every other texel's screen square.
-    let samples: Vec<(u32, u32)> = (0..T)
-        .step_by(3)
-        .flat_map(|v| (0..T).step_by(3).map(move |u| (u, v)))
-        .collect();
-    let expected_at = |stack: &[u32], u: u32, v: u32| -> [u8; 3] {
-        let mut rgb = [0u8; 3];
-        for &gid in stack {
-            let t = texel(&tiles, gid, u, v);
-            let under = [rgb[0], rgb[1], rgb[2], 255];
-            rgb = over(t, under);
-        }
-        rgb
-    };
-    let matches = |stack: &[u32], (c, r): (u32, u32)| -> (usize, Vec<String>) {
-        let mut ok = 0;
-        let mut bad = Vec::new();
-        for &(u, v) in &samples {
-            let wx = (c * T + u) as f64 + 0.5;
-            let wy = (r * T + v) as f64 + 0.5;
-            let (sx, sy) = (wx * zoom + ox, wy * zoom + oy);
-            let got = shot.at(sx as u32, sy as u32);
-            let want = expected_at(stack, u, v);
-            if got[..3].iter().zip(want).all(|(&g, w)| g.abs_diff(w) <= 6) {
-                ok += 1;
-            } else if bad.len() < 5 {
-                bad.push(format!(
-                    "texel ({u}, {v}) at screen ({sx}, {sy}): got {:?}, want {want:?}",
-                    &got[..3]
-                ));
-            }
-        }
-        (ok, bad)
-    };
     for ((c, r), stack) in cells {
-        let (ok, bad) = matches(stack, (c, r));
+        let (ok, n, bad) = cell_matches(&shot, &json, &tiles, stack, (c, r));
         assert!(
-            ok * 100 >= samples.len() * 97,
-            "cell ({c}, {r}) drawn with {stack:x?}: {ok} of {} samples match the tileset: {bad:?} ({json})",
-            samples.len()
+            ok * 100 >= n * 97,
+            "cell ({c}, {r}) drawn with {stack:x?}: {ok} of {n} samples match the tileset: {bad:?} ({json})"
         );
         // A flipped tile is drawn flipped: unflipped, it would not match.
         if let Some(&top) = stack.last() {
             if top & (H | V | D) != 0 {
                 let plain = [sand, top & !(H | V | D)];
-                let (same, _) = matches(&plain, (c, r));
+                let (same, n, _) = cell_matches(&shot, &json, &tiles, &plain, (c, r));
                 assert!(
-                    same * 100 < samples.len() * 90,
-                    "cell ({c}, {r}): {same} of {} samples also match the unflipped tile",
-                    samples.len()
+                    same * 100 < n * 90,
+                    "cell ({c}, {r}): {same} of {n} samples also match the unflipped tile"
                 );
             }
         }
@@ -300,4 +307,51 @@ fn the_client_draws_a_tiled_map_with_its_own_tileset() {
         flat < 10,
         "{flat} pixels of the flat solid colour {solid:?}"
     );
+}
+
+/// Tiled's own `desert.tmx` (one 40 x 40 layer, its external `desert.tsx`),
+/// exactly as Tiled's examples ship it: every cell in view shows the tile
+/// the file puts there, read with the `tiled` crate.
+#[test]
+fn the_client_draws_tileds_own_desert_map() {
+    let Some(xvfb) = xvfb_run() else {
+        if ci() {
+            panic!("xvfb-run is not on PATH: install xvfb (apt-get install xvfb) to run the screenshot tests in CI");
+        }
+        notice("xvfb-run is not on PATH (apt-get install xvfb xauth).");
+        return;
+    };
+    let Some(image) = corpus_image() else {
+        notice("no level corpus: run scripts/fetch-level-corpus.");
+        return;
+    };
+    let map = image.with_file_name("desert.tmx");
+    let (shot, json) = run_client(&xvfb, &map, (640.0, 640.0), "desert.png");
+    let tiles = Png::load(&image);
+    let tmx = tiled::Loader::new().load_tmx_map(&map).expect("desert.tmx");
+    let layer = tmx.get_layer(0).unwrap().as_tile_layer().unwrap();
+    let ts = tmx.tilesets()[0].clone();
+    assert_eq!((ts.margin, ts.spacing, ts.columns), (1, 1, 8));
+    // The 10 x 6 cells around the camera (640, 640) px, all in view at
+    // 960 x 540 and zoom 2 or less.
+    let mut checked = 0;
+    for r in 17..23 {
+        for c in 15..25 {
+            let lt = layer
+                .get_tile(c as i32, r as i32)
+                .expect("desert.tmx fills every cell");
+            let mut gid = lt.id() + 1;
+            gid |= if lt.flip_h { H } else { 0 }
+                | if lt.flip_v { V } else { 0 }
+                | if lt.flip_d { D } else { 0 };
+            let (ok, n, bad) = cell_matches(&shot, &json, &tiles, &[gid], (c, r));
+            assert!(
+                ok * 100 >= n * 97,
+                "desert.tmx cell ({c}, {r}), tile {}: {ok} of {n} samples match: {bad:?} ({json})",
+                lt.id()
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 60);
 }
