@@ -162,7 +162,7 @@ pub enum LevelError {
         bound: &'static str,
     },
     /// No entity is a player spawn.
-    #[error("{file}: {field}: no player spawn, and nothing in the level to place one on (add an entity named \"player\" or \"spawn\")")]
+    #[error("{file}: {field}: no player spawn, and nothing in the level to place one on: nothing in it collides (add an entity named \"player\" or \"spawn\", and make something collide: see docs/LEVELS.md, \"What collides\", and the level's settings file)")]
     MissingSpawn {
         /// The file.
         file: String,

@@ -355,3 +355,36 @@ fn sticker_knight_collides_where_its_static_bodies_are() {
         );
     }
 }
+
+/// The OGMO Editor 3 projects of `shared/testdata/levels` (beside the
+/// repository; real files from two other projects, licences there) with no
+/// settings file: the sample loads and says what it did not use; the echo
+/// slopes level (one tile layer of a foreign tileset, no entities) has
+/// nothing that collides without a settings file, and says so
+/// (`levels/tests/level_ogmo.rs` loads it with its tile table).
+#[test]
+fn ogmo_files_load_with_no_settings_and_say_what_they_skipped() {
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/testdata/levels");
+    let e = load_level(&shared.join("echo-slopes/slopes.json"), None).unwrap_err();
+    assert!(e.to_string().contains("nothing in it collides"), "{e}");
+    for (file, said) in [(
+        "ogmo3-sample/levels/uno.json",
+        "tile layer \"tile_1D\" does not collide",
+    )] {
+        let l = no_panics(|| load_level(&shared.join(file), None))
+            .unwrap_or_else(|e| panic!("{file}: {e}"));
+        Game::from_level(&l.level).unwrap();
+        assert!(
+            l.warnings.iter().any(|w| w.contains(said)),
+            "{file}: {:?}",
+            l.warnings
+        );
+        assert!(
+            l.warnings
+                .iter()
+                .any(|w| w.contains("no player spawn: players start at")),
+            "{file}: {:?}",
+            l.warnings
+        );
+    }
+}

@@ -519,7 +519,7 @@ fn missing_spawn() {
     let e = load(r#"{"layers": []}"#).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "levels/test.json: entities: no player spawn, and nothing in the level to place one on (add an entity named \"player\" or \"spawn\")"
+        "levels/test.json: entities: no player spawn, and nothing in the level to place one on: nothing in it collides (add an entity named \"player\" or \"spawn\", and make something collide: see docs/LEVELS.md, \"What collides\", and the level's settings file)"
     );
     // No free spot to stand on inside (the floor row is at the top): on
     // top of the level at its left edge, and said.
