@@ -32,9 +32,16 @@ async fn main() -> anyhow::Result<()> {
         println!("metrics at http://{addr}/metrics");
     }
     println!("certificate SHA-256 fingerprint: {fingerprint}");
+    // Players need the same level file (and its settings) until clients
+    // download it from the server.
+    let level = config
+        .level
+        .as_ref()
+        .map(|p| format!(" --level {}", p.display()))
+        .unwrap_or_default();
     println!(
         "connect with: cargo run --release -p ledge-client -- \
-         --connect 127.0.0.1:{port} --cert-hash {fingerprint} --name YOUR_NAME"
+         --connect 127.0.0.1:{port} --cert-hash {fingerprint}{level} --name YOUR_NAME"
     );
 
     let signals = ShutdownSignals::install().context("installing signal handlers")?;
