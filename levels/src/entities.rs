@@ -138,6 +138,15 @@ pub(crate) fn is_block_name(name: &str) -> bool {
     matches!(class_of(name), Some(Class::Block))
 }
 
+/// Whether `name` names an entity that moves or vanishes in play: a coin,
+/// a walker, a moving platform.
+pub(crate) fn moves_or_vanishes(name: &str) -> bool {
+    matches!(
+        class_of(name),
+        Some(Class::Coin | Class::Walker | Class::Platform)
+    )
+}
+
 /// Whether `name` is in the entity table ([`ENTITY_NAMES`]).
 pub(crate) fn is_entity_name(name: &str) -> bool {
     class_of(name).is_some()

@@ -152,7 +152,7 @@ fn load(
         grid: (0, 0, map.width, map.height),
     }
     .run(path)?;
-    loaded.art = crate::art::from_tiled(&file, &map)?;
+    loaded.art = crate::art::from_tiled(&file, &map, options)?;
     Ok(loaded)
 }
 
@@ -832,15 +832,8 @@ impl Conv<'_> {
                 continue;
             }
             let f = format!("{field}.objects[{k}]");
-            // The class names the entity, else the name (also when the
-            // class is not a ledge entity and the name is).
             let known = |n: &str| is_entity_name(self.options.entity_name(n));
-            let name = if o.user_type.trim().is_empty() || (!known(&o.user_type) && known(&o.name))
-            {
-                o.name.clone()
-            } else {
-                o.user_type.clone()
-            };
+            let name = object_name(self.options, &o).to_owned();
             let (x, y) = (o.x as f64 + off.0, o.y as f64 + off.1);
             let at = || {
                 format!(
@@ -1194,6 +1187,25 @@ impl Conv<'_> {
         }
         Ok(out)
     }
+}
+
+/// The name an object goes by: its class (`type` before Tiled 1.9), else
+/// its name, also when the class is no ledge entity (after the settings'
+/// aliases) and the name is.
+pub(crate) fn object_name<'o>(options: &LoadOptions, o: &'o ::tiled::ObjectData) -> &'o str {
+    let known = |n: &str| is_entity_name(options.entity_name(n));
+    if o.user_type.trim().is_empty() || (!known(&o.user_type) && known(&o.name)) {
+        &o.name
+    } else {
+        &o.user_type
+    }
+}
+
+/// Whether an object stands for an entity that moves or vanishes (a coin,
+/// a walker, a moving platform), which the game draws itself: the level's
+/// art leaves its picture out, or a collected coin would stay on screen.
+pub(crate) fn is_drawn_entity(options: &LoadOptions, o: &::tiled::ObjectData) -> bool {
+    crate::entities::moves_or_vanishes(options.entity_name(object_name(options, o)))
 }
 
 /// Whether a finite layer has fewer cells of data than its size: the tiled

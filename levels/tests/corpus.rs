@@ -353,6 +353,39 @@ fn sticker_knight_collides_where_its_static_bodies_are() {
             "{name}: {:?}",
             l.warnings
         );
+        // The art draws the static bodies' pictures, not the coins' or the
+        // enemy's (the game draws them: a collected coin vanishes, a walker
+        // walks): one art object per visible tile object of another kind.
+        let coins = l
+            .level
+            .entities
+            .iter()
+            .filter(|e| e.kind == EntityKind::Coin)
+            .count();
+        assert!(coins > 0, "{name}");
+        let drawn: usize = l
+            .art
+            .layers
+            .iter()
+            .map(|layer| match &layer.content {
+                ledge_levels::art::ArtContent::Objects(o) => o.len(),
+                _ => 0,
+            })
+            .sum();
+        let mut tile_objects = 0;
+        for layer in map.layers().filter(|l| l.visible) {
+            if let Some(ol) = layer.as_object_layer() {
+                tile_objects += ol
+                    .objects()
+                    .filter(|o| {
+                        o.visible
+                            && o.get_tile().is_some()
+                            && !["coin", "enemy"].contains(&o.user_type.as_str())
+                    })
+                    .count();
+            }
+        }
+        assert_eq!(drawn, tile_objects, "{name}");
     }
 }
 

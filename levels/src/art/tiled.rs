@@ -21,11 +21,16 @@ use crate::LevelError;
 /// An image that cannot be read or is not a PNG is left out, with what
 /// uses it, and a line in [`LevelArt::warnings`]; a bound exceeded is an
 /// error.
-pub(crate) fn from_tiled(file: &str, map: &Map) -> Result<LevelArt, LevelError> {
+pub(crate) fn from_tiled(
+    file: &str,
+    map: &Map,
+    options: &crate::LoadOptions,
+) -> Result<LevelArt, LevelError> {
     let map_dir = map.source.parent().map(normalize).unwrap_or_default();
     let mut b = Build {
         file,
         map,
+        options,
         map_dir,
         images: Images::default(),
         tilesets: Vec::new(),
@@ -81,6 +86,8 @@ struct Inherited {
 struct Build<'m> {
     file: &'m str,
     map: &'m Map,
+    /// The load's options (entity names and aliases).
+    options: &'m crate::LoadOptions,
     map_dir: PathBuf,
     images: Images,
     tilesets: Vec<ArtTileset>,
@@ -229,6 +236,10 @@ impl<'m> Build<'m> {
                 continue;
             }
             let Some(t) = o.get_tile() else { continue };
+            // The game draws its entities (a coin vanishes when collected).
+            if crate::tmx::is_drawn_entity(self.options, &o) {
+                continue;
+            }
             let of = format!("{field}.objects[{k}]");
             self.budget.object(self.file, &of)?;
             let ts = t.get_tileset();
