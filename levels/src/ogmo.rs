@@ -986,15 +986,42 @@ pub fn load_str(
     let mut warnings = level.warnings;
     let mut grids = Vec::new();
     let mut entities = Vec::new();
+    // OGMO tile layers say nothing about collision. A level with no
+    // collision data at all (no grid layer, no tile table or settings for
+    // its tilesets, no collision_layers) collides its collision-named tile
+    // layers, else all of them, as a Tiled map without data does, and says
+    // so.
+    let mapped = |t: &str| options.mapping.has_table(t) || options.has_tile_kinds(t);
+    let has_data = options.collision_layers.is_some()
+        || level.layers.iter().any(|l| match &l.content {
+            LayerContent::Grid { .. } => true,
+            LayerContent::Tiles { tileset, .. } => mapped(tileset),
+            _ => false,
+        });
+    let tile_layer = |l: &OgmoLayer| matches!(l.content, LayerContent::Tiles { .. });
+    let named = level
+        .layers
+        .iter()
+        .any(|l| tile_layer(l) && crate::collision::is_collision_layer_name(&l.name));
+    let fallback =
+        |l: &OgmoLayer| !has_data && (!named || crate::collision::is_collision_layer_name(&l.name));
+    if !has_data && level.layers.iter().any(tile_layer) {
+        warnings.push(format!(
+            "{file}: the level has no collision data (no grid layer, no tile table for its tilesets), so every tile of {} is solid; use a grid layer for collision, or map the tiles in the level's settings file (see docs/LEVELS.md, \"What collides\")",
+            if named {
+                "the tile layers named like collision layers (collision, solid, walls, ground, ...)"
+            } else {
+                "every tile layer"
+            }
+        ));
+    }
     for l in level.layers {
         let listed = options.layer_collides(&l.name);
         let wanted = listed != Some(false);
+        let falls_back = fallback(&l);
         let tiles = match l.content {
             LayerContent::Tiles { tileset, .. }
-                if wanted
-                    && listed.is_none()
-                    && !options.mapping.has_table(&tileset)
-                    && !options.has_tile_kinds(&tileset) =>
+                if wanted && listed.is_none() && !mapped(&tileset) && !falls_back =>
             {
                 // OGMO files say nothing about which tiles collide: only a
                 // tileset with a table (ledge's own, or one the settings

@@ -390,16 +390,32 @@ fn sticker_knight_collides_where_its_static_bodies_are() {
 }
 
 /// The OGMO Editor 3 projects of `shared/testdata/levels` (beside the
-/// repository; real files from two other projects, licences there) with no
-/// settings file: the sample loads and says what it did not use; the echo
-/// slopes level (one tile layer of a foreign tileset, no entities) has
-/// nothing that collides without a settings file, and says so
-/// (`levels/tests/level_ogmo.rs` loads it with its tile table).
+/// repository; real files from two other projects, licences there) load
+/// with no settings file and say what they did not use or guessed: the
+/// echo slopes level (one tile layer of a foreign tileset, no grid layer,
+/// no entities) collides every tile, said (`levels/tests/level_ogmo.rs`
+/// loads it with its tile table, slopes and all).
 #[test]
 fn ogmo_files_load_with_no_settings_and_say_what_they_skipped() {
     let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/testdata/levels");
-    let e = load_level(&shared.join("echo-slopes/slopes.json"), None).unwrap_err();
-    assert!(e.to_string().contains("nothing in it collides"), "{e}");
+    let l = no_panics(|| load_level(&shared.join("echo-slopes/slopes.json"), None)).unwrap();
+    assert!(
+        l.warnings.iter().any(|w| w.contains("no collision data")
+            && w.contains("every tile of every tile layer is solid")),
+        "{:?}",
+        l.warnings
+    );
+    // Solid exactly where the file has a tile.
+    let text = std::fs::read_to_string(shared.join("echo-slopes/slopes.json")).unwrap();
+    let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let data = doc["layers"][0]["data"]
+        .as_array()
+        .expect("a 1D tile layer");
+    let tiles = l.level.tilemap.tiles();
+    assert_eq!(tiles.len(), data.len());
+    for (i, (t, d)) in tiles.iter().zip(data).enumerate() {
+        assert_eq!(*t == Tile::Solid, d.as_i64().unwrap() >= 0, "cell {i}");
+    }
     let file = "ogmo3-sample/levels/uno.json";
     let l = no_panics(|| load_level(&shared.join(file), None))
         .unwrap_or_else(|e| panic!("{file}: {e}"));
