@@ -27,7 +27,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::LevelError;
 
-pub(crate) use self::ogmo::from_ogmo;
+pub(crate) use self::ogmo::{decode_base64, from_ogmo};
 pub(crate) use self::tiled::from_tiled;
 
 /// Largest image file, bytes (16 MiB).

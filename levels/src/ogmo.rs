@@ -473,23 +473,8 @@ pub fn parse_project(file: &str, text: &str) -> Result<Project, LevelError> {
 /// The width of the PNG in a `data:image/png;base64,` URI (from its IHDR).
 fn png_width(uri: &str) -> Option<u32> {
     let b64 = uri.split_once("base64,")?.1.as_bytes();
-    let head = b64.get(..32)?;
-    let mut bytes = Vec::with_capacity(24);
-    for quad in head.chunks(4) {
-        let mut acc = 0u32;
-        for &c in quad {
-            let v = match c {
-                b'A'..=b'Z' => c - b'A',
-                b'a'..=b'z' => c - b'a' + 26,
-                b'0'..=b'9' => c - b'0' + 52,
-                b'+' => 62,
-                b'/' => 63,
-                _ => return None,
-            };
-            acc = acc << 6 | v as u32;
-        }
-        bytes.extend_from_slice(&acc.to_be_bytes()[1..]);
-    }
+    // The first 24 bytes hold the signature and IHDR's width.
+    let bytes = crate::art::decode_base64(std::str::from_utf8(b64.get(..32)?).ok()?)?;
     (bytes.get(..8)? == b"\x89PNG\r\n\x1a\n" && bytes.get(12..16)? == b"IHDR")
         .then(|| u32::from_be_bytes(bytes[16..20].try_into().unwrap_or_default()))
 }
