@@ -232,17 +232,27 @@ fn cell_matches(
     (ok, samples.len(), bad)
 }
 
-#[test]
-fn the_client_draws_a_tiled_map_with_its_own_tileset() {
+/// `xvfb-run` and the Desert tileset image of the corpus; `None` (after a
+/// loud notice) when one is missing outside CI; in CI a missing `xvfb-run`
+/// fails.
+fn prerequisites() -> Option<(PathBuf, PathBuf)> {
     let Some(xvfb) = xvfb_run() else {
         if ci() {
             panic!("xvfb-run is not on PATH: install xvfb (apt-get install xvfb) to run the screenshot tests in CI");
         }
         notice("xvfb-run is not on PATH (apt-get install xvfb xauth).");
-        return;
+        return None;
     };
     let Some(image) = corpus_image() else {
         notice("no level corpus: run scripts/fetch-level-corpus.");
+        return None;
+    };
+    Some((xvfb, image))
+}
+
+#[test]
+fn the_client_draws_a_tiled_map_with_its_own_tileset() {
+    let Some((xvfb, image)) = prerequisites() else {
         return;
     };
 
@@ -314,15 +324,7 @@ fn the_client_draws_a_tiled_map_with_its_own_tileset() {
 /// the file puts there, read with the `tiled` crate.
 #[test]
 fn the_client_draws_tileds_own_desert_map() {
-    let Some(xvfb) = xvfb_run() else {
-        if ci() {
-            panic!("xvfb-run is not on PATH: install xvfb (apt-get install xvfb) to run the screenshot tests in CI");
-        }
-        notice("xvfb-run is not on PATH (apt-get install xvfb xauth).");
-        return;
-    };
-    let Some(image) = corpus_image() else {
-        notice("no level corpus: run scripts/fetch-level-corpus.");
+    let Some((xvfb, image)) = prerequisites() else {
         return;
     };
     let map = image.with_file_name("desert.tmx");
