@@ -846,6 +846,10 @@ impl Conv<'_> {
                 )
             };
             if !o.visible {
+                self.notes.borrow_mut().add(
+                    "hidden objects are ignored (make them visible in Tiled to use them)".into(),
+                    at,
+                );
                 continue;
             }
             if !known(&name) {
@@ -929,11 +933,6 @@ impl Conv<'_> {
                 continue;
             }
             if let ObjectShape::Polygon { points } = &o.shape {
-                let name = if name.trim().is_empty() || !known(&name) {
-                    "polygon".to_owned()
-                } else {
-                    name
-                };
                 let polygon = self.polygon(&f, o.id(), &name, points, (x, y), o.rotation)?;
                 out.push(PlacedEntity {
                     name,

@@ -104,7 +104,13 @@ fn tiled_layers_in_draw_order_with_offsets_flips_and_objects() {
     let dir = tempfile::tempdir().unwrap();
     let path = write_map(dir.path());
     let loaded = load_file_with(&path, &opts()).unwrap();
-    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    // The hidden tile object is said to be ignored (drawn and collided
+    // nowhere), nothing else.
+    assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
+    assert!(
+        loaded.warnings[0].contains("object 3")
+            && loaded.warnings[0].contains("hidden objects are ignored")
+    );
     let art = &loaded.art;
     assert!(art.warnings.is_empty(), "{:?}", art.warnings);
     assert_eq!(art.background, Some([0x10, 0x20, 0x30, 0xff]));
