@@ -4,6 +4,8 @@
 //! Ctrl-C or SIGTERM and shuts down gracefully. Options: `--help`, and
 //! `docs/SERVER.md`.
 
+use std::io::{IsTerminal, Write};
+
 use anyhow::Context;
 use clap::Parser;
 use ledge_server::config::Cli;
@@ -13,8 +15,16 @@ use tracing_subscriber::EnvFilter;
 #[tokio::main]
 async fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
+    // Logs on stderr, coloured only on a terminal; stdout carries the
+    // join instructions. A log line that cannot be written (stderr closed:
+    // `ledge-server 2>&1 | head -1`) is dropped: reporting it would
+    // `eprintln!` to the same closed stderr, which panics, and a panicking
+    // signal task would leave the server deaf to Ctrl-C and SIGTERM.
     tracing_subscriber::fmt()
         .with_env_filter(EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()))
+        .with_writer(std::io::stderr)
+        .with_ansi(std::io::stderr().is_terminal())
+        .log_internal_errors(false)
         .init();
     let config = cli.resolve().context("reading the configuration")?;
 
@@ -25,13 +35,21 @@ async fn main() -> anyhow::Result<()> {
             config.cert_dir.display()
         )
     })?;
+    // Signals first: whoever reads the join instructions may stop the
+    // server at once.
+    let signals = ShutdownSignals::install().context("installing signal handlers")?;
     let fingerprint = server.fingerprint();
     let port = server.local_addr().port();
-    println!("ledge server listening on {}", server.local_addr());
+    say(format_args!(
+        "ledge server listening on {}",
+        server.local_addr()
+    ));
     if let Some(addr) = server.metrics_addr() {
-        println!("metrics at http://{addr}/metrics");
+        say(format_args!("metrics at http://{addr}/metrics"));
     }
-    println!("certificate SHA-256 fingerprint: {fingerprint}");
+    say(format_args!(
+        "certificate SHA-256 fingerprint: {fingerprint}"
+    ));
     // Players need the same level file (and its settings) until clients
     // download it from the server.
     let level = config
@@ -39,12 +57,11 @@ async fn main() -> anyhow::Result<()> {
         .as_ref()
         .map(|p| format!(" --level {}", p.display()))
         .unwrap_or_default();
-    println!(
+    say(format_args!(
         "connect with: cargo run --release -p ledge-client -- \
          --connect 127.0.0.1:{port} --cert-hash {fingerprint}{level} --name YOUR_NAME"
-    );
+    ));
 
-    let signals = ShutdownSignals::install().context("installing signal handlers")?;
     let shutdown = server.shutdown_handle();
     tokio::spawn(async move {
         let signal = signals.recv().await;
@@ -52,6 +69,14 @@ async fn main() -> anyhow::Result<()> {
         shutdown.shutdown();
     });
     server.run().await.context("running the server")
+}
+
+/// A line on stdout. Unlike `println!`, a closed stdout (`ledge-server |
+/// head -1`) is no reason to panic: the server keeps running and still
+/// stops on Ctrl-C and SIGTERM.
+fn say(line: std::fmt::Arguments<'_>) {
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{line}").and_then(|()| out.flush());
 }
 
 /// Ctrl-C and, on Unix, SIGTERM.

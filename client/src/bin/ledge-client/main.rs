@@ -26,6 +26,7 @@ mod render;
 mod script;
 mod shot;
 
+use std::io::Write;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicI32, Ordering};
 use std::time::{Duration, Instant};
@@ -193,6 +194,9 @@ fn main() -> anyhow::Result<()> {
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
         )
         .with_writer(std::io::stderr)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        // A closed stderr drops log lines instead of panicking.
+        .log_internal_errors(false)
         .init();
 
     let bindings = match &cli.keys {
@@ -213,11 +217,12 @@ fn main() -> anyhow::Result<()> {
                 .map_err(|e| anyhow::anyhow!("loading the level: {e}"))?;
             // What the importer ignored, guessed or placed: the player
             // (and the level's author) should see it.
+            let mut err = std::io::stderr().lock();
             for w in &loaded.warnings {
-                eprintln!("warning: {w}");
+                let _ = writeln!(err, "warning: {w}");
             }
             for w in &loaded.art.warnings {
-                eprintln!("warning: level art: {w}");
+                let _ = writeln!(err, "warning: level art: {w}");
             }
             (loaded.level, loaded.art)
         }
