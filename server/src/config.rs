@@ -223,8 +223,10 @@ pub struct Cli {
     /// TOML configuration file.
     #[arg(long, value_name = "PATH")]
     pub config: Option<PathBuf>,
-    /// UDP address to listen on [default: 0.0.0.0:4433].
-    #[arg(long, value_name = "ADDR:PORT")]
+    /// UDP address to listen on: ADDR:PORT, HOST:PORT (resolved, the
+    /// first address) or a bare PORT (all interfaces) [default:
+    /// 0.0.0.0:4433].
+    #[arg(long, value_name = "ADDR:PORT", value_parser = parse_bind)]
     pub bind: Option<SocketAddr>,
     /// Level file to play [default: the embedded default level].
     #[arg(long, value_name = "PATH")]
@@ -261,7 +263,8 @@ pub struct Cli {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FileConfig {
-    bind: Option<SocketAddr>,
+    /// As `--bind`: ADDR:PORT, HOST:PORT or PORT.
+    bind: Option<String>,
     level: Option<PathBuf>,
     level_settings: Option<PathBuf>,
     tick_rate: Option<u32>,
@@ -297,7 +300,12 @@ impl Cli {
             Some(dir) if p.is_relative() => dir.join(p),
             _ => p,
         };
-        set(&mut c.bind, file.bind);
+        if let Some(b) = &file.bind {
+            c.bind = parse_bind(b).map_err(|message| ConfigError::Parse {
+                path: self.config.clone().unwrap_or_default(),
+                message: format!("bind: {message}"),
+            })?;
+        }
         set(&mut c.level, file.level.map(|p| Some(relative(p))));
         set(
             &mut c.level_settings,
@@ -338,6 +346,27 @@ fn set<T>(slot: &mut T, value: Option<T>) {
     }
 }
 
+/// A listening address: `ADDR:PORT`, `HOST:PORT` (resolved; the first
+/// address) or a bare `PORT` (all interfaces, `0.0.0.0:PORT`).
+pub fn parse_bind(s: &str) -> Result<SocketAddr, String> {
+    let s = s.trim();
+    if let Ok(port) = s.parse::<u16>() {
+        return Ok(SocketAddr::from(([0, 0, 0, 0], port)));
+    }
+    if let Ok(addr) = s.parse::<SocketAddr>() {
+        return Ok(addr);
+    }
+    use std::net::ToSocketAddrs;
+    match s.to_socket_addrs() {
+        Ok(mut addrs) => addrs
+            .next()
+            .ok_or_else(|| format!("{s:?} resolves to no address")),
+        Err(e) => Err(format!(
+            "{s:?} is not ADDR:PORT, HOST:PORT or PORT (e.g. 0.0.0.0:4433, localhost:4433, 4433): {e}"
+        )),
+    }
+}
+
 fn parse_file(text: &str, path: &Path) -> Result<FileConfig, ConfigError> {
     toml::from_str(text).map_err(|e| ConfigError::Parse {
         path: path.to_owned(),
@@ -348,6 +377,26 @@ fn parse_file(text: &str, path: &Path) -> Result<FileConfig, ConfigError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bind_takes_addresses_host_names_and_bare_ports() {
+        assert_eq!(parse_bind("4433"), Ok("0.0.0.0:4433".parse().unwrap()));
+        assert_eq!(
+            parse_bind("127.0.0.1:5000"),
+            Ok("127.0.0.1:5000".parse().unwrap())
+        );
+        assert_eq!(parse_bind("[::1]:5000"), Ok("[::1]:5000".parse().unwrap()));
+        let local = parse_bind("localhost:5001").unwrap();
+        assert!(local.ip().is_loopback() && local.port() == 5001, "{local}");
+        let e = parse_bind("no such host").unwrap_err();
+        assert!(e.contains("is not ADDR:PORT, HOST:PORT or PORT"), "{e}");
+        assert!(parse_bind("70000").is_err());
+        assert_eq!(
+            cli(&["--bind", "6001"]).resolve().unwrap().bind,
+            "0.0.0.0:6001".parse().unwrap()
+        );
+        assert!(Cli::try_parse_from(["ledge-server", "--bind", "nowhere:x"]).is_err());
+    }
 
     fn cli(args: &[&str]) -> Cli {
         Cli::try_parse_from(std::iter::once("ledge-server").chain(args.iter().copied())).unwrap()
