@@ -26,7 +26,7 @@ pub enum ClientError {
         presented: Fingerprint,
     },
     /// The server closed the connection with an application close code.
-    #[error("server closed the connection ({code:?}): {reason}")]
+    #[error("{}", closed_text(*code, reason))]
     ClosedByServer {
         /// The close code, if this version knows it.
         code: Option<CloseCode>,
@@ -96,6 +96,66 @@ impl ClientError {
                 reason: String::from_utf8_lossy(&close.reason).into_owned(),
             },
             other => ClientError::Connection(other),
+        }
+    }
+}
+
+/// Why the server closed the connection, in words (not the close code's
+/// debug form), with the server's own reason when it gave one.
+fn closed_text(code: Option<CloseCode>, reason: &str) -> String {
+    let what = match code {
+        Some(CloseCode::ServerShutdown) => "the server shut down",
+        Some(CloseCode::Kicked) => "the server removed us from the game",
+        Some(CloseCode::Timeout) => "the server closed the connection: we sent nothing in time",
+        Some(CloseCode::ProtocolViolation) => {
+            "the server closed the connection: it could not read what we sent (client and server versions may differ)"
+        }
+        Some(CloseCode::Rejected) => "the server refused us",
+        Some(CloseCode::Normal) => "the server closed the connection",
+        None => "the server closed the connection (a reason this version does not know)",
+    };
+    match reason.trim() {
+        "" => what.to_owned(),
+        r => format!("{what} ({r})"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_server_close_is_told_in_words() {
+        let closed = |code, reason: &str| {
+            ClientError::ClosedByServer {
+                code,
+                reason: reason.into(),
+            }
+            .to_string()
+        };
+        assert_eq!(
+            closed(Some(CloseCode::ServerShutdown), "server shutting down"),
+            "the server shut down (server shutting down)"
+        );
+        assert_eq!(
+            closed(Some(CloseCode::Kicked), ""),
+            "the server removed us from the game"
+        );
+        assert_eq!(
+            closed(None, "bye"),
+            "the server closed the connection (a reason this version does not know) (bye)"
+        );
+        for code in [
+            Some(CloseCode::Normal),
+            Some(CloseCode::ProtocolViolation),
+            Some(CloseCode::Rejected),
+            Some(CloseCode::Timeout),
+            Some(CloseCode::ServerShutdown),
+            Some(CloseCode::Kicked),
+            None,
+        ] {
+            let text = closed(code, "why");
+            assert!(!text.contains("Some(") && !text.contains("None"), "{text}");
         }
     }
 }
