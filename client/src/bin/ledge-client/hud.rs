@@ -178,18 +178,92 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
     draw_text(help, x, y, 16.0, DIM);
 }
 
-/// A centred banner (connecting, disconnected, won).
+/// A centred banner (connecting, disconnected, won), wrapped to the
+/// window's width so a long message is never clipped.
 pub fn banner(text: &str) {
     let size = 28.0;
-    let dims = measure_text(text, None, size as u16, 1.0);
-    let x = (screen_width() - dims.width) / 2.0;
-    let y = screen_height() * 0.3;
+    let max = (screen_width() - 64.0).max(64.0);
+    let lines = wrap(text, max, |t| measure_text(t, None, size as u16, 1.0).width);
+    let line_h = size * 1.15;
+    let widest = lines
+        .iter()
+        .map(|l| measure_text(l, None, size as u16, 1.0).width)
+        .fold(0.0f32, f32::max);
+    let top = screen_height() * 0.3 - size;
     draw_rectangle(
-        x - 16.0,
-        y - dims.offset_y - 12.0,
-        dims.width + 32.0,
-        dims.height + 24.0,
+        (screen_width() - widest) / 2.0 - 16.0,
+        top - 12.0,
+        widest + 32.0,
+        line_h * lines.len() as f32 + 24.0,
         PANEL,
     );
-    draw_text(text, x, y, size, WHITE);
+    for (i, line) in lines.iter().enumerate() {
+        let w = measure_text(line, None, size as u16, 1.0).width;
+        let y = top + size * 0.85 + line_h * i as f32;
+        draw_text(line, (screen_width() - w) / 2.0, y, size, WHITE);
+    }
+}
+
+/// `text` in lines no wider than `max` (by `width`), broken between words;
+/// a word wider than `max` alone is broken between characters.
+pub fn wrap(text: &str, max: f32, width: impl Fn(&str) -> f32) -> Vec<String> {
+    let mut lines = Vec::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        let candidate = if line.is_empty() {
+            word.to_owned()
+        } else {
+            format!("{line} {word}")
+        };
+        if width(&candidate) <= max {
+            line = candidate;
+            continue;
+        }
+        if !line.is_empty() {
+            lines.push(std::mem::take(&mut line));
+        }
+        // The word alone: split it if it does not fit either.
+        for c in word.chars() {
+            let mut next = line.clone();
+            next.push(c);
+            if width(&next) > max && !line.is_empty() {
+                lines.push(std::mem::take(&mut line));
+                line.push(c);
+            } else {
+                line = next;
+            }
+        }
+    }
+    if !line.is_empty() || lines.is_empty() {
+        lines.push(line);
+    }
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrap;
+
+    #[test]
+    fn long_messages_wrap_between_words_and_never_exceed_the_width() {
+        let w = |s: &str| s.chars().count() as f32;
+        let text = "the server plays level \"sandbox2\" (hash 8240e92b1acea947), but the embedded default level has hash 89e9fbc2af16c009: pass the server's level file (--level)";
+        let lines = wrap(text, 30.0, w);
+        assert!(lines.len() > 3, "{lines:?}");
+        assert!(lines.iter().all(|l| w(l) <= 30.0), "{lines:?}");
+        // Nothing lost, nothing added but line breaks.
+        assert_eq!(
+            lines.join(" ").split_whitespace().collect::<Vec<_>>(),
+            text.split_whitespace().collect::<Vec<_>>()
+        );
+        // A word longer than a line is split.
+        let long = "x".repeat(75);
+        let lines = wrap(&long, 30.0, w);
+        assert_eq!(
+            lines.iter().map(|l| l.len()).collect::<Vec<_>>(),
+            [30, 30, 15]
+        );
+        assert_eq!(wrap("", 30.0, w), [""]);
+        assert_eq!(wrap("short", 30.0, w), ["short"]);
+    }
 }
