@@ -13,8 +13,12 @@
 //! missing `xvfb-run` fails the test.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+mod common;
+
+use std::process::Command;
+use std::time::Duration;
+
+use common::run_to_end;
 
 use serde_json::Value;
 
@@ -158,7 +162,8 @@ fn run_client(xvfb: &Path, map: &Path, look_at: (f64, f64), name: &str) -> (Png,
         .unwrap_or_else(|| out.path().to_owned());
     std::fs::create_dir_all(&dir).unwrap();
     let png_path = dir.join(name);
-    let mut child = Command::new(xvfb)
+    let mut command = Command::new(xvfb);
+    command
         .args(["-a", "-s", "-screen 0 1280x720x24"])
         .arg(env!("CARGO_BIN_EXE_ledge-client"))
         .arg("--level")
@@ -168,23 +173,14 @@ fn run_client(xvfb: &Path, map: &Path, look_at: (f64, f64), name: &str) -> (Png,
         .arg(&png_path)
         .args(["--look-at", &format!("{},{}", look_at.0, look_at.1)])
         .args(["--window", "960x540"])
-        .env("LIBGL_ALWAYS_SOFTWARE", "1")
-        .stdin(Stdio::null())
-        .spawn()
-        .expect("xvfb-run starts");
-    let deadline = Instant::now() + CLIENT_TIMEOUT;
-    let status = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break status;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("the client did not exit within {CLIENT_TIMEOUT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    };
-    assert!(status.success(), "the client failed: {status}");
+        .env("LIBGL_ALWAYS_SOFTWARE", "1");
+    let out = run_to_end(command, CLIENT_TIMEOUT);
+    let status = out.status;
+    assert!(
+        status.success(),
+        "the client failed: {status}; stderr:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let json: Value = serde_json::from_str(
         &std::fs::read_to_string(dir.join(format!("{name}.json"))).expect("the screenshot's JSON"),
     )

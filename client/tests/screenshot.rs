@@ -9,8 +9,12 @@
 
 use std::net::SocketAddr;
 use std::path::Path;
-use std::process::{Command, Stdio};
+mod common;
+
+use std::process::Command;
 use std::time::{Duration, Instant};
+
+use common::run_to_end;
 
 use ledge_client::{connect, Session};
 use ledge_levels::default_level;
@@ -164,7 +168,8 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
         .unwrap_or_else(|| out.path().to_owned());
     std::fs::create_dir_all(&dir).unwrap();
     let png_path = dir.join("shot.png");
-    let mut child = Command::new(xvfb)
+    let mut command = Command::new(xvfb);
+    command
         .args(["-a", "-s", "-screen 0 1280x720x24"])
         .arg(env!("CARGO_BIN_EXE_ledge-client"))
         .args(["--connect", &addr.to_string()])
@@ -175,28 +180,19 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
         .arg("--screenshot")
         .arg(&png_path)
         .args(["--window", "960x540"])
-        .env("LIBGL_ALWAYS_SOFTWARE", "1")
-        .stdin(Stdio::null())
-        .spawn()
-        .expect("xvfb-run starts");
-    let deadline = Instant::now() + CLIENT_TIMEOUT;
-    let status = loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            break status;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("the client did not exit within {CLIENT_TIMEOUT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    };
+        .env("LIBGL_ALWAYS_SOFTWARE", "1");
+    let out = run_to_end(command, CLIENT_TIMEOUT);
+    let status = out.status;
     runtime.block_on(bob.close());
     shutdown.shutdown();
     runtime.block_on(async {
         let _ = tokio::time::timeout(Duration::from_secs(5), task).await;
     });
-    assert!(status.success(), "the client failed: {status}");
+    assert!(
+        status.success(),
+        "the client failed: {status}; stderr:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 
     let json_path = dir.join("shot.png.json");
     let json: Value = serde_json::from_str(
