@@ -18,7 +18,7 @@ mod common;
 use std::process::Command;
 use std::time::Duration;
 
-use common::run_to_end;
+use common::{pair, run_to_end, xvfb_run, Png};
 
 use serde_json::Value;
 
@@ -46,13 +46,6 @@ fn notice(what: &str) {
     let _ = std::io::Write::write_all(&mut std::io::stderr(), text.as_bytes());
 }
 
-fn xvfb_run() -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|dir| dir.join("xvfb-run"))
-        .find(|p| p.is_file())
-}
-
 fn ci() -> bool {
     std::env::var("CI").as_deref() == Ok("true")
 }
@@ -72,54 +65,6 @@ fn corpus_image() -> Option<PathBuf> {
         );
     }
     image.is_file().then_some(image)
-}
-
-/// An RGBA picture.
-struct Png {
-    width: u32,
-    height: u32,
-    rgba: Vec<u8>,
-}
-
-impl Png {
-    fn load(path: &Path) -> Png {
-        let file = std::fs::File::open(path).expect("PNG exists");
-        let mut decoder = png::Decoder::new(file);
-        decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-        let mut reader = decoder.read_info().expect("a PNG");
-        let mut buf = vec![0; reader.output_buffer_size()];
-        let info = reader.next_frame(&mut buf).expect("PNG data");
-        buf.truncate(info.buffer_size());
-        let rgba = match info.color_type {
-            png::ColorType::Rgba => buf,
-            png::ColorType::Rgb => buf
-                .chunks(3)
-                .flat_map(|c| [c[0], c[1], c[2], 255])
-                .collect(),
-            png::ColorType::GrayscaleAlpha => buf
-                .chunks(2)
-                .flat_map(|c| [c[0], c[0], c[0], c[1]])
-                .collect(),
-            png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g, 255]).collect(),
-            other => panic!("unexpected PNG colour type {other:?}"),
-        };
-        Png {
-            width: info.width,
-            height: info.height,
-            rgba,
-        }
-    }
-
-    fn at(&self, x: u32, y: u32) -> [u8; 4] {
-        assert!(x < self.width && y < self.height, "({x}, {y}) outside");
-        let i = (y as usize * self.width as usize + x as usize) * 4;
-        [
-            self.rgba[i],
-            self.rgba[i + 1],
-            self.rgba[i + 2],
-            self.rgba[i + 3],
-        ]
-    }
 }
 
 /// The tileset pixel that Tiled shows at `(u, v)` of tile `gid` (first gid
@@ -145,11 +90,6 @@ fn texel(tiles: &Png, gid: u32, u: u32, v: u32) -> [u8; 4] {
 fn over(top: [u8; 4], under: [u8; 4]) -> [u8; 3] {
     let a = top[3] as f64 / 255.0;
     [0, 1, 2].map(|i| (top[i] as f64 * a + under[i] as f64 * (1.0 - a)).round() as u8)
-}
-
-fn pair(v: &Value) -> (f64, f64) {
-    let a = v.as_array().expect("[x, y]");
-    (a[0].as_f64().unwrap(), a[1].as_f64().unwrap())
 }
 
 /// Runs the real client under Xvfb offline on `map`, the camera on

@@ -8,13 +8,12 @@
 //! loud notice and passes without checking anything.
 
 use std::net::SocketAddr;
-use std::path::Path;
 mod common;
 
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use common::run_to_end;
+use common::{pair, run_to_end, xvfb_run, Png};
 
 use ledge_client::{connect, Session};
 use ledge_levels::default_level;
@@ -56,57 +55,6 @@ async fn bob_runs_left(
     bob
 }
 
-fn xvfb_run() -> Option<std::path::PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|dir| dir.join("xvfb-run"))
-        .find(|p| p.is_file())
-}
-
-struct Png {
-    width: u32,
-    height: u32,
-    rgba: Vec<u8>,
-}
-
-impl Png {
-    fn load(path: &Path) -> Png {
-        let file = std::fs::File::open(path).expect("screenshot exists");
-        let mut decoder = png::Decoder::new(file);
-        decoder.set_transformations(png::Transformations::EXPAND);
-        let mut reader = decoder.read_info().expect("a PNG");
-        let mut buf = vec![0; reader.output_buffer_size()];
-        let info = reader.next_frame(&mut buf).expect("PNG data");
-        buf.truncate(info.buffer_size());
-        let channels = match info.color_type {
-            png::ColorType::Rgba => 4,
-            png::ColorType::Rgb => 3,
-            other => panic!("unexpected PNG colour type {other:?}"),
-        };
-        let rgba = if channels == 4 {
-            buf
-        } else {
-            buf.chunks(3)
-                .flat_map(|c| [c[0], c[1], c[2], 255])
-                .collect()
-        };
-        Png {
-            width: info.width,
-            height: info.height,
-            rgba,
-        }
-    }
-
-    fn at(&self, x: f64, y: f64) -> Option<[u8; 3]> {
-        let (x, y) = (x.floor(), y.floor());
-        if x < 0.0 || y < 0.0 || x >= self.width as f64 || y >= self.height as f64 {
-            return None;
-        }
-        let i = (y as usize * self.width as usize + x as usize) * 4;
-        Some([self.rgba[i], self.rgba[i + 1], self.rgba[i + 2]])
-    }
-}
-
 fn close(a: [u8; 3], b: [u8; 3]) -> bool {
     a.iter().zip(b).all(|(&x, y)| x.abs_diff(y) <= 3)
 }
@@ -114,11 +62,6 @@ fn close(a: [u8; 3], b: [u8; 3]) -> bool {
 fn rgb(v: &Value) -> [u8; 3] {
     let a = v.as_array().expect("[r, g, b]");
     [0, 1, 2].map(|i| a[i].as_u64().expect("byte") as u8)
-}
-
-fn pair(v: &Value) -> (f64, f64) {
-    let a = v.as_array().expect("[x, y]");
-    (a[0].as_f64().unwrap(), a[1].as_f64().unwrap())
 }
 
 #[test]
@@ -234,14 +177,14 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
             let around = [(-1, 0), (1, 0), (0, -1), (0, 1)].map(|(dc, dr)| tile(c + dc, r + dr));
             if around.iter().all(|&n| n == Tile::Solid) {
                 let (sx, sy) = to_screen(x + t / 2.0, y + t / 2.0);
-                if let Some(p) = img.at(sx, sy) {
+                if let Some(p) = img.rgb_at(sx, sy) {
                     interior += 1;
                     solid_ok += close(p, solid) as u32;
                 }
             }
             if tile(c, r - 1) == Tile::Empty {
                 let (sx, sy) = to_screen(x + t / 2.0, y + 1.0);
-                if let Some(p) = img.at(sx, sy) {
+                if let Some(p) = img.rgb_at(sx, sy) {
                     tops += 1;
                     grass_ok += close(p, grass) as u32;
                 }
@@ -289,7 +232,7 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
     let mut body = 0;
     for ddy in -3..=3 {
         for ddx in -3..=3 {
-            let p = img.at(cx + ddx as f64, cy + 2.0 + ddy as f64).unwrap();
+            let p = img.rgb_at(cx + ddx as f64, cy + 2.0 + ddy as f64).unwrap();
             body += close(p, me) as u32;
         }
     }
@@ -302,7 +245,7 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
     let mut total = 0;
     for y in 0..img.height {
         for x in 0..img.width {
-            if close(img.at(x as f64, y as f64).unwrap(), me) {
+            if close(img.rgb_at(x as f64, y as f64).unwrap(), me) {
                 total += 1;
                 let (fx, fy) = (x as f64 + 0.5, y as f64 + 0.5);
                 if (fx - cx).abs() > hw + 3.0 || (fy - cy).abs() > hh + 3.0 {
@@ -340,7 +283,7 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
     for y in (head - 26.0) as i32..(head - 2.0) as i32 {
         for x in (bx - 24.0) as i32..(bx + 24.0) as i32 {
             white += img
-                .at(x as f64, y as f64)
+                .rgb_at(x as f64, y as f64)
                 .is_some_and(|p| p.iter().all(|&c| c >= 250)) as u32;
         }
     }
@@ -348,7 +291,7 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
         white >= 10,
         "only {white} white label pixels above bob at ({bx}, {head})"
     );
-    let body = img.at(bx, by + 2.0).expect("bob on screen");
+    let body = img.rgb_at(bx, by + 2.0).expect("bob on screen");
     assert!(!close(body, sky), "bob's body is drawn: {body:?}");
 
     // Background around it, where the level is empty (no tile, no entity
@@ -389,7 +332,7 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
             continue;
         }
         let (sx, sy) = to_screen(wx, wy);
-        let p = img.at(sx, sy).expect("on screen");
+        let p = img.rgb_at(sx, sy).expect("on screen");
         assert!(
             close(p, sky),
             "background {sky:?} expected at world ({wx}, {wy}), screen ({sx}, {sy}): {p:?}"

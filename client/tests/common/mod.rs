@@ -86,3 +86,78 @@ pub fn run_to_end(mut command: Command, timeout: Duration) -> Output {
     }
     child.wait_with_output().unwrap()
 }
+
+/// `xvfb-run` on `PATH`, if any (the screenshot tests run the window
+/// under it).
+pub fn xvfb_run() -> Option<std::path::PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join("xvfb-run"))
+        .find(|p| p.is_file())
+}
+
+/// A JSON `[x, y]` pair.
+pub fn pair(v: &serde_json::Value) -> (f64, f64) {
+    let a = v.as_array().expect("[x, y]");
+    (a[0].as_f64().unwrap(), a[1].as_f64().unwrap())
+}
+
+/// An RGBA picture.
+pub struct Png {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+}
+
+impl Png {
+    /// Loads a PNG of any colour type as RGBA.
+    pub fn load(path: &std::path::Path) -> Png {
+        let file = std::fs::File::open(path).expect("the PNG exists");
+        let mut decoder = png::Decoder::new(file);
+        decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+        let mut reader = decoder.read_info().expect("a PNG");
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).expect("PNG data");
+        buf.truncate(info.buffer_size());
+        let rgba = match info.color_type {
+            png::ColorType::Rgba => buf,
+            png::ColorType::Rgb => buf
+                .chunks(3)
+                .flat_map(|c| [c[0], c[1], c[2], 255])
+                .collect(),
+            png::ColorType::GrayscaleAlpha => buf
+                .chunks(2)
+                .flat_map(|c| [c[0], c[0], c[0], c[1]])
+                .collect(),
+            png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g, 255]).collect(),
+            other => panic!("unexpected PNG colour type {other:?}"),
+        };
+        Png {
+            width: info.width,
+            height: info.height,
+            rgba,
+        }
+    }
+
+    /// The pixel at `(x, y)`, which must lie inside.
+    pub fn at(&self, x: u32, y: u32) -> [u8; 4] {
+        assert!(x < self.width && y < self.height, "({x}, {y}) outside");
+        let i = (y as usize * self.width as usize + x as usize) * 4;
+        [
+            self.rgba[i],
+            self.rgba[i + 1],
+            self.rgba[i + 2],
+            self.rgba[i + 3],
+        ]
+    }
+
+    /// The RGB of the pixel under the point `(x, y)`; `None` outside.
+    pub fn rgb_at(&self, x: f64, y: f64) -> Option<[u8; 3]> {
+        let (x, y) = (x.floor(), y.floor());
+        if x < 0.0 || y < 0.0 || x >= self.width as f64 || y >= self.height as f64 {
+            return None;
+        }
+        let [r, g, b, _] = self.at(x as u32, y as u32);
+        Some([r, g, b])
+    }
+}
