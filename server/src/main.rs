@@ -81,6 +81,10 @@ fn say(line: std::fmt::Arguments<'_>) {
 
 /// Ctrl-C and, on Unix, SIGTERM.
 struct ShutdownSignals {
+    /// SIGINT, registered at once: `tokio::signal::ctrl_c()` registers only
+    /// when first polled, and a Ctrl-C before that killed the process.
+    #[cfg(unix)]
+    int: tokio::signal::unix::Signal,
     #[cfg(unix)]
     term: tokio::signal::unix::Signal,
 }
@@ -88,34 +92,40 @@ struct ShutdownSignals {
 impl ShutdownSignals {
     /// Registers the handlers now, so a failure stops the start-up.
     fn install() -> std::io::Result<ShutdownSignals> {
+        #[cfg(unix)]
+        use tokio::signal::unix::{signal, SignalKind};
         Ok(ShutdownSignals {
             #[cfg(unix)]
-            term: tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?,
+            int: signal(SignalKind::interrupt())?,
+            #[cfg(unix)]
+            term: signal(SignalKind::terminate())?,
         })
     }
 
     /// Resolves on the first signal, naming it.
     async fn recv(mut self) -> &'static str {
-        let ctrl_c = async {
-            match tokio::signal::ctrl_c().await {
-                Ok(()) => "Ctrl-C",
-                Err(e) => {
-                    tracing::error!("cannot listen for Ctrl-C: {e}");
-                    std::future::pending().await
-                }
-            }
-        };
         #[cfg(unix)]
         {
             tokio::select! {
-                name = ctrl_c => name,
+                _ = self.int.recv() => "Ctrl-C",
                 _ = self.term.recv() => "SIGTERM",
             }
         }
         #[cfg(not(unix))]
         {
             let _ = &mut self;
-            ctrl_c.await
+            Self::ctrl_c().await
+        }
+    }
+
+    #[cfg(not(unix))]
+    async fn ctrl_c() -> &'static str {
+        match tokio::signal::ctrl_c().await {
+            Ok(()) => "Ctrl-C",
+            Err(e) => {
+                tracing::error!("cannot listen for Ctrl-C: {e}");
+                std::future::pending().await
+            }
         }
     }
 }
