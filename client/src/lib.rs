@@ -53,8 +53,8 @@ pub use game::ClientGame;
 pub use ledge_shared::protocol::Fingerprint;
 pub use online::{OnlineGame, OnlineRequest};
 pub use session::{
-    connect, connect_with, handshake, JoinOptions, Session, SessionEvent, SessionStats,
+    connect, connect_with, handshake, list_rooms, JoinOptions, Session, SessionEvent, SessionStats,
     SnapshotUpdate,
 };
-pub use trust::{connect_trusted, Trust};
+pub use trust::{connect_trusted, dial_trusted, list_rooms_trusted, Trust};
 pub use view::{EntityDraw, Facing, FrameView, NetStats, PlayerDraw};

@@ -18,8 +18,8 @@ use std::time::{Duration, Instant};
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
     write_frame, ClientControl, CloseCode, Fingerprint, FrameDecoder, InputPacket, Message,
-    NoticeKind, PlayerId, RosterEntry, ServerControl, Snapshot, SnapshotHistory, StateSnapshot,
-    Welcome, MAX_FRAME, MAX_INPUT_HISTORY, MAX_ROSTER, PROTOCOL_VERSION,
+    NoticeKind, PlayerId, RoomInfo, RosterEntry, ServerControl, Snapshot, SnapshotHistory,
+    StateSnapshot, Welcome, MAX_FRAME, MAX_INPUT_HISTORY, MAX_ROSTER, PROTOCOL_VERSION,
 };
 
 use crate::error::ClientError;
@@ -115,34 +115,16 @@ pub async fn handshake(dialed: Dialed, hello: ClientControl) -> Result<Session, 
         connection,
     } = dialed;
     let mut decoder = FrameDecoder::new(MAX_FRAME);
-    let result = tokio::time::timeout(REPLY_TIMEOUT, async {
-        let (mut send, mut recv) = connection
-            .open_bi()
-            .await
-            .map_err(ClientError::from_connection_error)?;
-        let mut frame = Vec::new();
-        write_frame(&hello, &mut frame)?;
-        send.write_all(&frame)
-            .await
-            .map_err(|e| ClientError::Stream(e.to_string()))?;
-        let mut buf = vec![0u8; 8192];
-        loop {
-            if let Some(message) = decoder.pop_message::<ServerControl>() {
-                return match message? {
-                    ServerControl::Welcome(welcome) => Ok((send, recv, welcome)),
-                    ServerControl::Reject { reason } => Err(ClientError::Rejected(reason)),
-                    other => Err(ClientError::Unexpected(format!("{other:?} before welcome"))),
-                };
-            }
-            match recv.read(&mut buf).await {
-                Ok(Some(n)) => decoder.push(&buf[..n])?,
-                Ok(None) => return Err(ClientError::StreamEnded),
-                Err(e) => return Err(ClientError::Stream(e.to_string())),
-            }
-        }
-    })
-    .await
-    .unwrap_or(Err(ClientError::Timeout));
+    let result = ask(&connection, &hello, &mut decoder)
+        .await
+        .and_then(|(send, recv, answer)| match answer {
+            ServerControl::Welcome(welcome) => Ok((send, recv, welcome)),
+            ServerControl::Reject { reason } => Err(ClientError::Rejected(reason)),
+            other => Err(ClientError::Unexpected(format!(
+                "{} before the welcome",
+                other.kind()
+            ))),
+        });
     match result {
         Ok((send, recv, welcome)) => Ok(Session {
             endpoint,
@@ -168,6 +150,67 @@ pub async fn handshake(dialed: Dialed, hello: ClientControl) -> Result<Session, 
             Err(e)
         }
     }
+}
+
+/// Opens the control stream, sends `first` and reads the server's first
+/// answer (within [`REPLY_TIMEOUT`]).
+async fn ask(
+    connection: &quinn::Connection,
+    first: &ClientControl,
+    decoder: &mut FrameDecoder,
+) -> Result<(quinn::SendStream, quinn::RecvStream, ServerControl), ClientError> {
+    tokio::time::timeout(REPLY_TIMEOUT, async {
+        let (mut send, mut recv) = connection
+            .open_bi()
+            .await
+            .map_err(ClientError::from_connection_error)?;
+        let mut frame = Vec::new();
+        write_frame(first, &mut frame)?;
+        send.write_all(&frame)
+            .await
+            .map_err(|e| ClientError::Stream(e.to_string()))?;
+        let mut buf = vec![0u8; 8192];
+        loop {
+            if let Some(message) = decoder.pop_message::<ServerControl>() {
+                return Ok((send, recv, message?));
+            }
+            match recv.read(&mut buf).await {
+                Ok(Some(n)) => decoder.push(&buf[..n])?,
+                Ok(None) => return Err(ClientError::StreamEnded),
+                Err(e) => return Err(ClientError::Stream(e.to_string())),
+            }
+        }
+    })
+    .await
+    .unwrap_or(Err(ClientError::Timeout))
+}
+
+/// Asks a dialed server for its rooms (`ListRooms`) instead of joining,
+/// then closes the connection.
+pub async fn list_rooms(dialed: Dialed) -> Result<Vec<RoomInfo>, ClientError> {
+    let Dialed {
+        endpoint,
+        connection,
+    } = dialed;
+    let first = ClientControl::ListRooms {
+        version: PROTOCOL_VERSION,
+    };
+    let mut decoder = FrameDecoder::new(MAX_FRAME);
+    let result = ask(&connection, &first, &mut decoder)
+        .await
+        .and_then(|(_, _, answer)| match answer {
+            ServerControl::Rooms { rooms } => Ok(rooms),
+            ServerControl::Reject { reason } => Err(ClientError::Rejected(reason)),
+            other => Err(ClientError::Unexpected(format!(
+                "{} instead of the room list",
+                other.kind()
+            ))),
+        })
+        .map_err(|e| explain(&connection, e));
+    connection.close(CloseCode::Normal.to_u32().into(), b"listed");
+    // Lets the close reach the server (bounded: it may be gone).
+    let _ = tokio::time::timeout(CLOSE_LINGER, endpoint.wait_idle()).await;
+    result
 }
 
 /// Replaces a stream-level error by the connection's close reason when the
@@ -523,8 +566,10 @@ impl Session {
             }
             ServerControl::PlayerJoined(entry) => self.player_joined(entry),
             ServerControl::PlayerLeft { id } => self.player_left(id),
-            ServerControl::Welcome(_) | ServerControl::Reject { .. } => {
-                tracing::warn!("ignoring a second welcome or reject");
+            ServerControl::Welcome(_)
+            | ServerControl::Reject { .. }
+            | ServerControl::Rooms { .. } => {
+                tracing::warn!("ignoring a second welcome, a reject or a room list");
             }
         }
     }

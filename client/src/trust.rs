@@ -16,11 +16,11 @@ use std::fmt;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use ledge_shared::protocol::Fingerprint;
+use ledge_shared::protocol::{Fingerprint, RoomInfo};
 
 use crate::error::ClientError;
-use crate::session::{handshake, JoinOptions, Session};
-use crate::transport::{dial_any_or, resolve};
+use crate::session::{handshake, list_rooms, JoinOptions, Session};
+use crate::transport::{dial_any_or, resolve, Dialed};
 
 /// How to trust the server's certificate.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -258,10 +258,7 @@ pub enum Trusted {
 }
 
 /// Connects to `server` (`HOST:PORT`) and joins with `options`, trusting
-/// the certificate as `trust` says. With [`Trust::KnownHosts`], an address
-/// not in the file is trusted and stored (after the TLS handshake proved
-/// the server holds the certificate's key); a known address must present
-/// the stored certificate, else [`TrustError::Changed`].
+/// the certificate as `trust` says (see [`dial_trusted`]).
 pub async fn connect_trusted(
     server: &str,
     trust: &Trust,
@@ -269,6 +266,27 @@ pub async fn connect_trusted(
 ) -> Result<(Session, Trusted), ClientError> {
     let hello = options.hello();
     ledge_shared::protocol::Message::validate(&hello)?;
+    let (dialed, trusted) = dial_trusted(server, trust).await?;
+    let session = handshake(dialed, hello).await?;
+    Ok((session, trusted))
+}
+
+/// Lists the rooms of `server` (`HOST:PORT`), trusting its certificate as
+/// `trust` says (see [`dial_trusted`]).
+pub async fn list_rooms_trusted(
+    server: &str,
+    trust: &Trust,
+) -> Result<(Vec<RoomInfo>, Trusted), ClientError> {
+    let (dialed, trusted) = dial_trusted(server, trust).await?;
+    Ok((list_rooms(dialed).await?, trusted))
+}
+
+/// Connects to `server` (`HOST:PORT`), trusting the certificate as `trust`
+/// says. With [`Trust::KnownHosts`], an address not in the file is trusted
+/// and stored (after the TLS handshake proved the server holds the
+/// certificate's key); a known address must present the stored
+/// certificate, else [`TrustError::Changed`].
+pub async fn dial_trusted(server: &str, trust: &Trust) -> Result<(Dialed, Trusted), ClientError> {
     let (addr, server_name) = resolve(server).await?;
     let (pin, known) = match trust {
         Trust::Pinned(pin) => (Some(*pin), None),
@@ -296,8 +314,7 @@ pub async fn connect_trusted(
             Trusted::FirstUse(presented)
         }
     };
-    let session = handshake(dialed, hello).await?;
-    Ok((session, trusted))
+    Ok((dialed, trusted))
 }
 
 #[cfg(test)]

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use clap::Parser;
+use ledge_shared::protocol::MAX_ROOMS;
 use serde::Deserialize;
 
 /// Default UDP address the server listens on.
@@ -25,6 +26,9 @@ pub const DEFAULT_SNAPSHOT_RATE: u32 = 30;
 pub const DEFAULT_MAX_PLAYERS: usize = 16;
 /// Default number of rooms.
 pub const DEFAULT_ROOMS: u32 = 1;
+/// Default most rooms at once, counting those players open by name (the
+/// cap is at least `rooms`).
+pub const DEFAULT_MAX_ROOMS: u32 = 16;
 /// Default most simultaneous connections (players and handshakes).
 pub const DEFAULT_MAX_CONNECTIONS: usize = 256;
 /// Default bound on ticks run back to back after a stall (0.25 s at 60 Hz).
@@ -96,8 +100,13 @@ pub struct ServerConfig {
     pub snapshot_rate: u32,
     /// Most players in one room.
     pub max_players: usize,
-    /// Number of rooms (named `room-1`, `room-2`, ...).
+    /// Number of rooms open from the start and never closed (named
+    /// `room-1`, `room-2`, ...).
     pub rooms: u32,
+    /// Most rooms at once: a client asking for a room by a new name opens
+    /// it while fewer are open (it closes once empty for a while). At least
+    /// `rooms`, at most [`MAX_ROOMS`].
+    pub max_rooms: u32,
     /// Most simultaneous connections; more are refused at once.
     pub max_connections: usize,
     /// TCP address of the Prometheus metrics endpoint; `None`: no endpoint.
@@ -126,6 +135,7 @@ impl Default for ServerConfig {
             snapshot_rate: DEFAULT_SNAPSHOT_RATE,
             max_players: DEFAULT_MAX_PLAYERS,
             rooms: DEFAULT_ROOMS,
+            max_rooms: DEFAULT_MAX_ROOMS,
             max_connections: DEFAULT_MAX_CONNECTIONS,
             metrics_bind: None,
             max_catch_up: DEFAULT_MAX_CATCH_UP,
@@ -156,8 +166,16 @@ impl ServerConfig {
         if self.max_players == 0 {
             return bad("max_players must be at least 1");
         }
-        if self.rooms == 0 || self.rooms > 1000 {
-            return bad("rooms must be 1..=1000");
+        if self.rooms == 0 || self.rooms as usize > MAX_ROOMS {
+            return Err(ConfigError::Invalid(format!(
+                "rooms must be 1..={MAX_ROOMS}"
+            )));
+        }
+        if self.max_rooms < self.rooms || self.max_rooms as usize > MAX_ROOMS {
+            return Err(ConfigError::Invalid(format!(
+                "max_rooms must be rooms ({})..={MAX_ROOMS}",
+                self.rooms
+            )));
         }
         if self.max_connections == 0 {
             return bad("max_connections must be at least 1");
@@ -244,9 +262,13 @@ pub struct Cli {
     /// Most players per room [default: 16].
     #[arg(long, value_name = "N")]
     pub max_players: Option<usize>,
-    /// Number of rooms [default: 1].
+    /// Rooms open from the start (room-1, room-2, ...) [default: 1].
     #[arg(long, value_name = "N")]
     pub rooms: Option<u32>,
+    /// Most rooms at once, counting rooms players open by name with
+    /// `--room NAME` [default: 16, or --rooms if more].
+    #[arg(long, value_name = "N")]
+    pub max_rooms: Option<u32>,
     /// Most simultaneous connections [default: 256].
     #[arg(long, value_name = "N")]
     pub max_connections: Option<usize>,
@@ -271,6 +293,7 @@ struct FileConfig {
     snapshot_rate: Option<u32>,
     max_players: Option<usize>,
     rooms: Option<u32>,
+    max_rooms: Option<u32>,
     max_connections: Option<usize>,
     cert_dir: Option<PathBuf>,
     metrics_bind: Option<SocketAddr>,
@@ -315,6 +338,7 @@ impl Cli {
         set(&mut c.snapshot_rate, file.snapshot_rate);
         set(&mut c.max_players, file.max_players);
         set(&mut c.rooms, file.rooms);
+        set(&mut c.max_rooms, file.max_rooms);
         set(&mut c.max_connections, file.max_connections);
         set(&mut c.cert_dir, file.cert_dir.map(relative));
         set(&mut c.metrics_bind, file.metrics_bind.map(Some));
@@ -332,6 +356,11 @@ impl Cli {
         set(&mut c.snapshot_rate, self.snapshot_rate);
         set(&mut c.max_players, self.max_players);
         set(&mut c.rooms, self.rooms);
+        set(&mut c.max_rooms, self.max_rooms);
+        // Unless set, the cap follows a larger number of rooms.
+        if file.max_rooms.is_none() && self.max_rooms.is_none() {
+            c.max_rooms = c.max_rooms.max(c.rooms);
+        }
         set(&mut c.max_connections, self.max_connections);
         set(&mut c.cert_dir, self.cert_dir.clone());
         set(&mut c.metrics_bind, self.metrics_bind.map(Some));
@@ -500,10 +529,25 @@ datagrams_per_second = 500.0
             &["--snapshot-rate", "61"],
             &["--max-players", "0"],
             &["--rooms", "0"],
+            &["--rooms", "257"],
+            &["--rooms", "3", "--max-rooms", "2"],
+            &["--max-rooms", "257"],
         ] {
             let err = cli(args).resolve().unwrap_err();
             assert!(matches!(err, ConfigError::Invalid(_)), "{args:?}: {err}");
         }
+    }
+
+    #[test]
+    fn the_room_cap_follows_the_rooms_unless_set() {
+        let c = cli(&[]).resolve().unwrap();
+        assert_eq!((c.rooms, c.max_rooms), (1, DEFAULT_MAX_ROOMS));
+        let c = cli(&["--rooms", "20"]).resolve().unwrap();
+        assert_eq!((c.rooms, c.max_rooms), (20, 20));
+        let c = cli(&["--rooms", "2", "--max-rooms", "5"])
+            .resolve()
+            .unwrap();
+        assert_eq!((c.rooms, c.max_rooms), (2, 5));
     }
 
     #[test]

@@ -40,6 +40,7 @@ use crate::config::Limits;
 use crate::metrics::{Channel, ClientBytes, DropReason, KickLabel, KickReason, Metrics};
 use crate::ratelimit::TokenBucket;
 use crate::room::{self, ClientLink, JoinError, Outbound, PlayerInbox, RoomHandle};
+use crate::rooms::Rooms;
 
 /// How long a client has from connecting to finishing its `Hello`.
 pub const HELLO_TIMEOUT: Duration = Duration::from_secs(5);
@@ -51,7 +52,8 @@ pub const CLIENT_MAX_FRAME: usize = 1024;
 /// Frames queued for one client's control stream; more are dropped.
 pub const CONTROL_QUEUE: usize = 64;
 
-/// How long a rejected client gets to receive the `Reject` before the close.
+/// How long a rejected client gets to receive the `Reject` (or a lister
+/// its room list) before the close.
 const REJECT_LINGER: Duration = Duration::from_secs(1);
 /// How long a departing client gets to receive what was queued for it.
 const LEAVE_LINGER: Duration = Duration::from_millis(500);
@@ -63,8 +65,8 @@ pub const SHUTDOWN_LINGER: Duration = Duration::from_secs(1);
 /// What every connection task shares.
 #[derive(Debug)]
 pub struct Shared {
-    /// The rooms, in name order.
-    pub rooms: Vec<RoomHandle>,
+    /// The open rooms.
+    pub rooms: Rooms,
     /// Metrics.
     pub metrics: Arc<Metrics>,
     /// Per-client limits.
@@ -132,7 +134,7 @@ enum End {
 /// Removes the player from its room, and its metric series, however the
 /// session ends.
 struct Membership<'a> {
-    room: &'a RoomHandle,
+    room: RoomHandle,
     player_id: PlayerId,
     metrics: &'a Metrics,
 }
@@ -155,13 +157,17 @@ async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
         }
     };
 
-    let (version, name, wanted_room) = match &hello {
-        Ok(hello) => hello.as_hello().expect("handshake returns a hello"),
+    let first = match hello {
+        Ok(first) => first,
         Err(reason) => {
-            reject(&mut send, reason).await;
+            reject(&mut send, &reason).await;
             return Err(End::Close(CloseCode::Rejected, reason.to_string()));
         }
     };
+    if let ClientControl::ListRooms { version } = first {
+        return list_rooms(&mut send, shared, version).await;
+    }
+    let (version, name, wanted_room) = first.as_hello().expect("handshake returns a hello");
     let rejection = if check_version(version).is_err() {
         Some(RejectReason::ProtocolVersion {
             server: PROTOCOL_VERSION,
@@ -193,7 +199,7 @@ async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
             return Err(End::Close(CloseCode::Rejected, reason.to_string()));
         }
     };
-    let _membership = Membership {
+    let membership = Membership {
         room,
         player_id,
         metrics: &shared.metrics,
@@ -214,7 +220,7 @@ async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
     ));
     let mut client = Client {
         shared,
-        room,
+        room: &membership.room,
         player_id,
         inbox: joined.inbox,
         bytes,
@@ -271,31 +277,16 @@ async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
     }
 }
 
-/// Joins the wanted room, or the least full one with a free place.
-async fn join<'a>(
-    shared: &'a Shared,
+/// Joins the wanted room (opening it if need be), or the least full one
+/// with a free place.
+async fn join(
+    shared: &Shared,
     wanted: Option<&str>,
     player_id: PlayerId,
     name: &str,
     link: ClientLink,
-) -> Result<(&'a RoomHandle, room::Joined), RejectReason> {
-    let candidates: Vec<&RoomHandle> = match wanted {
-        Some(wanted) => match shared.rooms.iter().find(|r| r.name() == wanted) {
-            Some(room) => vec![room],
-            None => {
-                return Err(RejectReason::Other {
-                    reason: format!("there is no room named {wanted:?}"),
-                })
-            }
-        },
-        None => {
-            let mut rooms: Vec<&RoomHandle> = shared.rooms.iter().collect();
-            // Stable: the first of equally full rooms.
-            rooms.sort_by_key(|r| r.players());
-            rooms
-        }
-    };
-    for room in candidates {
+) -> Result<(RoomHandle, room::Joined), RejectReason> {
+    for room in shared.rooms.for_join(wanted, Instant::now())? {
         if wanted.is_none() && !room.has_room() {
             continue;
         }
@@ -309,12 +300,30 @@ async fn join<'a>(
     Err(RejectReason::RoomFull)
 }
 
-/// The client's hello, or the polite rejection of a hello that failed
-/// validation.
+/// Answers a `ListRooms` (or rejects another protocol version) and ends
+/// the session normally.
+async fn list_rooms(send: &mut SendStream, shared: &Shared, version: u32) -> Result<(), End> {
+    if check_version(version).is_err() {
+        let reason = RejectReason::ProtocolVersion {
+            server: PROTOCOL_VERSION,
+            client: version,
+        };
+        reject(send, &reason).await;
+        return Err(End::Close(CloseCode::Rejected, reason.to_string()));
+    }
+    let rooms = ServerControl::Rooms {
+        rooms: shared.rooms.list(),
+    };
+    say_last(send, &rooms).await;
+    Ok(())
+}
+
+/// The client's first message (a hello or `ListRooms`), or the polite
+/// rejection of a hello that failed validation.
 type Hello = Result<ClientControl, RejectReason>;
 
 /// Accepts the control stream and reads the first message, which must be a
-/// hello. A hello whose name is invalid is answered with
+/// hello or `ListRooms`. A hello whose name is invalid is answered with
 /// [`RejectReason::InvalidName`]; anything else malformed closes.
 async fn handshake(
     connection: &Connection,
@@ -356,7 +365,7 @@ async fn handshake(
         }
     };
     let hello = match ClientControl::decode(&payload) {
-        Ok(m) if m.as_hello().is_some() => Ok(m),
+        Ok(m) if m.as_hello().is_some() || matches!(m, ClientControl::ListRooms { .. }) => Ok(m),
         Ok(_) => {
             return Err(End::Close(
                 CloseCode::ProtocolViolation,
@@ -511,7 +520,9 @@ impl Client<'_> {
                 }
             };
             match message {
-                ClientControl::Hello { .. } | ClientControl::HelloRoom { .. } => {
+                ClientControl::Hello { .. }
+                | ClientControl::HelloRoom { .. }
+                | ClientControl::ListRooms { .. } => {
                     return Err(Ending::malformed("second hello".into()));
                 }
                 ClientControl::Chat { text } => self.room.chat(self.player_id, text),
@@ -604,17 +615,20 @@ async fn write_control(
     }
 }
 
-/// Sends a `Reject` and waits (briefly) until the client has it, since
-/// closing the connection discards unacknowledged stream data.
+/// Sends a `Reject` and waits (briefly) until the client has it.
 async fn reject(send: &mut SendStream, reason: &RejectReason) {
+    let reject = ServerControl::Reject {
+        reason: reason.clone(),
+    };
+    say_last(send, &reject).await;
+}
+
+/// Sends the session's last message and waits (briefly) until the client
+/// has it, since closing the connection discards unacknowledged stream
+/// data.
+async fn say_last(send: &mut SendStream, message: &ServerControl) {
     let mut frame = Vec::new();
-    if write_frame(
-        &ServerControl::Reject {
-            reason: reason.clone(),
-        },
-        &mut frame,
-    )
-    .is_err()
+    if write_frame(message, &mut frame).is_err()
         || send.write_all(&frame).await.is_err()
         || send.finish().is_err()
     {

@@ -16,6 +16,8 @@
 //! * [`inputs`]: a client's bounded input buffer;
 //! * [`snapshots`]: a room's snapshot history and per-client encoding;
 //! * [`room`]: the game, its tick loop and snapshot sending;
+//! * [`rooms`]: the open rooms, opened by name up to the cap, closed when
+//!   idle;
 //! * [`record`]: optional match recording (inputs, joins, hashes per tick);
 //! * [`connection`]: one client's handshake, control stream and datagrams;
 //! * [`ratelimit`]: token buckets;
@@ -34,6 +36,7 @@ pub mod metrics;
 pub mod ratelimit;
 pub mod record;
 pub mod room;
+pub mod rooms;
 pub mod server;
 pub mod snapshots;
 pub mod tls;

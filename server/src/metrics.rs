@@ -1,9 +1,10 @@
 //! Prometheus metrics (`prometheus-client`) and a minimal HTTP endpoint
 //! serving them as text at `/metrics`.
 //!
-//! Label sets are bounded: rooms are fixed at start, reasons are enums, and
-//! the per-client byte counters are labelled by player id and removed when
-//! the player leaves, so at most `max_connections` client series exist.
+//! Label sets are bounded: at most `max_rooms` rooms are open at once and a
+//! room's series are removed when it closes, reasons are enums, and the
+//! per-client byte counters are labelled by player id and removed when the
+//! player leaves, so at most `max_connections` client series exist.
 
 use std::net::SocketAddr;
 use std::sync::Arc;
@@ -129,6 +130,8 @@ pub struct Metrics {
     pub missed_ticks: Family<RoomLabel, Counter>,
     /// Players in each room.
     pub players: Family<RoomLabel, Gauge>,
+    /// Open rooms.
+    pub rooms: Gauge,
     /// Open connections (including handshakes).
     pub connections: Gauge,
     /// Connections refused because of `max_connections`.
@@ -196,6 +199,7 @@ impl Metrics {
             tick_duration: Family::new_with_constructor(tick_histogram as fn() -> Histogram),
             missed_ticks: Family::default(),
             players: Family::default(),
+            rooms: Gauge::default(),
             connections: Gauge::default(),
             connections_refused: Counter::default(),
             client_bytes_in: Family::default(),
@@ -222,6 +226,7 @@ impl Metrics {
             m.missed_ticks.clone(),
         );
         r.register("players", "Players in the room", m.players.clone());
+        r.register("rooms", "Open rooms", m.rooms.clone());
         r.register(
             "connections",
             "Open QUIC connections",
@@ -315,7 +320,16 @@ impl Metrics {
         }
     }
 
-    /// Removes a departed client's series.
+    /// Removes a closed room's series.
+    pub fn forget_room(&self, room: &str) {
+        let label = RoomLabel { room: room.into() };
+        self.tick_duration.remove(&label);
+        self.missed_ticks.remove(&label);
+        self.players.remove(&label);
+        self.input_starvation.remove(&label);
+    }
+
+    /// Removes a departed client's byte series.
     pub fn forget_client(&self, client: u32) {
         let label = ClientLabel { client };
         self.client_bytes_in.remove(&label);

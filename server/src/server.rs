@@ -4,7 +4,7 @@
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use ledge_shared::game::{Game, GameError};
 use ledge_shared::level::Level;
@@ -21,12 +21,16 @@ use crate::fingerprint::Fingerprint;
 use crate::levels::{self, LevelLoadError};
 use crate::metrics::{self, Metrics};
 use crate::record::Recorder;
-use crate::room::{self, RoomConfig};
+use crate::room::RoomConfig;
+use crate::rooms::Rooms;
 use crate::snapshots::DEFAULT_HISTORY;
 use crate::tls::{self, TlsError};
 
 /// How long shutdown waits for connection tasks, then for the endpoint.
 const SHUTDOWN_GRACE: Duration = Duration::from_secs(3);
+
+/// How often idle rooms opened by name are looked for and closed.
+const ROOM_SWEEP: Duration = Duration::from_secs(5);
 
 /// Why the server could not start.
 #[derive(Debug, thiserror::Error)]
@@ -47,13 +51,35 @@ pub enum ServerError {
     #[error(transparent)]
     Tls(#[from] TlsError),
     /// A socket could not be bound.
-    #[error("cannot bind {addr}: {source}")]
+    #[error("cannot bind {addr}: {source}; {}", bind_hint(option, *addr, source))]
     Bind {
         /// The address asked for.
         addr: SocketAddr,
+        /// The option that sets it (`--bind`, `--metrics-bind`).
+        option: &'static str,
         /// The underlying error.
         source: std::io::Error,
     },
+}
+
+/// What to do when `addr` (set by `option`) cannot be bound.
+fn bind_hint(option: &str, addr: SocketAddr, error: &std::io::Error) -> String {
+    let mut other = addr;
+    other.set_port(addr.port().checked_add(1).unwrap_or(4433));
+    let change = format!("choose another with {option} (e.g. {option} {other})");
+    match error.kind() {
+        std::io::ErrorKind::AddrInUse => format!(
+            "another program (another ledge-server?) uses port {}: stop it, or {change}",
+            addr.port()
+        ),
+        std::io::ErrorKind::AddrNotAvailable => {
+            format!("{} is not an address of this machine: {change}", addr.ip())
+        }
+        std::io::ErrorKind::PermissionDenied if addr.port() < 1024 => {
+            format!("ports below 1024 need privileges: {change}")
+        }
+        _ => change,
+    }
 }
 
 /// Resolves once the shutdown flag is true (at once if it already is, or if
@@ -108,13 +134,20 @@ impl Server {
             info!(dir = %config.cert_dir.display(), "generated a new self-signed certificate");
         }
         let quic = tls::server_config(&identity, config.idle_timeout)?;
-        let bind_err = |addr| move |source| ServerError::Bind { addr, source };
-        let endpoint = quinn::Endpoint::server(quic, config.bind).map_err(bind_err(config.bind))?;
-        let local_addr = endpoint.local_addr().map_err(bind_err(config.bind))?;
+        let bind_err = |addr, option| move |source| ServerError::Bind {
+            addr,
+            option,
+            source,
+        };
+        let udp = bind_err(config.bind, "--bind");
+        let endpoint = quinn::Endpoint::server(quic, config.bind).map_err(udp)?;
+        let local_addr = endpoint.local_addr().map_err(udp)?;
         let metrics_listener = match config.metrics_bind {
             Some(addr) => {
-                let listener = metrics::bind(addr).map_err(bind_err(addr))?;
-                let bound = listener.local_addr().map_err(bind_err(addr))?;
+                let listener = metrics::bind(addr).map_err(bind_err(addr, "--metrics-bind"))?;
+                let bound = listener
+                    .local_addr()
+                    .map_err(bind_err(addr, "--metrics-bind"))?;
                 Some((listener, bound))
             }
             None => None,
@@ -203,31 +236,29 @@ impl Server {
         } = self;
         let mut stop = shutdown.subscribe();
 
-        let level_id = levels::level_id(&level);
-        let level_hash = levels::level_hash(&level);
-        let mut rooms = Vec::new();
-        let mut room_tasks = Vec::new();
+        let template = RoomConfig {
+            name: String::new(),
+            tick_rate: config.tick_rate,
+            snapshot_interval: config.snapshot_interval(),
+            max_players: config.max_players,
+            max_catch_up: config.max_catch_up,
+            input_window: config.tick_rate.max(32) as usize,
+            input_redundancy: DEFAULT_INPUT_REDUNDANCY,
+            history: DEFAULT_HISTORY,
+            level_id: levels::level_id(&level),
+            level_hash: levels::level_hash(&level),
+            record: None,
+        };
+        let level_id = template.level_id.clone();
+        let rooms = Rooms::new(
+            Game::from_level(&level)?,
+            template,
+            config.max_rooms as usize,
+            metrics.clone(),
+        );
         for i in 1..=config.rooms {
-            let game = Game::from_level(&level)?;
-            let room_config = RoomConfig {
-                name: format!("room-{i}"),
-                tick_rate: config.tick_rate,
-                snapshot_interval: config.snapshot_interval(),
-                max_players: config.max_players,
-                max_catch_up: config.max_catch_up,
-                input_window: config.tick_rate.max(32) as usize,
-                input_redundancy: DEFAULT_INPUT_REDUNDANCY,
-                history: DEFAULT_HISTORY,
-                level_id: level_id.clone(),
-                level_hash,
-                record: recorders.get(i as usize - 1).cloned(),
-            };
-            if let Some(r) = &room_config.record {
-                r.start(&game);
-            }
-            let (handle, task) = room::spawn(game, room_config, metrics.clone());
-            rooms.push(handle);
-            room_tasks.push(task);
+            let record = recorders.get(i as usize - 1).cloned();
+            rooms.open_permanent(format!("room-{i}"), record);
         }
         let metrics_task = metrics_listener.map(|(listener, addr)| {
             info!(%addr, "serving metrics at /metrics");
@@ -251,10 +282,14 @@ impl Server {
             "listening"
         );
         let mut connections = JoinSet::new();
+        let mut sweep = tokio::time::interval(ROOM_SWEEP);
         loop {
             tokio::select! {
                 // `shutdown` lives until the end of `run`, so this never errs.
                 () = stopped(&mut stop) => break,
+                _ = sweep.tick() => {
+                    shared.rooms.close_idle(Instant::now());
+                }
                 incoming = endpoint.accept() => match incoming {
                     Some(incoming) => {
                         if shared.open.load(Ordering::Relaxed) >= config.max_connections {
@@ -307,6 +342,7 @@ impl Server {
             warn!("endpoint not idle after {SHUTDOWN_GRACE:?}");
         }
         // Rooms stop once their last handle is gone.
+        let room_tasks = shared.rooms.close_all();
         drop(shared);
         for task in room_tasks {
             if let Err(e) = task.await {

@@ -24,9 +24,16 @@ pub const MAX_SIM_CONFIG_LEN: usize = 4096;
 /// store. A full roster is at most about 10 KiB (checked at compile time).
 pub const MAX_ROSTER: usize = 256;
 
+/// Most rooms one [`ServerControl::Rooms`] lists, and so most rooms a
+/// server may run at once (its room cap is checked against this).
+pub const MAX_ROOMS: usize = 256;
+
 // Worst-case roster frame: variant (1) + count (3) + per entry id (5) +
 // name length (1) + name (MAX_NAME_LEN).
 const _: () = assert!(1 + 3 + MAX_ROSTER * (5 + 1 + MAX_NAME_LEN) <= MAX_FRAME);
+// Worst-case room list: variant (1) + count (3) + per room two strings
+// (1 + MAX_ID_LEN each) and two counts (5 each).
+const _: () = assert!(1 + 3 + MAX_ROOMS * (2 * (1 + MAX_ID_LEN) + 10) <= MAX_FRAME);
 
 /// Checks a text field: `min..=max` bytes of UTF-8, no control characters
 /// (which covers newlines, escapes and NUL).
@@ -156,40 +163,93 @@ pub fn check_roster(players: &[RosterEntry]) -> Result<(), ProtocolError> {
     players.iter().try_for_each(|p| check_name(&p.name))
 }
 
-/// Serde helper for [`ServerControl::Roster`]: the list grows as entries
-/// arrive (never by the claimed length) and more than [`MAX_ROSTER`]
-/// entries is an error at once, so a hostile count allocates nothing.
-mod roster_list {
-    use serde::de::{Error, SeqAccess, Visitor};
-    use serde::{Deserializer, Serialize, Serializer};
+/// One room, as [`ServerControl::Rooms`] lists it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RoomInfo {
+    /// The room's name (what `--room` takes), checked like a room name.
+    pub name: String,
+    /// The level it plays (a level id, same rules).
+    pub level_id: String,
+    /// Players in it now.
+    pub players: u32,
+    /// Most players it takes.
+    pub capacity: u32,
+}
 
-    use super::{RosterEntry, MAX_ROSTER};
+/// Checks a room list: at most [`MAX_ROOMS`] entries, names strictly
+/// ascending (one canonical encoding, no duplicates), every text valid.
+pub fn check_rooms(rooms: &[RoomInfo]) -> Result<(), ProtocolError> {
+    if rooms.len() > MAX_ROOMS {
+        return Err(ProtocolError::too_large(
+            "room list",
+            rooms.len(),
+            MAX_ROOMS,
+        ));
+    }
+    if rooms.windows(2).any(|w| w[0].name >= w[1].name) {
+        return Err(ProtocolError::malformed(
+            "room list",
+            "room names not strictly ascending",
+        ));
+    }
+    rooms.iter().try_for_each(|r| {
+        check_text("room name", &r.name, 1, MAX_ID_LEN)?;
+        check_text("level id", &r.level_id, 1, MAX_ID_LEN)
+    })
+}
 
-    pub fn serialize<S: Serializer>(v: &[RosterEntry], s: S) -> Result<S::Ok, S::Error> {
-        v.serialize(s)
+/// Serde helpers for bounded lists ([`ServerControl::Roster`],
+/// [`ServerControl::Rooms`]): the list grows as entries arrive (never by
+/// the claimed length) and one entry more than the bound is an error at
+/// once, so a hostile count allocates nothing.
+mod bounded {
+    use std::marker::PhantomData;
+
+    use serde::de::{Deserialize, Error, SeqAccess, Visitor};
+    use serde::Deserializer;
+
+    use super::{RoomInfo, RosterEntry, MAX_ROOMS, MAX_ROSTER};
+
+    struct Bounded<T> {
+        max: usize,
+        what: &'static str,
+        item: PhantomData<T>,
     }
 
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<RosterEntry>, D::Error> {
-        struct V;
-        impl<'de> Visitor<'de> for V {
-            type Value = Vec<RosterEntry>;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                write!(f, "at most {MAX_ROSTER} roster entries")
-            }
-            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
-                let mut v = Vec::new();
-                while let Some(entry) = seq.next_element()? {
-                    if v.len() == MAX_ROSTER {
-                        return Err(A::Error::custom(format!(
-                            "more than {MAX_ROSTER} roster entries"
-                        )));
-                    }
-                    v.push(entry);
-                }
-                Ok(v)
-            }
+    impl<'de, T: Deserialize<'de>> Visitor<'de> for Bounded<T> {
+        type Value = Vec<T>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            write!(f, "at most {} {}", self.max, self.what)
         }
-        d.deserialize_seq(V)
+        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+            let mut v = Vec::new();
+            while let Some(entry) = seq.next_element()? {
+                if v.len() == self.max {
+                    return Err(A::Error::custom(format!(
+                        "more than {} {}",
+                        self.max, self.what
+                    )));
+                }
+                v.push(entry);
+            }
+            Ok(v)
+        }
+    }
+
+    pub fn roster<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<RosterEntry>, D::Error> {
+        d.deserialize_seq(Bounded {
+            max: MAX_ROSTER,
+            what: "roster entries",
+            item: PhantomData,
+        })
+    }
+
+    pub fn rooms<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<RoomInfo>, D::Error> {
+        d.deserialize_seq(Bounded {
+            max: MAX_ROOMS,
+            what: "rooms",
+            item: PhantomData,
+        })
     }
 }
 
@@ -232,6 +292,14 @@ pub enum ClientControl {
         /// The room to join: 1..=[`MAX_ID_LEN`] bytes, no control characters.
         room: String,
     },
+    /// Instead of a hello, as the first message: asks for the server's
+    /// rooms. The server answers [`ServerControl::Rooms`] (or a
+    /// [`ServerControl::Reject`] for another version) and closes normally.
+    /// Added in protocol version 5.
+    ListRooms {
+        /// The client's [`PROTOCOL_VERSION`], checked by the server.
+        version: u32,
+    },
 }
 
 impl ClientControl {
@@ -262,7 +330,9 @@ impl Message for ClientControl {
                 check_text("room name", room, 1, MAX_ID_LEN)
             }
             ClientControl::Chat { text } => check_text("chat text", text, 1, MAX_CHAT_LEN),
-            ClientControl::Ping { .. } | ClientControl::Leave => Ok(()),
+            ClientControl::Ping { .. } | ClientControl::Leave | ClientControl::ListRooms { .. } => {
+                Ok(())
+            }
         }
     }
 }
@@ -411,7 +481,7 @@ pub enum ServerControl {
     /// version 4.
     Roster {
         /// The players.
-        #[serde(with = "roster_list")]
+        #[serde(deserialize_with = "bounded::roster")]
         players: Vec<RosterEntry>,
     },
     /// A player joined the room (sent to everyone else in it). Added in
@@ -422,6 +492,33 @@ pub enum ServerControl {
         /// Who left.
         id: PlayerId,
     },
+    /// Answer to [`ClientControl::ListRooms`]: every room, ascending by
+    /// name, at most [`MAX_ROOMS`] ([`check_rooms`]); the server closes the
+    /// connection next. Added in protocol version 5.
+    Rooms {
+        /// The rooms.
+        #[serde(deserialize_with = "bounded::rooms")]
+        rooms: Vec<RoomInfo>,
+    },
+}
+
+impl ServerControl {
+    /// The message's name, for errors and logs (never its contents, which
+    /// may be large or hostile).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            ServerControl::Welcome(_) => "Welcome",
+            ServerControl::Reject { .. } => "Reject",
+            ServerControl::Chat { .. } => "Chat",
+            ServerControl::Notice { .. } => "Notice",
+            ServerControl::FullState(_) => "FullState",
+            ServerControl::Pong { .. } => "Pong",
+            ServerControl::Roster { .. } => "Roster",
+            ServerControl::PlayerJoined(_) => "PlayerJoined",
+            ServerControl::PlayerLeft { .. } => "PlayerLeft",
+            ServerControl::Rooms { .. } => "Rooms",
+        }
+    }
 }
 
 impl Message for ServerControl {
@@ -459,6 +556,7 @@ impl Message for ServerControl {
             ServerControl::Pong { .. } | ServerControl::PlayerLeft { .. } => Ok(()),
             ServerControl::Roster { players } => check_roster(players),
             ServerControl::PlayerJoined(entry) => check_name(&entry.name),
+            ServerControl::Rooms { rooms } => check_rooms(rooms),
         }
     }
 }
@@ -541,5 +639,61 @@ mod tests {
             room: "r".repeat(MAX_ID_LEN + 1),
         };
         assert!(long.encode().is_err());
+    }
+
+    fn room(name: &str) -> RoomInfo {
+        RoomInfo {
+            name: name.into(),
+            level_id: "default".into(),
+            players: 2,
+            capacity: 16,
+        }
+    }
+
+    #[test]
+    fn room_lists_round_trip_and_are_bounded() {
+        let ask = ClientControl::ListRooms {
+            version: PROTOCOL_VERSION,
+        };
+        assert_eq!(ClientControl::decode(&ask.encode().unwrap()).unwrap(), ask);
+        assert_eq!(ask.as_hello(), None);
+        let list = ServerControl::Rooms {
+            rooms: vec![room("friends"), room("room-1")],
+        };
+        assert_eq!(
+            ServerControl::decode(&list.encode().unwrap()).unwrap(),
+            list
+        );
+        // Out of order, duplicated or badly named: refused.
+        for rooms in [
+            vec![room("room-1"), room("friends")],
+            vec![room("a"), room("a")],
+            vec![room("")],
+            vec![room("a\u{7}")],
+        ] {
+            let bad = ServerControl::Rooms { rooms };
+            assert!(bad.encode().is_err(), "{bad:?}");
+        }
+        // The most rooms fit one frame; one more is refused while decoding,
+        // however the count claims.
+        let most: Vec<RoomInfo> = (0..MAX_ROOMS)
+            .map(|i| RoomInfo {
+                name: format!("{i:0>64}"),
+                level_id: "l".repeat(MAX_ID_LEN),
+                players: u32::MAX,
+                capacity: u32::MAX,
+            })
+            .collect();
+        let full = ServerControl::Rooms { rooms: most };
+        let bytes = full.encode().unwrap();
+        assert!(bytes.len() <= MAX_FRAME);
+        assert_eq!(ServerControl::decode(&bytes).unwrap(), full);
+        let mut over = full.clone();
+        if let ServerControl::Rooms { rooms } = &mut over {
+            rooms.push(room(&"z".repeat(MAX_ID_LEN)));
+        }
+        let over = bincode::serde::encode_to_vec(&over, bincode::config::standard()).unwrap();
+        let err = ServerControl::decode(&over).unwrap_err().to_string();
+        assert!(err.contains("more than 256 rooms"), "{err}");
     }
 }
