@@ -15,15 +15,18 @@
 
 use std::collections::BTreeMap;
 use std::fmt;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::thread;
 use std::time::Duration;
 
+use ledge_levels::LevelBundle;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{Fingerprint, NoticeKind, PlayerId, Welcome};
 use tokio::sync::oneshot;
 
+use crate::bundle::{fetch_level, FetchOptions, Fetched, LevelCache};
 use crate::error::ClientError;
 use crate::netstats::TransportSample;
 use crate::session::{JoinOptions, SessionEvent, SnapshotUpdate};
@@ -59,6 +62,13 @@ pub struct NetOptions {
     /// [`Trust::KnownHosts`] (trust on first use) the request's
     /// fingerprint is ignored.
     pub trust: Option<Trust>,
+    /// Get the server's level after joining (embedded, cached or
+    /// downloaded: [`crate::bundle::fetch_level`]) and send it as
+    /// [`NetEvent::Level`] before [`NetEvent::Connected`]; `false` when the
+    /// front end has the level file.
+    pub download_level: bool,
+    /// Where downloaded levels are cached (`None`: in memory only).
+    pub level_cache: Option<PathBuf>,
 }
 
 /// What the front end asks the network thread to do.
@@ -78,6 +88,16 @@ pub enum NetCommand {
 /// What the background thread reports.
 #[derive(Debug, Clone, PartialEq)]
 pub enum NetEvent {
+    /// Downloading the server's level: `got` of `total` bytes.
+    LevelProgress {
+        /// Bytes so far (a resumed download starts above 0).
+        got: u64,
+        /// The level's size.
+        total: u64,
+    },
+    /// The server's level (with [`NetOptions::download_level`]), just
+    /// before [`NetEvent::Connected`].
+    Level(Box<LevelBundle>, Fetched),
     /// The server welcomed us.
     Connected(Welcome),
     /// A fresh round-trip measurement.
@@ -298,6 +318,37 @@ async fn run(
         }
     };
     sample(&session);
+    if options.download_level {
+        let fetch = FetchOptions {
+            cache: options.level_cache.clone().map(LevelCache::new),
+            cut_after: None,
+        };
+        let total = session.welcome().level.size;
+        let mut shown = 0;
+        let fetched = fetch_level(&mut session, &fetch, |got, total| {
+            // A few dozen updates, not one per read.
+            if got == total || got >= shown + total / 32 {
+                shown = got;
+                events.send(NetEvent::LevelProgress { got, total });
+            }
+        });
+        tracing::info!("the server's level is {total} bytes");
+        let result = tokio::select! {
+            _ = &mut quit => return,
+            result = fetched => result,
+        };
+        match result {
+            Ok((bundle, fetched)) => {
+                tracing::info!("level: {fetched:?}");
+                events.send(NetEvent::Level(Box::new(bundle), fetched));
+            }
+            Err(e) => {
+                events.send(NetEvent::Failed(e.to_string()));
+                session.close().await;
+                return;
+            }
+        }
+    }
     events.send(NetEvent::Connected(session.welcome().clone()));
     let mut ticker = tokio::time::interval(PING_INTERVAL);
     let mut transport_ticker = tokio::time::interval(TRANSPORT_INTERVAL);
@@ -357,6 +408,13 @@ pub enum NetStatus {
     Offline,
     /// Connecting to the named server.
     Connecting(String),
+    /// Joined; downloading the server's level.
+    Downloading {
+        /// Bytes so far.
+        got: u64,
+        /// The level's size.
+        total: u64,
+    },
     /// Joined.
     Connected {
         /// The server's welcome.
@@ -379,9 +437,11 @@ impl NetStatus {
                 welcome,
                 rtt: Some(rtt),
             },
+            (_, NetEvent::LevelProgress { got, total }) => NetStatus::Downloading { got, total },
             (
                 status,
                 NetEvent::Rtt(_)
+                | NetEvent::Level(..)
                 | NetEvent::Snapshot(_)
                 | NetEvent::Chat { .. }
                 | NetEvent::Notice(_)
@@ -401,6 +461,12 @@ impl fmt::Display for NetStatus {
         match self {
             NetStatus::Offline => write!(f, "offline (local simulation)"),
             NetStatus::Connecting(server) => write!(f, "connecting to {server}..."),
+            NetStatus::Downloading { got, total } => write!(
+                f,
+                "downloading the level: {} of {} KiB",
+                got / 1024,
+                total.div_ceil(1024)
+            ),
             NetStatus::Connected { welcome, rtt } => {
                 write!(
                     f,
@@ -433,6 +499,7 @@ mod tests {
             room: "room-1".into(),
             level_id: "level".into(),
             level_hash: 0xabc,
+            level: Default::default(),
             server_tick: 10,
             timing: NetTiming {
                 tick_rate: 60,

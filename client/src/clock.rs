@@ -317,6 +317,7 @@ mod tests {
             room: "r".into(),
             level_id: "l".into(),
             level_hash: 0,
+            level: Default::default(),
             server_tick: tick,
             timing: NetTiming {
                 tick_rate: 60,

@@ -76,6 +76,29 @@ pub enum ClientError {
     /// A level file could not be loaded.
     #[error("level: {0}")]
     Level(String),
+    /// The server offers a level bigger than any client downloads.
+    #[error(
+        "the server's level is {size} bytes, more than the {max} a client downloads: the \
+         server's host should use a smaller level (fewer or smaller images)"
+    )]
+    LevelTooLarge {
+        /// The offered size.
+        size: u64,
+        /// The client's limit.
+        max: u64,
+    },
+    /// Downloading the server's level failed (it resumes on the next join).
+    #[error("downloading the server's level failed: {0}; joining again resumes it")]
+    LevelDownload(String),
+    /// The downloaded level is not the one the server named.
+    #[error(
+        "the downloaded level does not match the hash the server announced ({expected}); \
+         it was deleted: join again to download it afresh"
+    )]
+    LevelHashMismatch {
+        /// The announced SHA-256, hex.
+        expected: String,
+    },
     /// The game refused something (a snapshot, a player).
     #[error("game: {0}")]
     Game(#[from] ledge_shared::game::GameError),

@@ -23,6 +23,7 @@
 //! * [`session`]: the handshake, inputs out, snapshots and control messages
 //!   in ([`Session`], [`SessionEvent`]);
 //! * [`levels`]: the server's level, checked by hash;
+//! * [`bundle`]: the server's level downloaded, cached by hash;
 //! * [`background`]: the network on its own thread, for GUI front ends;
 //! * [`timestep`]: fixed-step accumulator for render loops;
 //! * [`error`]: what can fail ([`ClientError`]).
@@ -32,6 +33,7 @@
 
 pub mod background;
 pub mod bot;
+pub mod bundle;
 pub mod clock;
 pub mod error;
 pub mod game;

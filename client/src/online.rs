@@ -28,13 +28,16 @@ use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use ledge_levels::art::LevelArt;
+use ledge_levels::LevelBundle;
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
 use ledge_shared::protocol::{Fingerprint, NoticeKind, PlayerId, StateSnapshot};
 
 use crate::background::{ConnectRequest, NetEvent, NetOptions, NetStatus, NetThread};
+use crate::bundle::{Fetched, LevelCache};
 use crate::game::ClientGame;
-use crate::levels::level_for;
+use crate::levels::{check_level, level_for};
 use crate::trust::Trust;
 use crate::view::{FrameView, NetStats};
 
@@ -52,8 +55,12 @@ pub struct OnlineRequest {
     pub player_name: String,
     /// Room to join (`None`: any).
     pub room: Option<String>,
-    /// The server's level file, when it is not the embedded default level.
+    /// A copy of the server's level file; `None` (the usual): the
+    /// embedded default level, the cache, or downloaded.
     pub level: Option<PathBuf>,
+    /// Where downloaded levels are cached (`None`: in memory only;
+    /// [`crate::bundle::LevelCache::default_dir`] is the usual place).
+    pub level_cache: Option<PathBuf>,
 }
 
 impl OnlineRequest {
@@ -65,6 +72,7 @@ impl OnlineRequest {
             player_name: player_name.to_owned(),
             room: None,
             level: None,
+            level_cache: LevelCache::default_dir(),
         }
     }
 }
@@ -84,6 +92,10 @@ pub struct OnlineGame {
     error: Option<String>,
     /// Why the server's certificate was refused, if it was.
     untrusted: Option<String>,
+    /// The server's level and art, once fetched.
+    bundle: Option<LevelBundle>,
+    /// How it was fetched.
+    fetched: Option<Fetched>,
     /// The newest authoritative state.
     latest: Option<StateSnapshot>,
     /// Snapshots arrived since the last [`OnlineGame::take_arrivals`].
@@ -109,6 +121,8 @@ impl OnlineGame {
             NetOptions {
                 room: request.room.clone(),
                 trust: Some(request.trust.clone()),
+                download_level: request.level.is_none(),
+                level_cache: request.level_cache.clone(),
             },
         )?;
         Ok(OnlineGame {
@@ -121,6 +135,8 @@ impl OnlineGame {
             notices: VecDeque::new(),
             error: None,
             untrusted: None,
+            bundle: None,
+            fetched: None,
             latest: None,
             arrivals: 0,
             fresh: false,
@@ -175,6 +191,12 @@ impl OnlineGame {
 
     /// Takes one event from the network thread.
     fn take(&mut self, event: NetEvent, now: Instant) {
+        if let NetEvent::Level(bundle, fetched) = event {
+            // Kept without a copy: the game is made from it on `Connected`.
+            self.fetched = Some(fetched);
+            self.bundle = Some(*bundle);
+            return;
+        }
         self.handle(&event, now);
         match event {
             // Kept without a copy (the status has no use for it).
@@ -192,8 +214,12 @@ impl OnlineGame {
                     .net
                     .transport()
                     .map_or(Duration::from_millis(50), |t| t.rtt);
-                let made = level_for(welcome, self.level_file.as_deref())
-                    .and_then(|level| ClientGame::new(welcome, level, rtt, now));
+                let level = match &self.bundle {
+                    Some(bundle) => check_level(welcome, &bundle.level, "the downloaded level")
+                        .map(|()| bundle.level.clone()),
+                    None => level_for(welcome, self.level_file.as_deref()),
+                };
+                let made = level.and_then(|level| ClientGame::new(welcome, level, rtt, now));
                 match made {
                     Ok(mut game) => {
                         game.set_name(&self.name);
@@ -238,7 +264,10 @@ impl OnlineGame {
                 }
             }
             NetEvent::Untrusted(reason) => self.untrusted = Some(reason.clone()),
-            NetEvent::Failed(_) | NetEvent::Disconnected(_) => {}
+            NetEvent::Failed(_)
+            | NetEvent::Disconnected(_)
+            | NetEvent::LevelProgress { .. }
+            | NetEvent::Level(..) => {}
         }
     }
 
@@ -267,6 +296,18 @@ impl OnlineGame {
     /// The level, once welcomed (draw its tilemap).
     pub fn level(&self) -> Option<&Level> {
         self.game.as_ref().map(ClientGame::level)
+    }
+
+    /// The downloaded (or cached) level's art, once it arrived (`None`
+    /// with a level file, or before).
+    pub fn level_art(&self) -> Option<&LevelArt> {
+        self.bundle.as_ref().map(|b| &b.art)
+    }
+
+    /// How the server's level was had, once it was (`None` with a level
+    /// file).
+    pub fn level_fetched(&self) -> Option<Fetched> {
+        self.fetched
     }
 
     /// A problem that keeps us from playing (the server's level is not

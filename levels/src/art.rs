@@ -294,6 +294,92 @@ pub struct ArtObject {
 }
 
 impl LevelArt {
+    /// Checks art that came from elsewhere (a server's level bundle) against
+    /// the bounds the loaders keep: counts and sizes within the `MAX_ART_*`
+    /// limits, every image a PNG whose header gives the size it claims, and
+    /// every index (image, tileset) in range, so drawing it cannot index out
+    /// of bounds or decode an oversized image.
+    pub fn check(&self) -> Result<(), String> {
+        if self.images.len() > MAX_ART_IMAGES {
+            return Err(format!(
+                "{} images, more than {MAX_ART_IMAGES}",
+                self.images.len()
+            ));
+        }
+        if self.image_bytes() > MAX_ART_BYTES {
+            return Err(format!(
+                "{} bytes of images, more than {MAX_ART_BYTES}",
+                self.image_bytes()
+            ));
+        }
+        for (i, image) in self.images.iter().enumerate() {
+            let size = png_size(&image.bytes);
+            if image.bytes.len() as u64 > MAX_ART_IMAGE_BYTES
+                || size != Some((image.width, image.height))
+                || image.width > MAX_ART_IMAGE_SIDE
+                || image.height > MAX_ART_IMAGE_SIDE
+            {
+                return Err(format!(
+                    "image {i} ({:?}) is not a PNG of {}x{} pixels (at most \
+                     {MAX_ART_IMAGE_SIDE} a side and {MAX_ART_IMAGE_BYTES} bytes)",
+                    image.name, image.width, image.height
+                ));
+            }
+        }
+        let image_ok = |i: u32| (i as usize) < self.images.len();
+        for (t, set) in self.tilesets.iter().enumerate() {
+            let bad = |what: &str| Err(format!("tileset {t} ({:?}): {what}", set.name));
+            if set.tile_count > MAX_ART_TILES || set.tiles.len() > MAX_ART_TILES as usize {
+                return bad("too many tiles");
+            }
+            if set.image.is_some_and(|i| !image_ok(i)) {
+                return bad("its image is not in the bundle");
+            }
+            if set.tiles.iter().any(|tile| !image_ok(tile.image)) {
+                return bad("a tile's image is not in the bundle");
+            }
+            if set.tiles.windows(2).any(|w| w[0].id >= w[1].id) {
+                return bad("tiles not in ascending id order");
+            }
+        }
+        let tileset_ok = |i: u32| (i as usize) < self.tilesets.len();
+        let (mut cells, mut objects) = (0u64, 0usize);
+        for (l, layer) in self.layers.iter().enumerate() {
+            let bad = |what: &str| Err(format!("layer {l} ({:?}): {what}", layer.name));
+            match &layer.content {
+                ArtContent::Tiles(grid) => {
+                    cells += grid.cells.len() as u64;
+                    if u64::from(grid.width) * u64::from(grid.height) != grid.cells.len() as u64 {
+                        return bad("its cells do not fill its grid");
+                    }
+                    if grid.cells.iter().flatten().any(|c| !tileset_ok(c.tileset)) {
+                        return bad("a cell's tileset is not in the bundle");
+                    }
+                }
+                ArtContent::Objects(list) => {
+                    objects += list.len();
+                    if list.iter().any(|o| !tileset_ok(o.tileset)) {
+                        return bad("an object's tileset is not in the bundle");
+                    }
+                }
+                ArtContent::Image { image, .. } => {
+                    if !image_ok(*image) {
+                        return bad("its image is not in the bundle");
+                    }
+                }
+            }
+        }
+        if cells > MAX_ART_CELLS {
+            return Err(format!("{cells} cells, more than {MAX_ART_CELLS}"));
+        }
+        if objects > MAX_ART_OBJECTS {
+            return Err(format!(
+                "{objects} tile objects, more than {MAX_ART_OBJECTS}"
+            ));
+        }
+        Ok(())
+    }
+
     /// Whether there is nothing to draw.
     pub fn is_empty(&self) -> bool {
         self.layers.is_empty()

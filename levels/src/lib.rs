@@ -26,6 +26,7 @@
 //! See `docs/LEVELS.md` for the user-facing description.
 
 pub mod art;
+pub mod bundle;
 mod collision;
 mod default;
 mod entities;
@@ -42,6 +43,7 @@ use std::path::Path;
 
 use glam::IVec2;
 
+pub use bundle::{BundleError, LevelBundle};
 pub use default::{
     default_level, default_route, load_default_level, DEFAULT_LEVEL_FILE, DEFAULT_PROJECT_FILE,
 };

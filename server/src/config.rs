@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use clap::Parser;
-use ledge_shared::protocol::MAX_ROOMS;
+use ledge_shared::protocol::{MAX_LEVEL_BUNDLE, MAX_ROOMS};
 use serde::Deserialize;
 
 /// Default UDP address the server listens on.
@@ -29,6 +29,9 @@ pub const DEFAULT_ROOMS: u32 = 1;
 /// Default most rooms at once, counting those players open by name (the
 /// cap is at least `rooms`).
 pub const DEFAULT_MAX_ROOMS: u32 = 16;
+/// Default largest level bundle the server offers, MiB: a level (with its
+/// art) that encodes bigger is refused at start.
+pub const DEFAULT_MAX_LEVEL_MIB: u64 = 32;
 /// Default most simultaneous connections (players and handshakes).
 pub const DEFAULT_MAX_CONNECTIONS: usize = 256;
 /// Default bound on ticks run back to back after a stall (0.25 s at 60 Hz).
@@ -109,6 +112,10 @@ pub struct ServerConfig {
     pub max_rooms: u32,
     /// Most simultaneous connections; more are refused at once.
     pub max_connections: usize,
+    /// Largest level bundle (level and art, as clients download it), MiB;
+    /// a bigger one stops the server at start. At most
+    /// [`MAX_LEVEL_BUNDLE`] (96 MiB).
+    pub max_level_mib: u64,
     /// TCP address of the Prometheus metrics endpoint; `None`: no endpoint.
     pub metrics_bind: Option<SocketAddr>,
     /// Most ticks run back to back after a stall; older ones are skipped.
@@ -137,6 +144,7 @@ impl Default for ServerConfig {
             rooms: DEFAULT_ROOMS,
             max_rooms: DEFAULT_MAX_ROOMS,
             max_connections: DEFAULT_MAX_CONNECTIONS,
+            max_level_mib: DEFAULT_MAX_LEVEL_MIB,
             metrics_bind: None,
             max_catch_up: DEFAULT_MAX_CATCH_UP,
             idle_timeout: DEFAULT_IDLE_TIMEOUT,
@@ -175,6 +183,12 @@ impl ServerConfig {
             return Err(ConfigError::Invalid(format!(
                 "max_rooms must be rooms ({})..={MAX_ROOMS}",
                 self.rooms
+            )));
+        }
+        if self.max_level_mib == 0 || self.max_level_mib > MAX_LEVEL_BUNDLE >> 20 {
+            return Err(ConfigError::Invalid(format!(
+                "max_level_mib must be 1..={}",
+                MAX_LEVEL_BUNDLE >> 20
             )));
         }
         if self.max_connections == 0 {
@@ -272,6 +286,10 @@ pub struct Cli {
     /// Most simultaneous connections [default: 256].
     #[arg(long, value_name = "N")]
     pub max_connections: Option<usize>,
+    /// Largest level clients download (the level and its images, encoded),
+    /// in MiB; a bigger level stops the server at start [default: 32].
+    #[arg(long, value_name = "MIB")]
+    pub max_level_mib: Option<u64>,
     /// Directory of the certificate and key, created on first start
     /// [default: certs].
     #[arg(long, value_name = "DIR")]
@@ -295,6 +313,7 @@ struct FileConfig {
     rooms: Option<u32>,
     max_rooms: Option<u32>,
     max_connections: Option<usize>,
+    max_level_mib: Option<u64>,
     cert_dir: Option<PathBuf>,
     metrics_bind: Option<SocketAddr>,
     max_catch_up: Option<u32>,
@@ -340,6 +359,7 @@ impl Cli {
         set(&mut c.rooms, file.rooms);
         set(&mut c.max_rooms, file.max_rooms);
         set(&mut c.max_connections, file.max_connections);
+        set(&mut c.max_level_mib, file.max_level_mib);
         set(&mut c.cert_dir, file.cert_dir.map(relative));
         set(&mut c.metrics_bind, file.metrics_bind.map(Some));
         set(&mut c.max_catch_up, file.max_catch_up);
@@ -362,6 +382,7 @@ impl Cli {
             c.max_rooms = c.max_rooms.max(c.rooms);
         }
         set(&mut c.max_connections, self.max_connections);
+        set(&mut c.max_level_mib, self.max_level_mib);
         set(&mut c.cert_dir, self.cert_dir.clone());
         set(&mut c.metrics_bind, self.metrics_bind.map(Some));
         c.validate()?;
@@ -532,6 +553,8 @@ datagrams_per_second = 500.0
             &["--rooms", "257"],
             &["--rooms", "3", "--max-rooms", "2"],
             &["--max-rooms", "257"],
+            &["--max-level-mib", "0"],
+            &["--max-level-mib", "97"],
         ] {
             let err = cli(args).resolve().unwrap_err();
             assert!(matches!(err, ConfigError::Invalid(_)), "{args:?}: {err}");

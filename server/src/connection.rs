@@ -49,6 +49,14 @@ pub const HELLO_TIMEOUT: Duration = Duration::from_secs(5);
 /// far smaller (a chat line is at most 256 bytes).
 pub const CLIENT_MAX_FRAME: usize = 1024;
 
+/// Level downloads one connection may start (resumes included); a client
+/// asking for more is disconnected, so nobody can make the server send its
+/// level over and over.
+pub const MAX_LEVEL_DOWNLOADS: u32 = 4;
+
+/// Bytes of the level written to its stream at a time (and counted).
+const LEVEL_CHUNK: usize = 16 * 1024;
+
 /// Frames queued for one client's control stream; more are dropped.
 pub const CONTROL_QUEUE: usize = 64;
 
@@ -67,6 +75,8 @@ pub const SHUTDOWN_LINGER: Duration = Duration::from_secs(1);
 pub struct Shared {
     /// The open rooms.
     pub rooms: Rooms,
+    /// The level bundle clients download ([`ClientControl::GetLevel`]).
+    pub level_bundle: Arc<Vec<u8>>,
     /// Metrics.
     pub metrics: Arc<Metrics>,
     /// Per-client limits.
@@ -220,6 +230,9 @@ async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
     ));
     let mut client = Client {
         shared,
+        connection: connection.clone(),
+        downloads: 0,
+        download: None,
         room: &membership.room,
         player_id,
         inbox: joined.inbox,
@@ -229,6 +242,9 @@ async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
         buckets: Buckets::new(&shared.limits, Instant::now()),
     };
     let ending = client.run(connection, &mut recv, &mut shutdown).await;
+    if let Some(download) = client.download.take() {
+        download.abort();
+    }
     // Say goodbye on the stream, then let the writer flush it (bounded).
     let (notice, linger) = match &ending {
         Ending::Left => (None, LEAVE_LINGER),
@@ -449,6 +465,11 @@ impl Buckets {
 /// A joined client's receive side.
 struct Client<'a> {
     shared: &'a Shared,
+    connection: Connection,
+    /// Level downloads started.
+    downloads: u32,
+    /// The level download running, if any.
+    download: Option<tokio::task::JoinHandle<()>>,
     room: &'a RoomHandle,
     player_id: PlayerId,
     inbox: Arc<Mutex<PlayerInbox>>,
@@ -535,8 +556,57 @@ impl Client<'_> {
                     }
                 }
                 ClientControl::Leave => return Err(Ending::Left),
+                ClientControl::GetLevel { offset } => self.send_level(offset)?,
             }
         }
+        Ok(())
+    }
+
+    /// Starts sending the level bundle from `offset` on a stream of its own
+    /// (so the control stream is never stuck behind it); one download at a
+    /// time, at most [`MAX_LEVEL_DOWNLOADS`] per connection.
+    fn send_level(&mut self, offset: u64) -> Result<(), Ending> {
+        let bundle = self.shared.level_bundle.clone();
+        let Some(rest) = usize::try_from(offset)
+            .ok()
+            .and_then(|at| bundle.get(at..).map(<[u8]>::len))
+        else {
+            return Err(Ending::malformed(format!(
+                "level asked for from byte {offset} of {}",
+                bundle.len()
+            )));
+        };
+        if self.download.as_ref().is_some_and(|d| !d.is_finished()) {
+            self.shared
+                .metrics
+                .count_drop(DropReason::ControlRateLimited);
+            return Ok(());
+        }
+        self.downloads += 1;
+        if self.downloads > MAX_LEVEL_DOWNLOADS {
+            return Err(Ending::flooding(format!(
+                "asked for the level more than {MAX_LEVEL_DOWNLOADS} times"
+            )));
+        }
+        let metrics = self.shared.metrics.clone();
+        let connection = self.connection.clone();
+        metrics.level_downloads.inc();
+        debug!(offset, rest, "sending the level");
+        self.download = Some(tokio::spawn(async move {
+            let at = bundle.len() - rest;
+            let Ok(mut stream) = connection.open_uni().await else {
+                return;
+            };
+            for chunk in bundle[at..].chunks(LEVEL_CHUNK) {
+                if stream.write_all(chunk).await.is_err() {
+                    return;
+                }
+                metrics.level_download_bytes.inc_by(chunk.len() as u64);
+            }
+            if stream.finish().is_ok() {
+                metrics.level_downloads_completed.inc();
+            }
+        }));
         Ok(())
     }
 

@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use ledge_levels::LevelBundle;
 use ledge_shared::level::Level;
 use ledge_shared::protocol::{check_text, MAX_ID_LEN};
 use tracing::warn;
@@ -23,8 +24,9 @@ pub enum LevelLoadError {
 /// Loads `path` (OGMO `.json` or Tiled `.tmx`) with its settings file
 /// (`settings`, else `LEVEL.ledge.toml` beside it when there is one; see
 /// [`ledge_levels::load_level`]), logging every warning the importer gives
-/// (what it ignored or placed, and where); or the embedded default level.
-pub fn load(path: Option<&Path>, settings: Option<&Path>) -> Result<Level, LevelLoadError> {
+/// (what it ignored or placed, and where), with the art clients draw it
+/// with; or the embedded default level (no art).
+pub fn load(path: Option<&Path>, settings: Option<&Path>) -> Result<LevelBundle, LevelLoadError> {
     match path {
         Some(path) => {
             let loaded =
@@ -35,9 +37,15 @@ pub fn load(path: Option<&Path>, settings: Option<&Path>) -> Result<Level, Level
             for w in &loaded.warnings {
                 warn!("level: {w}");
             }
-            Ok(loaded.level)
+            for w in &loaded.art.warnings {
+                warn!("level art: {w}");
+            }
+            Ok(LevelBundle {
+                level: loaded.level,
+                art: loaded.art,
+            })
         }
-        None => Ok(default_level()),
+        None => Ok(LevelBundle::default_level()),
     }
 }
 
@@ -72,8 +80,8 @@ mod tests {
 
     #[test]
     fn the_default_level_loads_and_has_a_stable_identity() {
-        let a = load(None, None).unwrap();
-        let b = load(None, None).unwrap();
+        let a = load(None, None).unwrap().level;
+        let b = load(None, None).unwrap().level;
         assert_eq!(level_hash(&a), level_hash(&b));
         assert!(check_text("level id", &level_id(&a), 1, MAX_ID_LEN).is_ok());
         let mut renamed = a.clone();

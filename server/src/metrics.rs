@@ -132,6 +132,12 @@ pub struct Metrics {
     pub players: Family<RoomLabel, Gauge>,
     /// Open rooms.
     pub rooms: Gauge,
+    /// Level bundle downloads started (a resumed one counts again).
+    pub level_downloads: Counter,
+    /// Level bundle downloads sent to their end.
+    pub level_downloads_completed: Counter,
+    /// Level bundle bytes sent.
+    pub level_download_bytes: Counter,
     /// Open connections (including handshakes).
     pub connections: Gauge,
     /// Connections refused because of `max_connections`.
@@ -200,6 +206,9 @@ impl Metrics {
             missed_ticks: Family::default(),
             players: Family::default(),
             rooms: Gauge::default(),
+            level_downloads: Counter::default(),
+            level_downloads_completed: Counter::default(),
+            level_download_bytes: Counter::default(),
             connections: Gauge::default(),
             connections_refused: Counter::default(),
             client_bytes_in: Family::default(),
@@ -227,6 +236,21 @@ impl Metrics {
         );
         r.register("players", "Players in the room", m.players.clone());
         r.register("rooms", "Open rooms", m.rooms.clone());
+        r.register(
+            "level_downloads",
+            "Level bundle downloads started (resumed ones included)",
+            m.level_downloads.clone(),
+        );
+        r.register(
+            "level_downloads_completed",
+            "Level bundle downloads sent to their end",
+            m.level_downloads_completed.clone(),
+        );
+        r.register(
+            "level_download_bytes",
+            "Level bundle bytes sent",
+            m.level_download_bytes.clone(),
+        );
         r.register(
             "connections",
             "Open QUIC connections",

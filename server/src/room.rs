@@ -22,8 +22,8 @@ use std::time::{Duration, Instant};
 use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
-    encode_sim_config, write_frame, InputPacket, NetTiming, Outgoing, PlayerId, RejectReason,
-    RosterEntry, ServerControl, Welcome, MAX_ROSTER,
+    encode_sim_config, write_frame, InputPacket, LevelOffer, NetTiming, Outgoing, PlayerId,
+    RejectReason, RosterEntry, ServerControl, Welcome, MAX_ROSTER,
 };
 use prometheus_client::metrics::counter::Counter;
 use prometheus_client::metrics::histogram::Histogram;
@@ -77,6 +77,8 @@ pub struct RoomConfig {
     pub level_id: String,
     /// Level hash sent in `Welcome`.
     pub level_hash: u64,
+    /// The level bundle offered in `Welcome`.
+    pub level: LevelOffer,
     /// Where to record the match (inputs, joins, leaves, hashes), if on.
     pub record: Option<Recorder>,
 }
@@ -455,6 +457,7 @@ impl Room {
                 room: self.config.name.clone(),
                 level_id: self.config.level_id.clone(),
                 level_hash: self.config.level_hash,
+                level: self.config.level,
                 server_tick: tick,
                 timing: NetTiming {
                     tick_rate: self.config.tick_rate,

@@ -212,6 +212,7 @@ mod tests {
             history: 64,
             level_id: "default".into(),
             level_hash: 1,
+            level: Default::default(),
             record: None,
         };
         let (metrics, _registry) = Metrics::new();

@@ -6,9 +6,10 @@ use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use ledge_levels::LevelBundle;
 use ledge_shared::game::{Game, GameError};
 use ledge_shared::level::Level;
-use ledge_shared::protocol::{CloseCode, DEFAULT_INPUT_REDUNDANCY};
+use ledge_shared::protocol::{CloseCode, LevelOffer, DEFAULT_INPUT_REDUNDANCY};
 use prometheus_client::registry::Registry;
 use tokio::sync::watch;
 use tokio::task::JoinSet;
@@ -50,6 +51,18 @@ pub enum ServerError {
     /// The TLS/QUIC configuration was refused.
     #[error(transparent)]
     Tls(#[from] TlsError),
+    /// The level, with its art, is bigger than clients may download.
+    #[error(
+        "the level and its images are {size} bytes once encoded for clients, more than \
+         the server's limit of {max_mib} MiB: raise --max-level-mib (at most 96), or use \
+         fewer or smaller images"
+    )]
+    LevelTooLarge {
+        /// The bundle's size, bytes.
+        size: u64,
+        /// The limit, MiB.
+        max_mib: u64,
+    },
     /// A socket could not be bound.
     #[error("cannot bind {addr}: {source}; {}", bind_hint(option, *addr, source))]
     Bind {
@@ -100,6 +113,9 @@ pub struct Server {
     fingerprint: Fingerprint,
     config: ServerConfig,
     level: Level,
+    /// The level bundle clients download, and its name.
+    level_bundle: Arc<Vec<u8>>,
+    level_offer: LevelOffer,
     metrics: Arc<Metrics>,
     registry: Arc<Registry>,
     metrics_listener: Option<(tokio::net::TcpListener, SocketAddr)>,
@@ -127,17 +143,27 @@ impl Server {
     /// Must be called inside a tokio runtime (the sockets register with it).
     pub fn bind(config: ServerConfig) -> Result<Server, ServerError> {
         config.validate()?;
-        let level = levels::load(config.level.as_deref(), config.level_settings.as_deref())?;
-        Game::from_level(&level)?;
+        let bundle = levels::load(config.level.as_deref(), config.level_settings.as_deref())?;
+        Game::from_level(&bundle.level)?;
+        let bundle_bytes = bundle.encode();
+        if bundle_bytes.len() as u64 > config.max_level_mib << 20 {
+            return Err(ServerError::LevelTooLarge {
+                size: bundle_bytes.len() as u64,
+                max_mib: config.max_level_mib,
+            });
+        }
+        let level = bundle.level;
         let identity = Identity::load_or_generate(&config.cert_dir)?;
         if identity.generated {
             info!(dir = %config.cert_dir.display(), "generated a new self-signed certificate");
         }
         let quic = tls::server_config(&identity, config.idle_timeout)?;
-        let bind_err = |addr, option| move |source| ServerError::Bind {
-            addr,
-            option,
-            source,
+        let bind_err = |addr, option| {
+            move |source| ServerError::Bind {
+                addr,
+                option,
+                source,
+            }
         };
         let udp = bind_err(config.bind, "--bind");
         let endpoint = quinn::Endpoint::server(quic, config.bind).map_err(udp)?;
@@ -168,6 +194,8 @@ impl Server {
             fingerprint: identity.fingerprint,
             config,
             level,
+            level_offer: LevelBundle::offer(&bundle_bytes),
+            level_bundle: Arc::new(bundle_bytes),
             metrics,
             registry: Arc::new(registry),
             metrics_listener,
@@ -206,6 +234,11 @@ impl Server {
         &self.level
     }
 
+    /// The level bundle clients download (hash and size).
+    pub fn level_offer(&self) -> LevelOffer {
+        self.level_offer
+    }
+
     /// The match record of room `room` (e.g. `room-1`), when recording is
     /// on (`ServerConfig::record_ticks`); it fills while the server runs and
     /// stays readable after it stopped.
@@ -227,6 +260,8 @@ impl Server {
             local_addr,
             config,
             level,
+            level_bundle,
+            level_offer,
             metrics,
             registry,
             metrics_listener,
@@ -247,6 +282,7 @@ impl Server {
             history: DEFAULT_HISTORY,
             level_id: levels::level_id(&level),
             level_hash: levels::level_hash(&level),
+            level: level_offer,
             record: None,
         };
         let level_id = template.level_id.clone();
@@ -266,6 +302,7 @@ impl Server {
         });
         let shared = Arc::new(Shared {
             rooms,
+            level_bundle,
             metrics: metrics.clone(),
             limits: config.limits,
             next_player: AtomicU32::new(1),
@@ -276,6 +313,7 @@ impl Server {
         info!(
             %local_addr,
             level = %level_id,
+            level_bundle_bytes = level_offer.size,
             rooms = config.rooms,
             tick_rate = config.tick_rate,
             snapshot_interval = config.snapshot_interval(),

@@ -199,6 +199,10 @@ fn server_control() -> impl Strategy<Value = ServerControl> {
                         snapshot_interval: every.min(rate),
                         input_redundancy: red,
                     },
+                    level: LevelOffer {
+                        sha256: [id as u8; 32],
+                        size: server_tick % (MAX_LEVEL_BUNDLE + 1),
+                    },
                     sim_config,
                 })
             },

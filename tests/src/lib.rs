@@ -415,3 +415,31 @@ impl PredictedClient {
     }
 }
 pub mod e2e;
+
+/// A file of the level corpus (`target/level-corpus`, made by
+/// `scripts/fetch-level-corpus`: Tiled's own examples, with their
+/// licences), fetched first when missing under `CI=true`; `None` (the test
+/// then says so loudly and passes) elsewhere without it.
+pub fn corpus_file(relative: &str) -> Option<std::path::PathBuf> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let file = root.join("target/level-corpus").join(relative);
+    if !file.is_file() && std::env::var("CI").as_deref() == Ok("true") {
+        let status = std::process::Command::new("bash")
+            .arg(root.join("scripts/fetch-level-corpus"))
+            .status()
+            .expect("scripts/fetch-level-corpus runs");
+        assert!(
+            status.success(),
+            "scripts/fetch-level-corpus failed: {status}"
+        );
+    }
+    if file.is_file() {
+        Some(file)
+    } else {
+        eprintln!(
+            "\n*** SKIPPED: no level corpus ({}): run scripts/fetch-level-corpus ***\n",
+            file.display()
+        );
+        None
+    }
+}

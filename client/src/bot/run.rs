@@ -10,6 +10,7 @@ use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{NoticeKind, PlayerId};
 
 use super::brain::Brain;
+use crate::bundle::{fetch_level, FetchOptions, Fetched, LevelCache};
 use crate::game::ClientGame;
 use crate::levels::level_for;
 use crate::netstats::TransportSample;
@@ -35,8 +36,11 @@ pub struct BotOptions {
     pub duration: Duration,
     /// Leave as soon as the brain is done (a runner at the goal).
     pub stop_when_done: bool,
-    /// The server's level file, when it is not the default level.
+    /// A copy of the server's level file; `None` (the usual): use the
+    /// embedded default level, the cache, or download it.
     pub level: Option<PathBuf>,
+    /// Where downloaded levels are cached (`None`: in memory only).
+    pub level_cache: Option<PathBuf>,
     /// Smallest input margin the clock keeps, ticks (`None`: the default).
     pub min_margin: Option<f64>,
 }
@@ -50,6 +54,7 @@ impl BotOptions {
             duration,
             stop_when_done: false,
             level: None,
+            level_cache: None,
             min_margin: None,
         }
     }
@@ -86,6 +91,8 @@ pub struct BotReport {
     pub ended: Option<String>,
     /// Wall-clock time played.
     pub played: Duration,
+    /// How the server's level was had (`None`: from `level`, a file).
+    pub level: Option<Fetched>,
 }
 
 impl fmt::Display for BotReport {
@@ -163,7 +170,22 @@ pub async fn run_bot(
         player: Some(me),
         ..BotReport::default()
     };
-    let level = match level_for(&welcome, options.level.as_deref()) {
+    let level = match &options.level {
+        Some(file) => level_for(&welcome, Some(file)),
+        None => {
+            let fetch = FetchOptions {
+                cache: options.level_cache.clone().map(LevelCache::new),
+                cut_after: None,
+            };
+            fetch_level(&mut session, &fetch, |_, _| {})
+                .await
+                .map(|(bundle, fetched)| {
+                    report.level = Some(fetched);
+                    bundle.level
+                })
+        }
+    };
+    let level = match level {
         Ok(level) => level,
         Err(e) => {
             report.ended = Some(e.to_string());

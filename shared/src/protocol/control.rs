@@ -292,6 +292,14 @@ pub enum ClientControl {
         /// The room to join: 1..=[`MAX_ID_LEN`] bytes, no control characters.
         room: String,
     },
+    /// Asks for the level bundle the [`Welcome`] offered, from byte
+    /// `offset` on (0, or how much a cut download already has): the server
+    /// opens a unidirectional stream and writes the bundle's bytes from
+    /// there to the end. Added in protocol version 5.
+    GetLevel {
+        /// First byte wanted; at most the bundle's size.
+        offset: u64,
+    },
     /// Instead of a hello, as the first message: asks for the server's
     /// rooms. The server answers [`ServerControl::Rooms`] (or a
     /// [`ServerControl::Reject`] for another version) and closes normally.
@@ -330,9 +338,10 @@ impl Message for ClientControl {
                 check_text("room name", room, 1, MAX_ID_LEN)
             }
             ClientControl::Chat { text } => check_text("chat text", text, 1, MAX_CHAT_LEN),
-            ClientControl::Ping { .. } | ClientControl::Leave | ClientControl::ListRooms { .. } => {
-                Ok(())
-            }
+            ClientControl::Ping { .. }
+            | ClientControl::Leave
+            | ClientControl::ListRooms { .. }
+            | ClientControl::GetLevel { .. } => Ok(()),
         }
     }
 }
@@ -365,6 +374,30 @@ impl NetTiming {
     }
 }
 
+/// Largest level bundle any server may offer, bytes: a client refuses a
+/// bigger offer before downloading anything. (A server's own cap is
+/// usually lower.)
+pub const MAX_LEVEL_BUNDLE: u64 = 96 << 20;
+
+/// The level bundle a server plays (the level and what clients draw it
+/// with, as `ledge_levels::LevelBundle` encodes it): what a client needs to
+/// find it in its cache or download it with [`ClientControl::GetLevel`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct LevelOffer {
+    /// SHA-256 of the bundle's bytes.
+    pub sha256: [u8; 32],
+    /// The bundle's size in bytes. Not checked by the decoder: a client
+    /// refuses more than [`MAX_LEVEL_BUNDLE`] itself, saying so.
+    pub size: u64,
+}
+
+impl LevelOffer {
+    /// The hash in lower-case hex (64 digits): the bundle's name in caches.
+    pub fn hex(&self) -> String {
+        self.sha256.iter().map(|b| format!("{b:02x}")).collect()
+    }
+}
+
 /// The server's answer to an accepted `Hello`.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Welcome {
@@ -376,6 +409,8 @@ pub struct Welcome {
     pub level_id: String,
     /// Hash of the level's content, so a client can check its copy.
     pub level_hash: u64,
+    /// The level bundle: its hash and size (added in protocol version 5).
+    pub level: LevelOffer,
     /// The room's simulation tick when the player joined.
     pub server_tick: u64,
     /// Tick and snapshot rates.
