@@ -28,6 +28,7 @@ use ledge_client::bot::{
     connect_and_run, misbehave, run_thin, BotOptions, Brain, Idle, Misbehavior, RandomWalker,
     Runner,
 };
+use ledge_client::bundle::LevelCache;
 use ledge_client::transport::resolve;
 use ledge_client::trust::{KnownHosts, Trust};
 use ledge_client::Fingerprint;
@@ -83,9 +84,14 @@ struct Cli {
     /// Room to join (default: the server picks).
     #[arg(long)]
     room: Option<String>,
-    /// The server's level file, when it is not the default level.
+    /// A copy of the server's level file. Without it the server's level is
+    /// downloaded (or found in the cache, or embedded).
     #[arg(long, value_name = "PATH")]
     level: Option<PathBuf>,
+    /// Where downloaded levels are cached [default:
+    /// $XDG_CACHE_HOME/ledge/levels or ~/.cache/ledge/levels].
+    #[arg(long, value_name = "DIR")]
+    level_cache: Option<PathBuf>,
     /// Name prefix (bots are PREFIX-1, PREFIX-2, ...).
     #[arg(long, default_value = "bot")]
     name: String,
@@ -134,6 +140,7 @@ async fn run(cli: Cli) -> ExitCode {
             room: cli.room.clone(),
             stop_when_done: cli.stop_at_goal,
             level: cli.level.clone(),
+            level_cache: cli.level_cache.clone().or_else(LevelCache::default_dir),
             min_margin: cli.margin,
             ..BotOptions::new(&format!("{}-{}", cli.name, i + 1), duration)
         };
