@@ -1,12 +1,15 @@
 //! Everything that can go wrong on the client side of a connection.
 
-use ledge_shared::protocol::{CloseCode, Fingerprint, ProtocolError, RejectReason};
+use ledge_shared::protocol::{CloseCode, Fingerprint, ProtocolError, RejectReason, MAX_NAME_LEN};
 
 /// Why connecting or talking to a server failed.
 #[derive(Debug, thiserror::Error)]
 pub enum ClientError {
     /// `HOST:PORT` could not be parsed or resolved.
-    #[error("cannot resolve server address {0:?} (expected HOST:PORT)")]
+    #[error(
+        "cannot find the server address \"{0}\": give it as HOST:PORT (for example \
+         192.168.1.20:4433, the address and port the server printed when it started)"
+    )]
     Address(String),
     /// The local UDP socket could not be opened.
     #[error("cannot open a UDP socket: {0}")]
@@ -18,7 +21,14 @@ pub enum ClientError {
     #[error("cannot connect: {0}")]
     Connect(#[from] quinn::ConnectError),
     /// The server's certificate is not the pinned one.
-    #[error("server certificate fingerprint is {presented}, expected {expected}")]
+    #[error(
+        "the server's certificate has fingerprint {presented}, not {expected} as --cert-hash \
+         says. The server prints its fingerprint when it starts (\"certificate SHA-256 \
+         fingerprint: ...\"): ask its operator for that line and pass the fingerprint with \
+         --cert-hash. If it is {presented}, connect again with --cert-hash {presented}; \
+         otherwise this is not the server you meant (or someone is intercepting the \
+         connection). Refusing to connect."
+    )]
     FingerprintMismatch {
         /// The pinned fingerprint.
         expected: Fingerprint,
@@ -34,34 +44,38 @@ pub enum ClientError {
         reason: String,
     },
     /// The connection failed (handshake, timeout, reset, ...).
-    #[error("connection failed: {0}")]
+    #[error("{}", connection_text(.0))]
     Connection(quinn::ConnectionError),
     /// The server refused the hello.
-    #[error("server rejected us: {0}")]
+    #[error("{}", rejected_text(.0))]
     Rejected(RejectReason),
     /// A message could not be encoded, or one from the server was
     /// malformed (the control stream is then out of sync).
-    #[error("protocol: {0}")]
+    #[error("{}", protocol_text(.0))]
     Protocol(#[from] ProtocolError),
     /// Reading or writing the control stream failed.
-    #[error("control stream: {0}")]
+    #[error("the connection to the server broke: {0}")]
     Stream(String),
     /// A datagram could not be sent.
     #[error("cannot send a datagram: {0}")]
     Datagram(#[from] quinn::SendDatagramError),
     /// The server sent a valid message at the wrong time.
-    #[error("unexpected message from server: {0}")]
+    #[error("the server sent something unexpected ({0}): client and server versions may differ")]
     Unexpected(String),
     /// The server ended the control stream.
-    #[error("server ended the control stream")]
+    #[error("the server ended the session")]
     StreamEnded,
     /// The server did not answer in time.
-    #[error("server did not answer in time")]
+    #[error(
+        "the server did not answer in time: check that it is running and that the address is \
+         a ledge server's"
+    )]
     Timeout,
     /// The server plays a level we do not have (or a different version).
     #[error(
-        "the server plays level {level_id:?} (hash {server:016x}), but {tried} has hash \
-         {ours:016x}: pass the server's level file (--level)"
+        "the server plays level \"{level_id}\" (hash {server:016x}), but {tried} has hash \
+         {ours:016x}: leave out --level to download the server's level, or pass the \
+         server's own level file with --level FILE"
     )]
     LevelMismatch {
         /// The level id the server sent.
@@ -74,7 +88,7 @@ pub enum ClientError {
         ours: u64,
     },
     /// A level file could not be loaded.
-    #[error("level: {0}")]
+    #[error("cannot load the level: {0}")]
     Level(String),
     /// The server offers a level bigger than any client downloads.
     #[error(
@@ -100,7 +114,7 @@ pub enum ClientError {
         expected: String,
     },
     /// The game refused something (a snapshot, a player).
-    #[error("game: {0}")]
+    #[error("the game refused what the server sent: {0}")]
     Game(#[from] ledge_shared::game::GameError),
     /// The server's certificate is not the one this client trusted for
     /// this address before (trust on first use).
@@ -120,6 +134,61 @@ impl ClientError {
             },
             other => ClientError::Connection(other),
         }
+    }
+}
+
+/// A failed connection in words, with what to check.
+fn connection_text(error: &quinn::ConnectionError) -> String {
+    use quinn::ConnectionError as E;
+    match error {
+        E::TimedOut => "the server did not answer (timed out): check the address and port (the \
+             server prints them when it starts), that the server is running, and that no \
+             firewall blocks UDP to that port"
+            .to_owned(),
+        E::Reset => "the server reset the connection (it may have restarted): connect again".into(),
+        E::VersionMismatch => {
+            "the server speaks another QUIC version: client and server versions differ".into()
+        }
+        E::LocallyClosed => "the connection was closed on our side".into(),
+        E::ApplicationClosed(close) => format!("the server closed the connection ({close})"),
+        other => format!("the connection failed: {other}"),
+    }
+}
+
+/// A refused hello in words, with what to do.
+fn rejected_text(reason: &RejectReason) -> String {
+    match reason {
+        RejectReason::InvalidName => format!(
+            "the server refused the player name: a name is 1 to {MAX_NAME_LEN} bytes without \
+             control characters; choose another with --name"
+        ),
+        RejectReason::RoomFull => "the server refused us: the room is full. Try again later, or \
+             ask the host for more places (ledge-server --max-players or --rooms)"
+            .to_owned(),
+        RejectReason::ShuttingDown => {
+            "the server refused us: it is shutting down. Connect again once it is back".to_owned()
+        }
+        RejectReason::ProtocolVersion { server, client } => format!(
+            "the server speaks protocol version {server} and this client {client}: use a \
+             client of the server's version"
+        ),
+        other => format!("the server refused us: {other}"),
+    }
+}
+
+/// A protocol error in words: our own bad input as it is, anything else
+/// from the server as a likely version difference.
+fn protocol_text(error: &ProtocolError) -> String {
+    match error {
+        ProtocolError::InvalidString { .. } | ProtocolError::InvalidValue { .. } => {
+            error.to_string()
+        }
+        ProtocolError::BadVersion { .. } => {
+            format!("{error}: use a client of the server's version")
+        }
+        other => format!(
+            "cannot read what the server sent ({other}): client and server versions may differ"
+        ),
     }
 }
 
@@ -179,6 +248,74 @@ mod tests {
         ] {
             let text = closed(code, "why");
             assert!(!text.contains("Some(") && !text.contains("None"), "{text}");
+        }
+    }
+
+    /// Every failure a player can meet, in words, saying what to do next.
+    #[test]
+    fn failures_say_what_to_do_next() {
+        let fp = |b| Fingerprint([b; 32]);
+        let cases: Vec<(ClientError, &[&str])> = vec![
+            (
+                ClientError::FingerprintMismatch {
+                    expected: fp(1),
+                    presented: fp(2),
+                },
+                &[
+                    "certificate SHA-256 fingerprint: ...",
+                    "--cert-hash 0202",
+                    "not 0101",
+                ],
+            ),
+            (
+                ClientError::Connection(quinn::ConnectionError::TimedOut),
+                &["address and port", "server is running", "firewall", "UDP"],
+            ),
+            (
+                ClientError::Rejected(RejectReason::InvalidName),
+                &["1 to 32 bytes", "--name"],
+            ),
+            (
+                ClientError::Rejected(RejectReason::RoomFull),
+                &["room is full", "Try again later"],
+            ),
+            (
+                ClientError::Rejected(RejectReason::Other {
+                    reason: "banned".into(),
+                }),
+                &["refused us: banned"],
+            ),
+            (
+                ClientError::LevelMismatch {
+                    level_id: "desert".into(),
+                    tried: "the embedded default level".into(),
+                    server: 1,
+                    ours: 2,
+                },
+                &["\"desert\"", "--level FILE", "0000000000000001"],
+            ),
+            (
+                ClientError::Address("nowhere".into()),
+                &["\"nowhere\"", "HOST:PORT"],
+            ),
+            (
+                ClientError::Protocol(ProtocolError::InvalidString {
+                    field: "player name",
+                    problem: "too long",
+                }),
+                &["invalid player name: too long"],
+            ),
+            (ClientError::Timeout, &["running"]),
+        ];
+        for (error, needles) in cases {
+            let text = error.to_string();
+            for needle in needles {
+                assert!(text.contains(needle), "{needle:?} missing from {text:?}");
+            }
+            // Words, not debug forms.
+            for debug in ["Some(", "None", "{ ", "\\\""] {
+                assert!(!text.contains(debug), "{debug:?} in {text:?}");
+            }
         }
     }
 }

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Duration;
 
-use common::{run_to_end, TestServer};
+use common::{run_to_end, xvfb_or_skip, TestServer};
 use ledge_client::Fingerprint;
 
 /// The client must have exited within this time.
@@ -129,22 +129,42 @@ fn known_hosts_and_a_pin_are_exclusive_and_need_a_server() {
     assert!(String::from_utf8_lossy(&alone.stderr).contains("--connect"));
 }
 
-fn xvfb_run() -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|dir| dir.join("xvfb-run"))
-        .find(|p| p.is_file())
+#[test]
+fn a_wrong_pinned_fingerprint_is_refused_saying_where_the_right_one_is() {
+    let server = TestServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    let wrong = Fingerprint([0x3c; 32]);
+    let mut command = client(dir.path());
+    command
+        .args(["--connect", &server.addr.to_string()])
+        .args(["--cert-hash", &wrong.to_string()])
+        .args(["--exit-after-ticks", "30"]);
+    let out = run(command);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(EXIT_UNTRUSTED),
+        "a wrong --cert-hash exits with {EXIT_UNTRUSTED}; stderr:\n{stderr}"
+    );
+    for needle in [
+        "ledge-client: ".to_owned(),
+        format!("not {wrong}"),
+        "certificate SHA-256 fingerprint: ...".to_owned(),
+        format!("--cert-hash {}", server.fingerprint),
+    ] {
+        assert!(
+            stderr.contains(&needle),
+            "{needle:?} missing from:\n{stderr}"
+        );
+    }
+    // Told once.
+    assert_eq!(stderr.matches("ledge-client: ").count(), 1, "{stderr}");
+    server.stop();
 }
 
 #[test]
 fn the_first_connection_stores_the_certificate() {
-    let Some(xvfb) = xvfb_run() else {
-        if std::env::var("CI").as_deref() == Ok("true") {
-            panic!("xvfb-run is not on PATH: install xvfb to run the client in CI");
-        }
-        let notice =
-            "\n*** SKIPPED trust-on-first-use client test: xvfb-run is not on PATH ***\n\n";
-        let _ = std::io::Write::write_all(&mut std::io::stderr(), notice.as_bytes());
+    let Some(xvfb) = xvfb_or_skip("the trust-on-first-use client test") else {
         return;
     };
     let server = TestServer::start();

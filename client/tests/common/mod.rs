@@ -23,19 +23,26 @@ impl TestServer {
     /// Starts a server with the default settings and a temporary
     /// certificate directory.
     pub fn start() -> TestServer {
+        TestServer::start_with(|_| {})
+    }
+
+    /// Starts a server on loopback with a temporary certificate directory
+    /// and the settings `configure` makes.
+    pub fn start_with(configure: impl FnOnce(&mut ServerConfig)) -> TestServer {
         let runtime = tokio::runtime::Builder::new_multi_thread()
             .worker_threads(1)
             .enable_all()
             .build()
             .unwrap();
         let certs = tempfile::tempdir().unwrap();
+        let mut config = ServerConfig {
+            bind: SocketAddr::from(([127, 0, 0, 1], 0)),
+            cert_dir: certs.path().to_owned(),
+            ..ServerConfig::default()
+        };
+        configure(&mut config);
         let (addr, fingerprint, shutdown, task) = runtime.block_on(async {
-            let server = Server::bind(ServerConfig {
-                bind: SocketAddr::from(([127, 0, 0, 1], 0)),
-                cert_dir: certs.path().to_owned(),
-                ..ServerConfig::default()
-            })
-            .expect("server binds");
+            let server = Server::bind(config).expect("server binds");
             (
                 server.local_addr(),
                 server.fingerprint(),
@@ -51,6 +58,12 @@ impl TestServer {
             task,
             _certs: certs,
         }
+    }
+
+    /// Runs `future` on the server's runtime (e.g. a session of a player
+    /// of the test's own).
+    pub fn block_on<F: std::future::Future>(&self, future: F) -> F::Output {
+        self.runtime.block_on(future)
     }
 
     /// Shuts the server down and waits (bounded) for it.
@@ -94,6 +107,25 @@ pub fn xvfb_run() -> Option<std::path::PathBuf> {
     std::env::split_paths(&path)
         .map(|dir| dir.join("xvfb-run"))
         .find(|p| p.is_file())
+}
+
+/// `xvfb-run` on `PATH`; without it, `None` after a loud notice that the
+/// test named `what` was skipped, or a failed test when `CI=true`.
+pub fn xvfb_or_skip(what: &str) -> Option<std::path::PathBuf> {
+    let found = xvfb_run();
+    if found.is_none() {
+        if std::env::var("CI").as_deref() == Ok("true") {
+            panic!("xvfb-run is not on PATH: install xvfb (apt-get install xvfb xauth) to run {what} in CI");
+        }
+        // Straight to the process's stderr: the test harness captures
+        // `eprintln!`, and this notice must be seen.
+        let notice = format!(
+            "\n*** SKIPPED {what}: xvfb-run is not on PATH (apt-get install xvfb xauth); \
+             with CI=true this test fails instead ***\n\n"
+        );
+        let _ = std::io::Write::write_all(&mut std::io::stderr(), notice.as_bytes());
+    }
+    found
 }
 
 /// A JSON `[x, y]` pair.

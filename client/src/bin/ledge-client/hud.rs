@@ -178,30 +178,114 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
     draw_text(help, x, y, 16.0, DIM);
 }
 
-/// A centred banner (connecting, disconnected, won), wrapped to the
-/// window's width so a long message is never clipped.
-pub fn banner(text: &str) {
-    let size = 28.0;
-    let max = (screen_width() - 64.0).max(64.0);
-    let lines = wrap(text, max, |t| measure_text(t, None, size as u16, 1.0).width);
-    let line_h = size * 1.15;
-    let widest = lines
-        .iter()
-        .map(|l| measure_text(l, None, size as u16, 1.0).width)
-        .fold(0.0f32, f32::max);
-    let top = screen_height() * 0.3 - size;
-    draw_rectangle(
-        (screen_width() - widest) / 2.0 - 16.0,
-        top - 12.0,
-        widest + 32.0,
-        line_h * lines.len() as f32 + 24.0,
-        PANEL,
-    );
-    for (i, line) in lines.iter().enumerate() {
-        let w = measure_text(line, None, size as u16, 1.0).width;
-        let y = top + size * 0.85 + line_h * i as f32;
-        draw_text(line, (screen_width() - w) / 2.0, y, size, WHITE);
+/// Font sizes a banner tries, largest first, until its text fits the
+/// window's height.
+const BANNER_SIZES: [f32; 6] = [28.0, 24.0, 20.0, 16.0, 14.0, 12.0];
+/// Between the window's edges and a banner's panel, pixels.
+const BANNER_EDGE: f32 = 16.0;
+/// Between a banner's panel and its text, pixels (sideways; 12 above and
+/// below).
+const BANNER_PAD: f32 = 16.0;
+/// A failure's panel: opaque, so its text stands out whatever is behind.
+pub const FAILURE_PANEL: Color = Color::new(0.45, 0.09, 0.1, 1.0);
+/// Drawn over the whole scene behind a failure's banner.
+const FAILURE_SHADE: Color = Color::new(0.02, 0.02, 0.04, 0.85);
+
+/// Where a banner goes: its lines, their font size and the panel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BannerLayout {
+    /// Font size, pixels.
+    pub size: f32,
+    /// The lines, each with the index of the paragraph it belongs to.
+    pub lines: Vec<(usize, String)>,
+    /// The panel behind them (the text lies inside, with margins).
+    pub panel: Rect,
+}
+
+impl BannerLayout {
+    /// Lays out `paragraphs` (each starts on a new line) centred in a
+    /// window of `screen` pixels: wrapped to the window's width, in the
+    /// largest of [`BANNER_SIZES`] whose lines fit its height, a third of
+    /// the way down when there is room. `width(text, size)` measures a
+    /// line.
+    pub fn new(paragraphs: &[&str], screen: Vec2, width: impl Fn(&str, f32) -> f32) -> Self {
+        let max = (screen.x - 2.0 * (BANNER_EDGE + BANNER_PAD)).max(16.0);
+        let room = screen.y - 2.0 * BANNER_EDGE;
+        let mut layout = None;
+        for size in BANNER_SIZES {
+            let lines: Vec<(usize, String)> = paragraphs
+                .iter()
+                .enumerate()
+                .flat_map(|(i, p)| {
+                    wrap(p, max, |t| width(t, size))
+                        .into_iter()
+                        .map(move |l| (i, l))
+                })
+                .collect();
+            let height = Self::line_height(size) * lines.len() as f32 + 24.0;
+            let fits = height <= room;
+            layout = Some((size, lines, height));
+            if fits {
+                break;
+            }
+        }
+        let (size, lines, height) = layout.expect("BANNER_SIZES is not empty");
+        let widest = lines
+            .iter()
+            .map(|(_, l)| width(l, size))
+            .fold(0.0f32, f32::max);
+        let w = widest + 2.0 * BANNER_PAD;
+        let lowest = (screen.y - BANNER_EDGE - height).max(BANNER_EDGE);
+        let y = (screen.y * 0.3 - size - 12.0).clamp(BANNER_EDGE, lowest);
+        BannerLayout {
+            size,
+            lines,
+            panel: Rect::new((screen.x - w) / 2.0, y, w, height),
+        }
     }
+
+    fn line_height(size: f32) -> f32 {
+        size * 1.15
+    }
+
+    /// The baseline of line `i` (where `draw_text` puts it).
+    pub fn baseline(&self, i: usize) -> f32 {
+        self.panel.y + 12.0 + self.size * 0.85 + Self::line_height(self.size) * i as f32
+    }
+}
+
+fn measure(text: &str, size: f32) -> f32 {
+    measure_text(text, None, size as u16, 1.0).width
+}
+
+/// Draws `layout` on `panel`: the first paragraph white, the others dim.
+fn draw_banner(layout: &BannerLayout, panel: Color) {
+    let p = layout.panel;
+    draw_rectangle(p.x, p.y, p.w, p.h, panel);
+    for (i, (paragraph, line)) in layout.lines.iter().enumerate() {
+        let x = (screen_width() - measure(line, layout.size)) / 2.0;
+        let colour = if *paragraph == 0 { WHITE } else { DIM };
+        draw_text(line, x, layout.baseline(i), layout.size, colour);
+    }
+}
+
+/// A centred banner (connecting, waiting), wrapped to the window's width
+/// so a long message is never clipped.
+pub fn banner(text: &str) {
+    let screen = vec2(screen_width(), screen_height());
+    draw_banner(&BannerLayout::new(&[text], screen, measure), PANEL);
+}
+
+/// The end of a failed session: the scene shaded, and `message` (what
+/// went wrong and what to do) on an opaque panel, wrapped to the window
+/// and shrunk to fit its height, with how to quit below it. Returns the
+/// layout drawn (for the screenshot's description).
+pub fn failure(message: &str) -> BannerLayout {
+    let screen = vec2(screen_width(), screen_height());
+    draw_rectangle(0.0, 0.0, screen.x, screen.y, FAILURE_SHADE);
+    let layout = BannerLayout::new(&[message, "Esc quits"], screen, measure);
+    draw_banner(&layout, FAILURE_PANEL);
+    layout
 }
 
 /// `text` in lines no wider than `max` (by `width`), broken between words;
@@ -242,7 +326,8 @@ pub fn wrap(text: &str, max: f32, width: impl Fn(&str) -> f32) -> Vec<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::wrap;
+    use super::{wrap, BannerLayout};
+    use macroquad::math::vec2;
 
     #[test]
     fn long_messages_wrap_between_words_and_never_exceed_the_width() {
@@ -265,5 +350,50 @@ mod tests {
         );
         assert_eq!(wrap("", 30.0, w), [""]);
         assert_eq!(wrap("short", 30.0, w), ["short"]);
+    }
+
+    /// A long failure in a small window: every line fits the width, the
+    /// panel lies inside the window, and the font shrinks until the lines
+    /// fit its height.
+    #[test]
+    fn a_banner_fits_small_windows() {
+        // 0.5 px per character per pixel of font size: 14 px per
+        // character at 28.
+        let w = |s: &str, size: f32| s.chars().count() as f32 * size * 0.5;
+        let long = "cannot play on 192.168.1.20:4433: the server plays level \"sandbox2\" (hash 8240e92b1acea947), but the embedded default level has hash 89e9fbc2af16c009: start the client with the server's level file, --level FILE (the server prints it in its join command)";
+        for (screen, short_enough) in [
+            (vec2(480.0, 270.0), true),
+            (vec2(960.0, 540.0), true),
+            (vec2(200.0, 120.0), false),
+        ] {
+            let layout = BannerLayout::new(&[long, "Esc quits"], screen, w);
+            let p = layout.panel;
+            assert!(
+                p.x >= 16.0 && p.right() <= screen.x - 16.0,
+                "{screen}: {p:?}"
+            );
+            assert!(p.y >= 16.0, "{screen}: {p:?}");
+            if short_enough {
+                assert!(p.bottom() <= screen.y - 16.0, "{screen}: {p:?}");
+            } else {
+                // Too long even at the smallest size: the top stays.
+                assert_eq!(layout.size, 12.0);
+            }
+            for (_, line) in &layout.lines {
+                assert!(w(line, layout.size) <= p.w - 32.0, "{line:?} in {p:?}");
+            }
+            assert_eq!(layout.lines.last().unwrap(), &(1, "Esc quits".to_owned()));
+            let first = layout.baseline(0) - layout.size * 0.85;
+            let last = layout.baseline(layout.lines.len() - 1) + layout.size * 0.3;
+            assert!(first >= p.y && last <= p.bottom(), "{layout:?}");
+        }
+        // Room to spare: the largest size, a third of the way down.
+        let small = BannerLayout::new(&["connecting..."], vec2(960.0, 540.0), w);
+        assert_eq!(small.size, 28.0);
+        assert_eq!(small.lines.len(), 1);
+        assert!((small.panel.y - (540.0 * 0.3 - 28.0 - 12.0)).abs() < 0.01);
+        // At 480x270 the long message needs a smaller font.
+        let shrunk = BannerLayout::new(&[long], vec2(480.0, 270.0), w);
+        assert!(shrunk.size < 28.0, "{shrunk:?}");
     }
 }

@@ -14,6 +14,19 @@
 //! The simulation runs at a fixed 60 Hz (accumulator); frames are drawn
 //! interpolated between the last two ticks. `--script`, `--screenshot` and
 //! `--exit-after-ticks` drive it without a human, for tests.
+//!
+//! A session that fails (the server cannot be reached, refuses us, drops
+//! us; its certificate is refused) is told once on stderr, prefixed
+//! `ledge-client: `, and in the window, wrapped to its size, until the
+//! player quits; the message says what to do next. Exit codes (also in
+//! `--help`):
+//!
+//! * 0: the game ended normally (Esc, window closed, `--exit-after-ticks`);
+//! * 1 ([`EXIT_FAILED`]): the session failed, or the game could not start
+//!   (a level or keys file, the screenshot);
+//! * 2 ([`EXIT_JOIN_TIMEOUT`]): not joined within `--join-timeout` (with
+//!   `--exit-after-ticks`); also clap's code for command-line errors;
+//! * 3 ([`EXIT_UNTRUSTED`]): the server's certificate was refused.
 
 mod art;
 mod camera;
@@ -51,8 +64,30 @@ const MAX_FPS: f64 = 240.0;
 /// refused certificate is reported on the terminal without a window.
 const CONNECT_WAIT: Duration = Duration::from_secs(3);
 
+/// Exit code when the session failed (or the game could not start).
+const EXIT_FAILED: i32 = 1;
+
+/// Exit code when not joined within `--join-timeout` (clap's usage errors
+/// exit with 2 too).
+const EXIT_JOIN_TIMEOUT: i32 = 2;
+
 /// Exit code when the server's certificate is refused.
 const EXIT_UNTRUSTED: i32 = 3;
+
+/// Frames drawn with a failure's banner before `--exit-after-ticks` ends
+/// the run (and `--screenshot` takes the last): the first frames of a
+/// new window may not be on screen yet.
+const FAILURE_FRAMES: u32 = 3;
+
+/// The exit codes, for `--help`.
+const EXIT_CODES: &str = "Exit codes:
+  0  the game ended normally (Esc, window closed, --exit-after-ticks reached)
+  1  the session failed (server unreachable, refused us or dropped us), or the
+     game could not start (level or keys file, screenshot); the reason is
+     printed on stderr, prefixed \"ledge-client: \"
+  2  a command-line error, or not joined within --join-timeout
+  3  the server's certificate was refused (wrong --cert-hash, or not the one
+     remembered in the known-hosts file)";
 
 /// The process exit code, set by the game loop (macroquad's loop owns the
 /// main thread until it ends).
@@ -65,7 +100,7 @@ static EXIT_CODE: AtomicI32 = AtomicI32::new(0);
 /// ledges, F1 debug overlay, F2 HUD, Esc quits. Gamepads need the
 /// `gamepad` build feature.
 #[derive(Debug, Parser)]
-#[command(version)]
+#[command(version, after_help = EXIT_CODES)]
 struct Cli {
     /// Server to join, as HOST:PORT (without it or --local: play offline).
     #[arg(long, value_name = "HOST:PORT")]
@@ -99,8 +134,8 @@ struct Cli {
     /// server's default].
     #[arg(long, value_name = "FILE")]
     level_settings: Option<PathBuf>,
-    /// Player name.
-    #[arg(long, default_value = "player")]
+    /// Player name: 1 to 32 bytes (UTF-8), no control characters.
+    #[arg(long, default_value = "player", value_parser = parse_name)]
     name: String,
     /// Key bindings file (TOML; actions left out keep their defaults).
     #[arg(long, value_name = "FILE")]
@@ -140,27 +175,46 @@ struct Cli {
 fn parse_size(s: &str) -> Result<(i32, i32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
-        .ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT"))?;
+        .ok_or_else(|| "expected WIDTHxHEIGHT, e.g. 960x540".to_owned())?;
     let n = |v: &str| {
         v.trim()
             .parse::<i32>()
             .ok()
             .filter(|&v| (64..=16384).contains(&v))
-            .ok_or_else(|| format!("{v:?}: expected a size in pixels (64..=16384)"))
+            .ok_or_else(|| format!("'{v}': expected a size in pixels (64 to 16384)"))
     };
     Ok((n(w)?, n(h)?))
+}
+
+/// A player name the server accepts (checked here, so a bad one is a
+/// command-line error naming the limit, not a refusal after connecting).
+fn parse_name(s: &str) -> Result<String, String> {
+    use ledge_shared::protocol::{check_name, MAX_NAME_LEN};
+    if check_name(s).is_ok() {
+        return Ok(s.to_owned());
+    }
+    Err(if s.is_empty() {
+        "a player name cannot be empty".to_owned()
+    } else if s.len() > MAX_NAME_LEN {
+        format!(
+            "the name is {} bytes long; a player name is at most {MAX_NAME_LEN} bytes",
+            s.len()
+        )
+    } else {
+        "a player name cannot contain control characters".to_owned()
+    })
 }
 
 fn parse_point(s: &str) -> Result<(f32, f32), String> {
     let (x, y) = s
         .split_once(',')
-        .ok_or_else(|| format!("{s:?}: expected X,Y"))?;
+        .ok_or_else(|| "expected X,Y, e.g. 400,240".to_owned())?;
     let n = |v: &str| {
         v.trim()
             .parse::<f32>()
             .ok()
             .filter(|v| v.is_finite())
-            .ok_or_else(|| format!("{v:?}: expected a number of pixels"))
+            .ok_or_else(|| format!("'{v}': expected a number of pixels"))
     };
     Ok((n(x)?, n(y)?))
 }
@@ -182,7 +236,23 @@ struct Setup {
     server: Option<local::LocalServer>,
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> std::process::ExitCode {
+    match run() {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            tell(&format!("{e:#}"));
+            std::process::ExitCode::from(EXIT_FAILED as u8)
+        }
+    }
+}
+
+/// A line on stderr, prefixed `ledge-client: ` (a closed stderr is no
+/// reason to panic).
+fn tell(message: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "ledge-client: {message}");
+}
+
+fn run() -> anyhow::Result<()> {
     // Parse before opening the window, so `--help` and errors need no display.
     let cli = Cli::parse();
     if cli.print_keys {
@@ -254,7 +324,7 @@ fn main() -> anyhow::Result<()> {
     // A refused certificate ends here, on the terminal, before any window.
     play.wait_for_network(CONNECT_WAIT);
     if let Some(message) = play.untrusted() {
-        eprintln!("ledge-client: {message}");
+        tell(message);
         std::process::exit(EXIT_UNTRUSTED);
     }
     let setup = Setup {
@@ -287,10 +357,37 @@ fn main() -> anyhow::Result<()> {
     }
 }
 
-/// Fails the run: message on stderr, exit code `code`.
+/// Fails the run: message on stderr, exit code `code` (the first failure's
+/// code is kept).
 fn fail(code: i32, message: &str) {
-    eprintln!("ledge-client: {message}");
-    EXIT_CODE.store(code, Ordering::Relaxed);
+    tell(message);
+    let _ = EXIT_CODE.compare_exchange(0, code, Ordering::Relaxed, Ordering::Relaxed);
+}
+
+/// Why the session cannot go on, if so: the exit code and the message
+/// (what went wrong and what to do). `waited`: time since the window
+/// opened.
+fn session_failure(setup: &Setup, waited: Duration) -> Option<(i32, String)> {
+    if let Some(message) = setup.play.untrusted() {
+        return Some((EXIT_UNTRUSTED, message.to_owned()));
+    }
+    if let Some(message) = setup.play.failure() {
+        return Some((EXIT_FAILED, message));
+    }
+    let waited_too_long =
+        setup.exit_after.is_some() && !setup.play.joined() && waited > setup.join_timeout;
+    waited_too_long.then(|| {
+        (
+            EXIT_JOIN_TIMEOUT,
+            format!(
+                "not joined to {} within {} s (--join-timeout): check the address and port \
+                 (the server prints them when it starts), that the server is running, and \
+                 that no firewall blocks UDP to that port",
+                setup.play.server(),
+                setup.join_timeout.as_secs()
+            ),
+        )
+    })
 }
 
 async fn game(mut setup: Setup) {
@@ -309,6 +406,10 @@ async fn game(mut setup: Setup) {
     );
     // Closing the window ends the loop below, so we leave the server.
     prevent_quit();
+    // The session's failure, once known: told once, then shown until the
+    // player quits.
+    let mut failed: Option<String> = None;
+    let mut failed_frames: u32 = 0;
     loop {
         if Bindings::pressed(&setup.bindings.quit) || is_quit_requested() {
             break;
@@ -341,18 +442,10 @@ async fn game(mut setup: Setup) {
         if let Some(stats) = &stats {
             graph.rtt(now, stats.rtt_ms);
         }
-        if let Some(message) = setup.play.untrusted() {
-            fail(EXIT_UNTRUSTED, message);
-            break;
-        }
-        if setup.exit_after.is_some() {
-            if let Some(reason) = setup.play.failure() {
-                fail(2, &reason);
-                break;
-            }
-            if !setup.play.joined() && started.elapsed() > setup.join_timeout {
-                fail(2, &format!("not joined after {:?}", setup.join_timeout));
-                break;
+        if failed.is_none() {
+            if let Some((code, message)) = session_failure(&setup, started.elapsed()) {
+                fail(code, &message);
+                failed = Some(message);
             }
         }
 
@@ -429,7 +522,9 @@ async fn game(mut setup: Setup) {
                 debug::draw(game.game().world(), &view);
             }
         }
-        if show_hud {
+        // A failure covers the scene; the HUD's figures mean nothing then.
+        let failure = failed.as_deref().map(hud::failure);
+        if show_hud && failure.is_none() {
             let status = setup.play.status_line();
             let info = hud::HudInfo {
                 status: &status,
@@ -441,12 +536,19 @@ async fn game(mut setup: Setup) {
             };
             hud::draw(&info, &graph, now);
         }
-        if let Some(text) = setup.play.banner() {
+        if let (None, Some(text)) = (&failure, setup.play.banner()) {
             hud::banner(&text);
         }
 
-        // Done?
-        if setup.exit_after.is_some_and(|n| played >= n) {
+        // Done? (A failed run after a few frames showing why.)
+        if failure.is_some() {
+            failed_frames += 1;
+        }
+        let done = match failure {
+            Some(_) => setup.exit_after.is_some() && failed_frames >= FAILURE_FRAMES,
+            None => setup.exit_after.is_some_and(|n| played >= n),
+        };
+        if done {
             if let Some(path) = &setup.screenshot {
                 let shot = shot::Shot {
                     tick: played,
@@ -465,9 +567,10 @@ async fn game(mut setup: Setup) {
                             size: p.size,
                         })
                         .collect(),
+                    failure: failed.as_deref().zip(failure.as_ref()),
                 };
                 if let Err(e) = shot::save(path, &shot) {
-                    fail(1, &format!("saving the screenshot: {e}"));
+                    fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));
                 }
             }
             break;

@@ -56,6 +56,8 @@ pub struct Play {
     /// The level drawn until the server's is known.
     level: Level,
     mode: Mode,
+    /// The server's address as the player gave it (online).
+    server: String,
     started: Instant,
 }
 
@@ -67,6 +69,7 @@ impl Play {
         Ok(Play {
             level,
             mode: Mode::Offline(Box::new(game)),
+            server: String::new(),
             started: Instant::now(),
         })
     }
@@ -74,11 +77,13 @@ impl Play {
     /// Connects on a background thread as `request` says; the game starts
     /// when welcomed. `level` is drawn until then.
     pub fn online(request: OnlineRequest, level: Level) -> anyhow::Result<Play> {
+        let server = request.server.clone();
         let online = OnlineGame::connect(request)
             .map_err(|e| anyhow::anyhow!("starting the network thread: {e}"))?;
         Ok(Play {
             level,
             mode: Mode::Online(Box::new(online)),
+            server,
             started: Instant::now(),
         })
     }
@@ -101,6 +106,11 @@ impl Play {
         if let Mode::Online(online) = &mut self.mode {
             online.wait(timeout);
         }
+    }
+
+    /// The server's address as the player gave it (empty offline).
+    pub fn server(&self) -> &str {
+        &self.server
     }
 
     /// The online game, if online.
@@ -127,15 +137,18 @@ impl Play {
         self.game().is_some()
     }
 
-    /// Why the game cannot go on, if so.
+    /// Why the game cannot go on, if so: one sentence or more, in words,
+    /// naming the server and saying what to do (the window shows it, and
+    /// stderr).
     pub fn failure(&self) -> Option<String> {
         let online = self.connection()?;
+        let server = &self.server;
         if let Some(e) = online.error() {
-            return Some(e.to_owned());
+            return Some(format!("cannot play on {server}: {e}"));
         }
         match online.status() {
-            NetStatus::Failed(r) => Some(format!("connection failed: {r}")),
-            NetStatus::Disconnected(r) => Some(format!("disconnected: {r}")),
+            NetStatus::Failed(r) => Some(format!("cannot join {server}: {r}")),
+            NetStatus::Disconnected(r) => Some(format!("disconnected from {server}: {r}")),
             _ => None,
         }
     }
@@ -190,7 +203,8 @@ impl Play {
         Some(self.connection()?.game()?.net_stats(Instant::now()))
     }
 
-    /// One line about the game.
+    /// One short line about the game (a failure's reason is the
+    /// banner's, not this line's: it would not fit).
     pub fn status_line(&self) -> String {
         match self.connection().map(OnlineGame::status) {
             None => format!("offline: {}", self.level.name),
@@ -198,15 +212,15 @@ impl Play {
                 "online: {} on {}, you are player {}",
                 welcome.room, welcome.level_id, welcome.player_id.0
             ),
+            Some(NetStatus::Failed(_)) => format!("could not join {}", self.server),
+            Some(NetStatus::Disconnected(_)) => format!("disconnected from {}", self.server),
             Some(status) => status.to_string(),
         }
     }
 
-    /// A message for the middle of the screen, if any.
+    /// A message for the middle of the screen while connecting or waiting,
+    /// if any (failures: [`Play::failure`]).
     pub fn banner(&self) -> Option<String> {
-        if let Some(f) = self.failure() {
-            return Some(f);
-        }
         match self.connection()?.status() {
             NetStatus::Connecting(server) => Some(format!(
                 "connecting to {server}... ({:.0} s)",

@@ -23,7 +23,14 @@
 //!     {"id": 2, "label": "bob", "drawn_screen": [60.0, 412.0], "size_px": [12.0, 16.0]}
 //!   ],
 //!   "colors": {"sky": [r, g, b], "solid": [...], "grass": [...],
-//!              "local_player": [...], "one_way": [...]}
+//!              "local_player": [...], "one_way": [...]},
+//!   "failure": {                       // null unless the session failed
+//!     "message": "cannot join ...",    // as printed on stderr
+//!     "font_size": 20.0,
+//!     "panel": [40.0, 16.0, 400.0, 200.0],  // x, y, w, h: the text is inside
+//!     "panel_color": [r, g, b],
+//!     "lines": ["cannot join ...", ..., "Esc quits"]
+//!   }
 //! }
 //! ```
 
@@ -35,6 +42,7 @@ use macroquad::math::{Rect, Vec2};
 use macroquad::texture::get_screen_data;
 
 use crate::camera::View;
+use crate::hud::{BannerLayout, FAILURE_PANEL};
 use crate::render::palette;
 
 /// What a screenshot records.
@@ -54,6 +62,8 @@ pub struct Shot<'a> {
     pub drawn: Option<Vec2>,
     /// The other players drawn.
     pub remotes: Vec<RemoteShot<'a>>,
+    /// The session's failure and its banner as drawn, if it failed.
+    pub failure: Option<(&'a str, &'a BannerLayout)>,
 }
 
 /// A remote player as drawn.
@@ -88,6 +98,23 @@ pub fn save(path: &Path, shot: &Shot) -> std::io::Result<()> {
 
 fn pair(v: Vec2) -> String {
     format!("[{:.3}, {:.3}]", v.x, v.y)
+}
+
+/// `text` as a JSON string.
+fn json_string(text: &str) -> String {
+    let mut s = String::from("\"");
+    for c in text.chars() {
+        match c {
+            '"' => s.push_str("\\\""),
+            '\\' => s.push_str("\\\\"),
+            c if u32::from(c) < 0x20 => {
+                let _ = write!(s, "\\u{:04x}", u32::from(c));
+            }
+            c => s.push(c),
+        }
+    }
+    s.push('"');
+    s
 }
 
 fn rgb(c: macroquad::color::Color) -> String {
@@ -160,13 +187,33 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
     }
     let _ = writeln!(
         s,
-        "  \"colors\": {{\"sky\": {}, \"solid\": {}, \"grass\": {}, \"local_player\": {}, \"one_way\": {}}}",
+        "  \"colors\": {{\"sky\": {}, \"solid\": {}, \"grass\": {}, \"local_player\": {}, \"one_way\": {}}},",
         rgb(palette::SKY),
         rgb(palette::SOLID),
         rgb(palette::GRASS),
         rgb(palette::LOCAL_PLAYER),
         rgb(palette::PLANK),
     );
+    match shot.failure {
+        Some((message, layout)) => {
+            let p = layout.panel;
+            let lines: Vec<String> = layout.lines.iter().map(|(_, l)| json_string(l)).collect();
+            let _ = writeln!(s, "  \"failure\": {{");
+            let _ = writeln!(s, "    \"message\": {},", json_string(message));
+            let _ = writeln!(s, "    \"font_size\": {:.1},", layout.size);
+            let _ = writeln!(
+                s,
+                "    \"panel\": [{:.3}, {:.3}, {:.3}, {:.3}],",
+                p.x, p.y, p.w, p.h
+            );
+            let _ = writeln!(s, "    \"panel_color\": {},", rgb(FAILURE_PANEL));
+            let _ = writeln!(s, "    \"lines\": [{}]", lines.join(", "));
+            let _ = writeln!(s, "  }}");
+        }
+        None => {
+            let _ = writeln!(s, "  \"failure\": null");
+        }
+    }
     s.push_str("}\n");
     s
 }
@@ -200,6 +247,7 @@ mod tests {
                 pos: Vec2::new(10.0, 20.0),
                 size: Vec2::new(12.0, 16.0),
             }],
+            failure: None,
         };
         let json = describe(&shot, Path::new("/tmp/a.png"), 960, 540);
         assert!(
@@ -219,5 +267,44 @@ mod tests {
             json_path(Path::new("x/s.png")),
             PathBuf::from("x/s.png.json")
         );
+    }
+
+    #[test]
+    fn json_tells_the_failure_as_printed() {
+        let view = View {
+            zoom: 1.0,
+            offset: Vec2::ZERO,
+            screen: Vec2::new(480.0, 270.0),
+        };
+        let message = "the server plays level \"a\\b\"\tnow";
+        let layout = BannerLayout {
+            size: 20.0,
+            lines: vec![(0, message.to_owned()), (1, "Esc quits".to_owned())],
+            panel: Rect::new(40.0, 16.0, 400.0, 80.5),
+        };
+        let shot = Shot {
+            tick: 0,
+            view: &view,
+            level_px: Rect::new(0.0, 0.0, 1.0, 1.0),
+            tile_px: 16,
+            server: None,
+            drawn: None,
+            remotes: Vec::new(),
+            failure: Some((message, &layout)),
+        };
+        let json: serde_json::Value =
+            serde_json::from_str(&describe(&shot, Path::new("f.png"), 480, 270)).expect("JSON");
+        let failure = &json["failure"];
+        assert_eq!(failure["message"], message);
+        assert_eq!(failure["lines"][1], "Esc quits");
+        assert_eq!(failure["panel"][3], 80.5);
+        assert_eq!(failure["font_size"], 20.0);
+        let none = Shot {
+            failure: None,
+            ..shot
+        };
+        let json: serde_json::Value =
+            serde_json::from_str(&describe(&none, Path::new("f.png"), 480, 270)).expect("JSON");
+        assert!(json["failure"].is_null());
     }
 }
