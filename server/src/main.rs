@@ -3,18 +3,60 @@
 //! Prints the certificate fingerprint clients must pin, then runs until
 //! Ctrl-C or SIGTERM and shuts down gracefully. Options: `--help`, and
 //! `docs/SERVER.md`.
+//!
+//! Exit codes: 0 stopped by Ctrl-C or SIGTERM; 1 could not start (the
+//! reason on stderr, prefixed `ledge-server: `, with what to change, e.g.
+//! `--bind` when the port is in use) or failed while running; 2 a
+//! command-line error.
 
 use std::io::{IsTerminal, Write};
+use std::process::ExitCode;
 
 use anyhow::Context;
-use clap::Parser;
+use clap::{CommandFactory, FromArgMatches};
 use ledge_server::config::Cli;
 use ledge_server::Server;
 use tracing_subscriber::EnvFilter;
+/// The exit codes, for `--help`.
+const EXIT_CODES: &str = "Exit codes:
+  0  stopped by Ctrl-C or SIGTERM
+  1  could not start (the reason and what to change are printed on stderr,
+     prefixed \"ledge-server: \"; a port in use: choose another with --bind),
+     or failed while running
+  2  a command-line error";
 
 #[tokio::main]
-async fn main() -> anyhow::Result<()> {
-    let cli = Cli::parse();
+async fn main() -> ExitCode {
+    match run().await {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            let _ = writeln!(std::io::stderr().lock(), "ledge-server: {}", told(&e));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// An error and its causes on one line, each cause once: most of our
+/// errors already say their cause (`cannot bind ...: {source}`), which
+/// anyhow's `{:#}` would repeat.
+fn told(error: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in error.chain() {
+        let cause = cause.to_string();
+        if text.contains(&cause) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&cause);
+    }
+    text
+}
+
+async fn run() -> anyhow::Result<()> {
+    let matches = Cli::command().after_help(EXIT_CODES).get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     // Logs on stderr, coloured only on a terminal; stdout carries the
     // join instructions. A log line that cannot be written (stderr closed:
     // `ledge-server 2>&1 | head -1`) is dropped: reporting it would
@@ -127,5 +169,23 @@ impl ShutdownSignals {
                 std::future::pending().await
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_error_says_each_cause_once() {
+        let io = std::io::Error::from(std::io::ErrorKind::AddrInUse);
+        let inner = anyhow::Error::new(io).context("cannot bind 0.0.0.0:1: address in use");
+        let e = inner.context("starting the server");
+        assert_eq!(
+            told(&e),
+            "starting the server: cannot bind 0.0.0.0:1: address in use"
+        );
+        let plain = anyhow::anyhow!("a").context("b");
+        assert_eq!(told(&plain), "b: a");
     }
 }

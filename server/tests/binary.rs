@@ -1,15 +1,20 @@
 //! The real `ledge-server` binary as a host runs it: logs on stderr without
 //! colour codes when stderr is not a terminal, the join instructions on
 //! stdout, and Ctrl-C (SIGINT) stops it promptly even after whoever read its
-//! output went away (`ledge-server 2>&1 | head -1`).
+//! output went away (`ledge-server 2>&1 | head -1`), and a port in use is
+//! a failure (exit code 1) saying which option to change.
 
 use std::io::{BufRead, BufReader, Read};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 fn start(cert_dir: &std::path::Path) -> Child {
+    start_on("127.0.0.1:0", cert_dir)
+}
+
+fn start_on(bind: &str, cert_dir: &std::path::Path) -> Child {
     Command::new(env!("CARGO_BIN_EXE_ledge-server"))
-        .args(["--bind", "127.0.0.1:0", "--cert-dir"])
+        .args(["--bind", bind, "--cert-dir"])
         .arg(cert_dir)
         .env("RUST_LOG", "info")
         .stdin(Stdio::null())
@@ -104,4 +109,34 @@ fn sigint_stops_it_after_its_readers_went_away() {
         "still running {:?} after SIGINT",
         started.elapsed()
     );
+}
+
+#[test]
+fn a_port_in_use_fails_naming_the_option_to_change() {
+    let taken = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let addr = taken.local_addr().unwrap();
+    let certs = tempfile::tempdir().unwrap();
+    let mut child = start_on(&addr.to_string(), certs.path());
+    let status = exits_within(&mut child, Duration::from_secs(30)).expect("exits");
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    assert_eq!(status.code(), Some(1), "{err}");
+    let next = format!("--bind 127.0.0.1:{}", addr.port() + 1);
+    for needle in [
+        "ledge-server: ",
+        &format!("cannot bind {addr}"),
+        &format!("uses port {}", addr.port()),
+        &next,
+    ] {
+        assert!(err.contains(needle), "{needle:?} missing from:\n{err}");
+    }
+    // Words, not a debug report; the cause said once.
+    assert!(!err.contains("Caused by") && !err.contains("Os {"), "{err}");
+    assert_eq!(err.matches("in use").count(), 1, "{err}");
+    drop(taken);
 }
