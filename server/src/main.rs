@@ -1,6 +1,8 @@
 //! `ledge-server`: host a ledge game.
 //!
-//! Prints the certificate fingerprint clients must pin, then runs until
+//! Prints the certificate fingerprint clients must pin and a join command
+//! for each address it can be reached on (every network interface when
+//! bound to all of them, loopback for this machine), then runs until
 //! Ctrl-C or SIGTERM and shuts down gracefully. Options: `--help`, and
 //! `docs/SERVER.md`.
 //!
@@ -10,6 +12,7 @@
 //! command-line error.
 
 use std::io::{IsTerminal, Write};
+use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddr};
 use std::process::ExitCode;
 
 use anyhow::Context;
@@ -17,6 +20,7 @@ use clap::{CommandFactory, FromArgMatches};
 use ledge_server::config::Cli;
 use ledge_server::Server;
 use tracing_subscriber::EnvFilter;
+
 /// The exit codes, for `--help`.
 const EXIT_CODES: &str = "Exit codes:
   0  stopped by Ctrl-C or SIGTERM
@@ -81,7 +85,7 @@ async fn run() -> anyhow::Result<()> {
     // server at once.
     let signals = ShutdownSignals::install().context("installing signal handlers")?;
     let fingerprint = server.fingerprint();
-    let port = server.local_addr().port();
+    let bound = server.local_addr();
     say(format_args!(
         "ledge server listening on {}",
         server.local_addr()
@@ -99,10 +103,37 @@ async fn run() -> anyhow::Result<()> {
         .as_ref()
         .map(|p| format!(" --level {}", p.display()))
         .unwrap_or_default();
-    say(format_args!(
-        "connect with: cargo run --release -p ledge-client -- \
-         --connect 127.0.0.1:{port} --cert-hash {fingerprint}{level} --name YOUR_NAME"
-    ));
+    let interfaces = if bound.ip().is_unspecified() {
+        match if_addrs::get_if_addrs() {
+            Ok(list) => list
+                .into_iter()
+                .filter(|i| i.oper_status != if_addrs::IfOperStatus::Down)
+                .map(|i| (i.name.clone(), i.ip()))
+                .collect(),
+            Err(e) => {
+                tracing::warn!("cannot list the network interfaces: {e}");
+                Vec::new()
+            }
+        }
+    } else {
+        Vec::new()
+    };
+    let joins = join_addresses(bound, &interfaces);
+    for join in &joins {
+        say(format_args!(
+            "{}: cargo run --release -p ledge-client -- \
+             --connect {} --cert-hash {fingerprint}{level} --name YOUR_NAME",
+            join.who(),
+            join.addr
+        ));
+    }
+    if bound.ip().is_unspecified() && joins.iter().all(|j| j.interface.is_none()) {
+        say(format_args!(
+            "(no network interface found: players on other machines can join once this \
+             one is on a network, at its address and port {})",
+            bound.port()
+        ));
+    }
 
     let shutdown = server.shutdown_handle();
     tokio::spawn(async move {
@@ -111,6 +142,67 @@ async fn run() -> anyhow::Result<()> {
         shutdown.shutdown();
     });
     server.run().await.context("running the server")
+}
+
+/// An address players can join at.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct JoinAddress {
+    /// The address to pass to `--connect`.
+    addr: SocketAddr,
+    /// The network interface it belongs to; `None`: loopback, for players
+    /// on this machine (or the one address the server is bound to).
+    interface: Option<String>,
+}
+
+impl JoinAddress {
+    /// Whom the address is for, as the join line starts.
+    fn who(&self) -> String {
+        match &self.interface {
+            None if self.addr.ip().is_loopback() => "join from this machine".to_owned(),
+            None => "join from this machine or your network".to_owned(),
+            Some(name) => format!("join from your network ({name})"),
+        }
+    }
+}
+
+/// The addresses a server bound to `bound` can be joined at, given the
+/// machine's interface addresses (`(interface name, address)`): bound to a
+/// specific address, just that one; bound to all IPv4 interfaces
+/// (`0.0.0.0`), loopback first (for this machine), then every other IPv4
+/// address; bound to `[::]`, the same with IPv6 addresses too (IPv6
+/// link-local addresses are left out: they need an interface scope to
+/// be dialled). Duplicates are dropped.
+fn join_addresses(bound: SocketAddr, interfaces: &[(String, IpAddr)]) -> Vec<JoinAddress> {
+    let port = bound.port();
+    let at = |ip: IpAddr, interface: Option<&String>| JoinAddress {
+        addr: SocketAddr::new(ip, port),
+        interface: interface.cloned(),
+    };
+    if !bound.ip().is_unspecified() {
+        return vec![at(bound.ip(), None)];
+    }
+    let v6 = bound.is_ipv6();
+    let loopback = if v6 {
+        IpAddr::V6(Ipv6Addr::LOCALHOST)
+    } else {
+        IpAddr::V4(Ipv4Addr::LOCALHOST)
+    };
+    let mut joins = vec![at(loopback, None)];
+    for (name, ip) in interfaces {
+        let usable = match ip {
+            IpAddr::V4(ip) => !ip.is_loopback() && !ip.is_unspecified(),
+            IpAddr::V6(ip) => {
+                v6 && !ip.is_loopback()
+                    && !ip.is_unspecified()
+                    // fe80::/10
+                    && (ip.segments()[0] & 0xffc0) != 0xfe80
+            }
+        };
+        if usable && joins.iter().all(|j| j.addr.ip() != *ip) {
+            joins.push(at(*ip, Some(name)));
+        }
+    }
+    joins
 }
 
 /// A line on stdout. Unlike `println!`, a closed stdout (`ledge-server |
@@ -176,6 +268,71 @@ impl ShutdownSignals {
 mod tests {
     use super::*;
 
+    fn ifaces(list: &[(&str, &str)]) -> Vec<(String, IpAddr)> {
+        list.iter()
+            .map(|(n, ip)| (n.to_string(), ip.parse().unwrap()))
+            .collect()
+    }
+
+    fn addrs(joins: &[JoinAddress]) -> Vec<String> {
+        joins.iter().map(|j| j.addr.to_string()).collect()
+    }
+
+    const MACHINE: &[(&str, &str)] = &[
+        ("lo", "127.0.0.1"),
+        ("eth0", "192.168.1.20"),
+        ("wlan0", "10.0.0.7"),
+        ("lo", "::1"),
+        ("eth0", "fe80::1c2:3ff:fe4:5"),
+        ("eth0", "2001:db8::20"),
+        // Listed twice (two interfaces on one address): said once.
+        ("br0", "192.168.1.20"),
+    ];
+
+    #[test]
+    fn all_ipv4_interfaces_loopback_first_then_each_network_address() {
+        let joins = join_addresses("0.0.0.0:4433".parse().unwrap(), &ifaces(MACHINE));
+        assert_eq!(
+            addrs(&joins),
+            ["127.0.0.1:4433", "192.168.1.20:4433", "10.0.0.7:4433"]
+        );
+        assert_eq!(joins[0].who(), "join from this machine");
+        assert_eq!(joins[1].who(), "join from your network (eth0)");
+        assert_eq!(joins[2].who(), "join from your network (wlan0)");
+    }
+
+    #[test]
+    fn all_interfaces_of_both_families_add_routable_ipv6_addresses() {
+        let joins = join_addresses("[::]:5001".parse().unwrap(), &ifaces(MACHINE));
+        assert_eq!(
+            addrs(&joins),
+            [
+                "[::1]:5001",
+                "192.168.1.20:5001",
+                "10.0.0.7:5001",
+                "[2001:db8::20]:5001"
+            ]
+        );
+        assert_eq!(joins[0].who(), "join from this machine");
+        assert_eq!(joins[3].who(), "join from your network (eth0)");
+    }
+
+    #[test]
+    fn a_specific_address_is_the_only_one() {
+        for (bound, who) in [
+            (
+                "192.168.1.20:4433",
+                "join from this machine or your network",
+            ),
+            ("127.0.0.1:4433", "join from this machine"),
+            ("[::1]:4433", "join from this machine"),
+        ] {
+            let joins = join_addresses(bound.parse().unwrap(), &ifaces(MACHINE));
+            assert_eq!(addrs(&joins), [bound]);
+            assert_eq!(joins[0].who(), who);
+        }
+    }
+
     #[test]
     fn an_error_says_each_cause_once() {
         let io = std::io::Error::from(std::io::ErrorKind::AddrInUse);
@@ -187,5 +344,15 @@ mod tests {
         );
         let plain = anyhow::anyhow!("a").context("b");
         assert_eq!(told(&plain), "b: a");
+    }
+
+    #[test]
+    fn without_network_interfaces_only_loopback() {
+        let joins = join_addresses(
+            "0.0.0.0:4433".parse().unwrap(),
+            &ifaces(&[("lo", "127.0.0.1")]),
+        );
+        assert_eq!(addrs(&joins), ["127.0.0.1:4433"]);
+        assert!(joins[0].interface.is_none());
     }
 }
