@@ -15,7 +15,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 use std::time::Duration;
 
-use common::{pair, run_to_end, xvfb_or_skip, Png, TestServer};
+use common::{pair, run_to_end, screenshot_dir, xvfb_or_skip, Png, TestServer};
 use ledge_client::connect;
 use serde_json::Value;
 
@@ -69,10 +69,7 @@ fn a_refused_join_is_shown_inside_a_small_window_and_on_stderr() {
 
     // LEDGE_SCREENSHOT_DIR keeps the picture (to look at it).
     let tmp = tempfile::tempdir().unwrap();
-    let dir = std::env::var_os("LEDGE_SCREENSHOT_DIR")
-        .map(std::path::PathBuf::from)
-        .unwrap_or_else(|| tmp.path().to_owned());
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = screenshot_dir(tmp.path());
     let png_path = dir.join("failure.png");
     let mut command = windowed(&xvfb, tmp.path());
     command

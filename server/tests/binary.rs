@@ -33,6 +33,18 @@ fn interrupt(child: &Child) {
     assert!(status.success());
 }
 
+/// All the child's stderr (to its end: call once it exited).
+fn stderr_of(child: &mut Child) -> String {
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    err
+}
+
 /// Waits up to `limit` for the child to exit.
 fn exits_within(child: &mut Child, limit: Duration) -> Option<std::process::ExitStatus> {
     let deadline = Instant::now() + limit;
@@ -47,47 +59,73 @@ fn exits_within(child: &mut Child, limit: Duration) -> Option<std::process::Exit
     None
 }
 
-#[test]
-fn logs_go_to_stderr_without_colour_and_stdout_says_how_to_join() {
+/// What a server bound to `bind` printed until Ctrl-C stopped it
+/// (cleanly, within 5 s) after its first three lines.
+struct Printed {
+    /// The first three lines of stdout: address, fingerprint, first join
+    /// line.
+    head: Vec<String>,
+    /// The rest of stdout.
+    rest: String,
+    /// All of stderr.
+    err: String,
+    /// The port it listened on.
+    port: String,
+    /// Its certificate's fingerprint.
+    fingerprint: String,
+}
+
+fn run_until_interrupted(bind: &str) -> Printed {
     let certs = tempfile::tempdir().unwrap();
-    let mut child = start(certs.path());
+    let mut child = start_on(bind, certs.path());
     let mut stdout = BufReader::new(child.stdout.take().unwrap());
-    let mut lines = Vec::new();
+    let mut head = Vec::new();
     for _ in 0..3 {
         let mut line = String::new();
         stdout.read_line(&mut line).unwrap();
-        lines.push(line);
+        head.push(line.trim_end().to_owned());
     }
     interrupt(&child);
     let status = exits_within(&mut child, Duration::from_secs(5)).expect("stopped on SIGINT");
     assert!(status.success(), "{status}");
-    let mut err = String::new();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
+    let err = stderr_of(&mut child);
+    let mut rest = String::new();
+    stdout.read_to_string(&mut rest).unwrap();
+    let port = head[0].rsplit(':').next().unwrap().to_owned();
+    let fingerprint = head[1]
+        .strip_prefix("certificate SHA-256 fingerprint: ")
+        .unwrap_or_else(|| panic!("no fingerprint line: {head:?}"))
+        .to_owned();
+    Printed {
+        head,
+        rest,
+        err,
+        port,
+        fingerprint,
+    }
+}
+
+/// The join command for `ip` of the server that printed `p`.
+fn join_command(p: &Printed, ip: &str) -> String {
+    format!(
+        "cargo run --release -p ledge-client -- --connect {ip}:{} --cert-hash {} \
+         --name YOUR_NAME",
+        p.port, p.fingerprint
+    )
+}
+
+#[test]
+fn logs_go_to_stderr_without_colour_and_stdout_says_how_to_join() {
+    let p = run_until_interrupted("127.0.0.1:0");
+    let (lines, err, rest) = (&p.head, &p.err, &p.rest);
     assert!(
         lines[0].starts_with("ledge server listening on 127.0.0.1:"),
         "{lines:?}"
     );
-    assert!(
-        lines[1].starts_with("certificate SHA-256 fingerprint: "),
-        "{lines:?}"
-    );
-    let fingerprint = lines[1]
-        .trim_end()
-        .strip_prefix("certificate SHA-256 fingerprint: ")
-        .unwrap();
-    let port = lines[0].trim_end().rsplit(':').next().unwrap();
     // Bound to one address: one join line, for this machine.
     assert_eq!(
-        lines[2].trim_end(),
-        format!(
-            "join from this machine: cargo run --release -p ledge-client -- --connect \
-             127.0.0.1:{port} --cert-hash {fingerprint} --name YOUR_NAME"
-        )
+        lines[2],
+        format!("join from this machine: {}", join_command(&p, "127.0.0.1"))
     );
     assert!(
         err.contains("INFO") && err.contains("room started"),
@@ -97,52 +135,25 @@ fn logs_go_to_stderr_without_colour_and_stdout_says_how_to_join() {
         !err.contains('\u{1b}'),
         "colour codes in a log that is not a terminal: {err:?}"
     );
-    let mut rest = String::new();
-    stdout.read_to_string(&mut rest).unwrap();
     assert!(!rest.contains("INFO"), "logs on stdout: {rest}");
     assert!(!rest.contains("join"), "one join line: {rest}");
 }
 
 #[test]
 fn bound_to_all_interfaces_it_says_how_to_join_at_each_address() {
-    let certs = tempfile::tempdir().unwrap();
-    let mut child = start_on("0.0.0.0:0", certs.path());
-    let mut stdout = BufReader::new(child.stdout.take().unwrap());
-    let mut head = Vec::new();
-    for _ in 0..3 {
-        let mut line = String::new();
-        stdout.read_line(&mut line).unwrap();
-        head.push(line);
-    }
-    interrupt(&child);
-    let status = exits_within(&mut child, Duration::from_secs(5)).expect("stopped on SIGINT");
-    assert!(status.success(), "{status}");
-    let mut rest = String::new();
-    stdout.read_to_string(&mut rest).unwrap();
-    let port = head[0].trim_end().rsplit(':').next().unwrap().to_owned();
-    assert!(head[0].starts_with("ledge server listening on 0.0.0.0:"));
-    let fingerprint = head[1]
-        .trim_end()
-        .strip_prefix("certificate SHA-256 fingerprint: ")
-        .unwrap()
-        .to_owned();
-    let joins: Vec<&str> = head[2..]
+    let p = run_until_interrupted("0.0.0.0:0");
+    assert!(p.head[0].starts_with("ledge server listening on 0.0.0.0:"));
+    let joins: Vec<&str> = p.head[2..]
         .iter()
-        .map(|l| l.trim_end())
-        .chain(rest.lines())
+        .map(String::as_str)
+        .chain(p.rest.lines())
         .filter(|l| l.starts_with("join"))
         .collect();
-    let command = |ip: &str| {
-        format!(
-            "cargo run --release -p ledge-client -- --connect {ip}:{port} \
-             --cert-hash {fingerprint} --name YOUR_NAME"
-        )
-    };
     // This machine first, then every IPv4 address of an interface that
     // is up, named.
     assert_eq!(
         joins[0],
-        format!("join from this machine: {}", command("127.0.0.1"))
+        format!("join from this machine: {}", join_command(&p, "127.0.0.1"))
     );
     let mut expected: Vec<String> = Vec::new();
     for i in if_addrs::get_if_addrs().unwrap() {
@@ -151,16 +162,16 @@ fn bound_to_all_interfaces_it_says_how_to_join_at_each_address() {
             let line = format!(
                 "join from your network ({}): {}",
                 i.name,
-                command(&ip.to_string())
+                join_command(&p, &ip.to_string())
             );
             if !expected.iter().any(|e| e.contains(&format!(" {ip}:"))) {
                 expected.push(line);
             }
         }
     }
-    assert_eq!(joins[1..], expected, "{head:?}{rest}");
+    assert_eq!(joins[1..], expected, "{:?}{}", p.head, p.rest);
     if expected.is_empty() {
-        assert!(rest.contains("no network interface found"), "{rest}");
+        assert!(p.rest.contains("no network interface found"), "{}", p.rest);
     }
 }
 
@@ -171,13 +182,7 @@ fn a_port_in_use_fails_naming_the_option_to_change() {
     let certs = tempfile::tempdir().unwrap();
     let mut child = start_on(&addr.to_string(), certs.path());
     let status = exits_within(&mut child, Duration::from_secs(30)).expect("exits");
-    let mut err = String::new();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
+    let err = stderr_of(&mut child);
     assert_eq!(status.code(), Some(1), "{err}");
     let next = format!("--bind 127.0.0.1:{}", addr.port() + 1);
     for needle in [

@@ -128,6 +128,16 @@ pub fn xvfb_or_skip(what: &str) -> Option<std::path::PathBuf> {
     found
 }
 
+/// Where a screenshot test saves its pictures: `$LEDGE_SCREENSHOT_DIR`
+/// (created; kept after the test, to look at them), else `tmp`.
+pub fn screenshot_dir(tmp: &std::path::Path) -> std::path::PathBuf {
+    let dir = std::env::var_os("LEDGE_SCREENSHOT_DIR")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| tmp.to_owned());
+    std::fs::create_dir_all(&dir).expect("the screenshot folder can be created");
+    dir
+}
+
 /// A JSON `[x, y]` pair.
 pub fn pair(v: &serde_json::Value) -> (f64, f64) {
     let a = v.as_array().expect("[x, y]");
