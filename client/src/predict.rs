@@ -499,4 +499,61 @@ mod tests {
         assert!(p.reconcile(&server.snapshot()).is_some());
         assert!(p.reconcile(&old).is_none(), "older than the last one");
     }
+
+    #[test]
+    fn idle_players_coming_and_going_never_disturb_the_prediction() {
+        // Idle players join and leave the server's game at their own ticks
+        // (freed body slots are reused there, so the client's bodies and
+        // colliders get other ids): with exact inputs we still predict
+        // the server exactly.
+        let level = default_level();
+        let me = PlayerId(5);
+        let mut server = Game::from_level(&level).unwrap();
+        for id in 1..5 {
+            server.add_player(PlayerId(id)).unwrap();
+            for _ in 0..7 {
+                server.step(&[]);
+            }
+        }
+        server.add_player(me).unwrap();
+        server.step(&[]);
+        let lag = 6;
+        let first = server.tick() + lag;
+        let mut p = Predictor::new(&level, me, first).unwrap();
+        p.reconcile(&server.snapshot()).unwrap();
+        // Our inputs start at `first`: the server holds nothing before.
+        let ours = |t: u64| if t < first { Buttons::NONE } else { buttons(t) };
+        let (mut next_id, mut present) = (6, vec![1, 2, 3, 4]);
+        let mut churn = 0;
+        for _ in 0..1200 {
+            let t = p.next_tick();
+            p.step(buttons(t));
+            while server.tick() + lag < p.next_tick() {
+                let st = server.tick();
+                if st % 37 == 0 && present.len() < 12 {
+                    server.add_player(PlayerId(next_id)).unwrap();
+                    present.push(next_id);
+                    next_id += 1;
+                    churn += 1;
+                }
+                if st % 53 == 0 && present.len() > 2 {
+                    assert!(server.remove_player(PlayerId(present.remove(0))));
+                    churn += 1;
+                }
+                server.step(&[(me, ours(st))]);
+                if server.tick() % 2 == 0 {
+                    let r = p.reconcile(&server.snapshot()).unwrap();
+                    assert!(!r.mispredicted && r.correction_px == 0.0, "{r:?}");
+                }
+            }
+        }
+        assert!(churn > 30, "{churn}");
+        assert!(p.stats().snapshots > 500);
+        assert_eq!(p.stats().mispredictions, 0);
+        let mut future = server.clone();
+        for t in server.tick()..p.next_tick() {
+            future.step(&[(me, ours(t))]);
+        }
+        assert_eq!(future.state_hash(), p.game().state_hash());
+    }
 }
