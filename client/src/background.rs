@@ -332,14 +332,13 @@ async fn run(
                 events.send(NetEvent::LevelProgress { got, total });
             }
         });
-        tracing::info!("the server's level is {total} bytes");
         let result = tokio::select! {
             _ = &mut quit => return,
             result = fetched => result,
         };
         match result {
             Ok((bundle, fetched)) => {
-                tracing::info!("level: {fetched:?}");
+                tracing::info!("{}", fetched.describe(total));
                 events.send(NetEvent::Level(Box::new(bundle), fetched));
             }
             Err(e) => {

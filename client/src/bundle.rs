@@ -148,6 +148,24 @@ pub struct Fetched {
     pub embedded: bool,
 }
 
+impl Fetched {
+    /// In words, for logs: where the level of `size` bytes came from.
+    pub fn describe(&self, size: u64) -> String {
+        if self.embedded {
+            "the server plays the embedded default level".to_owned()
+        } else if self.cached {
+            format!("the server's level ({size} bytes) was in the level cache")
+        } else if self.resumed_from > 0 {
+            format!(
+                "downloaded the rest of the server's level: {} of {size} bytes (resumed)",
+                self.downloaded
+            )
+        } else {
+            format!("downloaded the server's level: {size} bytes")
+        }
+    }
+}
+
 /// Options of [`fetch_level`].
 #[derive(Debug, Clone, Default)]
 pub struct FetchOptions {

@@ -184,8 +184,18 @@ impl OnlineGame {
     /// refused, failed) and takes it, so that a refused certificate is
     /// known before, say, a window opens.
     pub fn wait(&mut self, timeout: Duration) {
-        if let Some(event) = self.net.recv_timeout(timeout) {
+        let deadline = Instant::now() + timeout;
+        while let Some(event) = self
+            .net
+            .recv_timeout(deadline.saturating_duration_since(Instant::now()))
+        {
+            // The level (and its download's progress) comes before the
+            // first word.
+            let first_word = !matches!(event, NetEvent::Level(..) | NetEvent::LevelProgress { .. });
             self.take(event, Instant::now());
+            if first_word {
+                break;
+            }
         }
     }
 

@@ -96,13 +96,7 @@ async fn run() -> anyhow::Result<()> {
     say(format_args!(
         "certificate SHA-256 fingerprint: {fingerprint}"
     ));
-    // Players need the same level file (and its settings) until clients
-    // download it from the server.
-    let level = config
-        .level
-        .as_ref()
-        .map(|p| format!(" --level {}", p.display()))
-        .unwrap_or_default();
+    // Players need nothing but the address: clients download the level.
     let interfaces = if bound.ip().is_unspecified() {
         match if_addrs::get_if_addrs() {
             Ok(list) => list
@@ -122,7 +116,7 @@ async fn run() -> anyhow::Result<()> {
     for join in &joins {
         say(format_args!(
             "{}: cargo run --release -p ledge-client -- \
-             --connect {} --cert-hash {fingerprint}{level} --name YOUR_NAME",
+             --connect {} --cert-hash {fingerprint} --name YOUR_NAME",
             join.who(),
             join.addr
         ));

@@ -138,6 +138,7 @@ async fn chat_is_relayed_to_the_room() {
 async fn players_fill_the_least_full_room_or_the_named_one() {
     let server = TestServer::start_with(|c| {
         c.rooms = 2;
+        c.max_rooms = 2;
         c.max_players = 2;
     })
     .await;
@@ -167,9 +168,11 @@ async fn players_fill_the_least_full_room_or_the_named_one() {
         matches!(err, ClientError::Rejected(RejectReason::RoomFull)),
         "{err}"
     );
+    // Both rooms (the cap) are open: a new name is refused, saying why.
     let err = join("f", Some("nowhere")).await.unwrap_err();
     assert!(
-        matches!(err, ClientError::Rejected(RejectReason::Other { .. })),
+        matches!(&err, ClientError::Rejected(RejectReason::Other { reason })
+            if reason.contains("--list-rooms")),
         "{err}"
     );
     // Ids are unique across rooms.

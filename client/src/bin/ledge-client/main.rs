@@ -124,11 +124,23 @@ struct Cli {
     /// default level) and join it.
     #[arg(long, conflicts_with = "connect")]
     local: bool,
-    /// Level file (OGMO `.json` or Tiled `.tmx`) to play offline, or the
-    /// one the server plays (`ledge-server --level`); default: the
-    /// embedded level. `--local` always plays the embedded level.
+    /// Level file (OGMO `.json` or Tiled `.tmx`) to play offline; default:
+    /// the embedded level. Online the server's level is downloaded (or
+    /// found in the level cache); a file given here must be the server's.
+    /// `--local` always plays the embedded level.
     #[arg(long, value_name = "FILE")]
     level: Option<PathBuf>,
+    /// Where downloaded levels are kept [default:
+    /// $XDG_CACHE_HOME/ledge/levels or ~/.cache/ledge/levels].
+    #[arg(long, value_name = "DIR")]
+    level_cache: Option<PathBuf>,
+    /// The room to join (opened if the server has no room of that name
+    /// and its room cap allows); default: the server picks.
+    #[arg(long, value_name = "NAME", requires = "connect")]
+    room: Option<String>,
+    /// Print the server's rooms (name, level, players, capacity) and exit.
+    #[arg(long, requires = "connect")]
+    list_rooms: bool,
     /// The level's settings file for offline play [default: LEVEL.ledge.toml
     /// beside the level, when there is one; online, always that one, as the
     /// server's default].
@@ -306,14 +318,22 @@ fn run() -> anyhow::Result<()> {
         server = Some(s);
         Some(request)
     } else {
-        cli.connect.map(|server| {
-            let trust = Trust::from_args(cli.cert_hash, cli.known_hosts);
+        cli.connect.clone().map(|server| {
+            let trust = Trust::from_args(cli.cert_hash, cli.known_hosts.clone());
+            let default = OnlineRequest::new(&server, trust, &cli.name);
             OnlineRequest {
                 level: cli.level.clone(),
-                ..OnlineRequest::new(&server, trust, &cli.name)
+                room: cli.room.clone(),
+                level_cache: cli.level_cache.clone().or(default.level_cache.clone()),
+                ..default
             }
         })
     };
+    if cli.list_rooms {
+        if let Some(request) = &request {
+            return list_rooms(request);
+        }
+    }
     let mut play = match request {
         Some(request) => {
             tracing::info!("connecting to {} ({})", request.server, request.trust);
@@ -390,6 +410,34 @@ fn session_failure(setup: &Setup, waited: Duration) -> Option<(i32, String)> {
     })
 }
 
+/// `--list-rooms`: prints the server's rooms, one line each.
+fn list_rooms(request: &OnlineRequest) -> anyhow::Result<()> {
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
+    let (rooms, _) = runtime
+        .block_on(ledge_client::list_rooms_trusted(
+            &request.server,
+            &request.trust,
+        ))
+        .map_err(|e| anyhow::anyhow!("cannot list the rooms of {}: {e}", request.server))?;
+    let mut out = std::io::stdout().lock();
+    let plural = if rooms.len() == 1 { "" } else { "s" };
+    let _ = writeln!(out, "{} room{plural} on {}:", rooms.len(), request.server);
+    for r in &rooms {
+        let _ = writeln!(
+            out,
+            "  {}  level {}  {}/{} players",
+            r.name, r.level_id, r.players, r.capacity
+        );
+    }
+    let _ = writeln!(
+        out,
+        "join one with --room NAME (a new name opens a room while the server has places)"
+    );
+    Ok(())
+}
+
 async fn game(mut setup: Setup) {
     let started = Instant::now();
     let mut camera = Camera::new();
@@ -400,10 +448,12 @@ async fn game(mut setup: Setup) {
     // Ticks of play so far: the script's clock and --exit-after-ticks'.
     let mut played: u64 = 0;
     let mut last_frame = Instant::now();
-    let art = art::ArtView::new(
+    let mut art = art::ArtView::new(
         std::mem::take(&mut setup.level_art),
         &setup.play.level().tilemap,
     );
+    // The server's art arrives with its level (downloaded or cached).
+    let mut server_art = false;
     // Closing the window ends the loop below, so we leave the server.
     prevent_quit();
     // The session's failure, once known: told once, then shown until the
@@ -413,6 +463,12 @@ async fn game(mut setup: Setup) {
     loop {
         if Bindings::pressed(&setup.bindings.quit) || is_quit_requested() {
             break;
+        }
+        if !server_art && setup.play.joined() {
+            if let Some(level_art) = setup.play.level_art() {
+                art = art::ArtView::new(level_art.clone(), &setup.play.level().tilemap);
+            }
+            server_art = true;
         }
         if Bindings::pressed(&setup.bindings.debug) {
             show_debug = !show_debug;

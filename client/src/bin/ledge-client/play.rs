@@ -127,6 +127,12 @@ impl Play {
         self.connection()?.untrusted()
     }
 
+    /// The art of the server's level, once downloaded (or found in the
+    /// cache); `None` offline or with a level file.
+    pub fn level_art(&self) -> Option<&ledge_levels::art::LevelArt> {
+        self.connection()?.level_art()
+    }
+
     /// The level played (the server's, once welcomed).
     pub fn level(&self) -> &Level {
         self.game().map_or(&self.level, ClientGame::level)
