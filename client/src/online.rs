@@ -44,6 +44,11 @@ use crate::view::{FrameView, NetStats};
 /// Chat lines kept.
 pub const CHAT_LINES: usize = 32;
 
+/// After this long without a snapshot (a server sends 30 a second) a
+/// joined game says the connection is stalled ([`OnlineGame::stalled`]),
+/// long before QUIC's idle timeout (10 s) gives up on it.
+pub const STALL_AFTER: Duration = Duration::from_secs(1);
+
 /// Where, as whom, and how to trust.
 #[derive(Debug, Clone)]
 pub struct OnlineRequest {
@@ -100,6 +105,8 @@ pub struct OnlineGame {
     latest: Option<StateSnapshot>,
     /// Snapshots arrived since the last [`OnlineGame::take_arrivals`].
     arrivals: u32,
+    /// When the last snapshot (or the welcome) arrived.
+    last_news: Option<Instant>,
     /// The game was just created: the ticks due at its first update are
     /// nobody's play (e.g. a window was opening after [`OnlineGame::wait`]).
     fresh: bool,
@@ -139,6 +146,7 @@ impl OnlineGame {
             fetched: None,
             latest: None,
             arrivals: 0,
+            last_news: None,
             fresh: false,
         })
     }
@@ -236,11 +244,13 @@ impl OnlineGame {
                         game.set_player_names(&self.net.players());
                         self.game = Some(game);
                         self.fresh = true;
+                        self.last_news = Some(now);
                     }
                     Err(e) => self.error = Some(e.to_string()),
                 }
             }
             NetEvent::Snapshot(update) => {
+                self.last_news = Some(now);
                 self.arrivals = self.arrivals.saturating_add(1);
                 if let Some(game) = &mut self.game {
                     game.on_snapshot(update);
@@ -284,6 +294,17 @@ impl OnlineGame {
     /// What to draw, once the server welcomed us and we have its level.
     pub fn view(&self) -> Option<FrameView> {
         self.game.as_ref().map(ClientGame::view)
+    }
+
+    /// How long the server has been silent, once that is more than
+    /// [`STALL_AFTER`] while joined (`None` otherwise, and once the session
+    /// ended: then [`OnlineGame::status`] says why).
+    pub fn stalled(&self, now: Instant) -> Option<Duration> {
+        if !matches!(self.status, NetStatus::Connected { .. }) {
+            return None;
+        }
+        let silent = now.saturating_duration_since(self.last_news?);
+        (silent > STALL_AFTER).then_some(silent)
     }
 
     /// The network panel.

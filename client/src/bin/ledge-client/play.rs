@@ -209,15 +209,27 @@ impl Play {
         Some(self.connection()?.game()?.net_stats(Instant::now()))
     }
 
+    /// How long the server has been silent, when that is unusual.
+    fn stalled(&self) -> Option<Duration> {
+        self.connection()?.stalled(Instant::now())
+    }
+
     /// One short line about the game (a failure's reason is the
     /// banner's, not this line's: it would not fit).
     pub fn status_line(&self) -> String {
         match self.connection().map(OnlineGame::status) {
             None => format!("offline: {}", self.level.name),
-            Some(NetStatus::Connected { welcome, .. }) => format!(
-                "online: {} on {}, you are player {}",
-                welcome.room, welcome.level_id, welcome.player_id.0
-            ),
+            Some(NetStatus::Connected { welcome, .. }) => match self.stalled() {
+                Some(silent) => format!(
+                    "connection stalled: nothing from {} for {:.0} s",
+                    self.server,
+                    silent.as_secs_f32()
+                ),
+                None => format!(
+                    "online: {} on {}, you are player {}",
+                    welcome.room, welcome.level_id, welcome.player_id.0
+                ),
+            },
             Some(NetStatus::Failed(_)) => format!("could not join {}", self.server),
             Some(NetStatus::Disconnected(_)) => format!("disconnected from {}", self.server),
             Some(status) => status.to_string(),
@@ -235,6 +247,13 @@ impl Play {
             NetStatus::Connected { .. } if self.game().is_none_or(|g| !g.synced()) => {
                 Some("joined: waiting for the first snapshot...".into())
             }
+            NetStatus::Connected { .. } => self.stalled().map(|silent| {
+                format!(
+                    "connection stalled: nothing from {} for {:.0} s (it gives up after 10 s)",
+                    self.server,
+                    silent.as_secs_f32()
+                )
+            }),
             _ => None,
         }
     }

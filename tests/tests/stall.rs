@@ -1,0 +1,74 @@
+//! A joined window knows within a second when the server goes silent: a
+//! GUI front end ([`OnlineGame`]) behind a relay that drops everything says
+//! the connection is stalled (not "online" for the 10 s QUIC waits before
+//! it gives up), and stops saying so when snapshots come back.
+
+use std::time::{Duration, Instant};
+
+use ledge_client::online::STALL_AFTER;
+use ledge_client::{OnlineGame, OnlineRequest, Trust};
+use ledge_shared::input::Buttons;
+use ledge_tests::{TestServer, UdpRelay};
+
+/// Runs `online` in 10 ms frames until `done` holds; returns when it did,
+/// or panics after `within`.
+fn play_until(
+    online: &mut OnlineGame,
+    what: &str,
+    within: Duration,
+    done: impl Fn(&OnlineGame, Instant) -> bool,
+) -> Instant {
+    let deadline = Instant::now() + within;
+    loop {
+        let now = Instant::now();
+        online.update(now, Buttons::NONE);
+        if done(online, now) {
+            return now;
+        }
+        assert!(now < deadline, "{what}: status {}", online.status());
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+#[test]
+fn a_silent_server_is_noticed_within_a_second() {
+    let runtime = tokio::runtime::Runtime::new().unwrap();
+    let server = runtime.block_on(TestServer::start());
+    let relay = runtime.block_on(UdpRelay::start(server.addr));
+    let request = OnlineRequest::new(
+        &relay.addr.to_string(),
+        Trust::Pinned(server.fingerprint),
+        "ada",
+    );
+    let mut online = OnlineGame::connect(request).unwrap();
+    play_until(&mut online, "joined", Duration::from_secs(10), |o, now| {
+        o.game().is_some_and(|g| g.synced()) && o.stalled(now).is_none()
+    });
+
+    relay.blackhole();
+    let cut = Instant::now();
+    let noticed = play_until(
+        &mut online,
+        "stall noticed",
+        Duration::from_secs(3),
+        |o, now| o.stalled(now).is_some(),
+    );
+    let after = noticed - cut;
+    assert!(after >= STALL_AFTER, "noticed after {after:?}");
+    // A frame or two past the threshold, not the 10 s idle timeout.
+    assert!(
+        after < STALL_AFTER + Duration::from_millis(900),
+        "{after:?}"
+    );
+
+    relay.restore();
+    play_until(
+        &mut online,
+        "recovered",
+        Duration::from_secs(5),
+        |o, now| o.stalled(now).is_none(),
+    );
+    assert!(online.game().is_some(), "still in the game");
+    drop(online);
+    runtime.block_on(async { server.stop().await.unwrap() });
+}
