@@ -282,6 +282,7 @@ async fn run(
         let join = JoinOptions {
             player_name: request.player_name.clone(),
             room: options.room.clone(),
+            resume: None,
         };
         let trust = options
             .trust
@@ -499,6 +500,7 @@ mod tests {
             level_id: "level".into(),
             level_hash: 0xabc,
             level: Default::default(),
+            session_token: Default::default(),
             server_tick: 10,
             timing: NetTiming {
                 tick_rate: 60,

@@ -318,6 +318,7 @@ mod tests {
             level_id: "l".into(),
             level_hash: 0,
             level: Default::default(),
+            session_token: Default::default(),
             server_tick: tick,
             timing: NetTiming {
                 tick_rate: 60,

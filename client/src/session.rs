@@ -18,8 +18,9 @@ use std::time::{Duration, Instant};
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
     write_frame, ClientControl, CloseCode, Fingerprint, FrameDecoder, InputPacket, Message,
-    NoticeKind, PlayerId, RoomInfo, RosterEntry, ServerControl, Snapshot, SnapshotHistory,
-    StateSnapshot, Welcome, MAX_FRAME, MAX_INPUT_HISTORY, MAX_ROSTER, PROTOCOL_VERSION,
+    NoticeKind, PlayerId, RoomInfo, RosterEntry, ServerControl, SessionToken, Snapshot,
+    SnapshotHistory, StateSnapshot, Welcome, MAX_FRAME, MAX_INPUT_HISTORY, MAX_ROSTER,
+    PROTOCOL_VERSION,
 };
 
 use crate::error::ClientError;
@@ -45,6 +46,9 @@ pub struct JoinOptions {
     pub player_name: String,
     /// The room to join; `None`: the server picks the least full one.
     pub room: Option<String>,
+    /// Resume the session this token names (a lost connection's player:
+    /// same id, position, coins); an unknown or expired one joins as new.
+    pub resume: Option<SessionToken>,
 }
 
 impl JoinOptions {
@@ -53,11 +57,20 @@ impl JoinOptions {
         JoinOptions {
             player_name: player_name.to_owned(),
             room: None,
+            resume: None,
         }
     }
 
     /// The hello these options send.
     pub fn hello(&self) -> ClientControl {
+        if let Some(token) = self.resume {
+            return ClientControl::Resume {
+                version: PROTOCOL_VERSION,
+                name: self.player_name.clone(),
+                room: self.room.clone(),
+                token,
+            };
+        }
         match &self.room {
             None => ClientControl::Hello {
                 version: PROTOCOL_VERSION,

@@ -17,6 +17,7 @@ fn list_rooms_shows_a_room_opened_by_name() {
     let options = JoinOptions {
         player_name: "ana".into(),
         room: Some("friends".into()),
+        resume: None,
     };
     let ana = server
         .block_on(connect_with(

@@ -29,6 +29,8 @@ pub const DEFAULT_ROOMS: u32 = 1;
 /// Default most rooms at once, counting those players open by name (the
 /// cap is at least `rooms`).
 pub const DEFAULT_MAX_ROOMS: u32 = 16;
+/// Default time a player whose connection was lost is kept for a resume.
+pub const DEFAULT_RECONNECT_GRACE: Duration = Duration::from_secs(30);
 /// Default largest level bundle the server offers, MiB: a level (with its
 /// art) that encodes bigger is refused at start.
 pub const DEFAULT_MAX_LEVEL_MIB: u64 = 32;
@@ -122,6 +124,9 @@ pub struct ServerConfig {
     pub max_catch_up: u32,
     /// QUIC idle timeout: silent connections are dropped after it.
     pub idle_timeout: Duration,
+    /// How long a player whose connection was lost stays in its room (still)
+    /// for its client to resume it; then it leaves.
+    pub reconnect_grace: Duration,
     /// Per-client rate limits.
     pub limits: Limits,
     /// Record each room's match (inputs, joins and leaves, state hash per
@@ -148,6 +153,7 @@ impl Default for ServerConfig {
             metrics_bind: None,
             max_catch_up: DEFAULT_MAX_CATCH_UP,
             idle_timeout: DEFAULT_IDLE_TIMEOUT,
+            reconnect_grace: DEFAULT_RECONNECT_GRACE,
             limits: Limits::default(),
             record_ticks: None,
         }
@@ -196,6 +202,9 @@ impl ServerConfig {
         }
         if self.record_ticks == Some(0) {
             return bad("record_ticks must be at least 1 when set");
+        }
+        if self.reconnect_grace > Duration::from_secs(3600) {
+            return bad("reconnect_grace must be at most 3600 s");
         }
         if self.idle_timeout < Duration::from_millis(100) {
             return bad("idle_timeout must be at least 0.1 s");
@@ -286,6 +295,10 @@ pub struct Cli {
     /// Most simultaneous connections [default: 256].
     #[arg(long, value_name = "N")]
     pub max_connections: Option<usize>,
+    /// Seconds a player whose connection was lost is kept for its client to
+    /// come back (same player, position, coins) [default: 30].
+    #[arg(long, value_name = "SECONDS")]
+    pub reconnect_grace: Option<f64>,
     /// Largest level clients download (the level and its images, encoded),
     /// in MiB; a bigger level stops the server at start [default: 32].
     #[arg(long, value_name = "MIB")]
@@ -319,6 +332,8 @@ struct FileConfig {
     max_catch_up: Option<u32>,
     /// Seconds.
     idle_timeout: Option<f64>,
+    /// Seconds.
+    reconnect_grace: Option<f64>,
     limits: Option<Limits>,
 }
 
@@ -368,6 +383,10 @@ impl Cli {
                 .map_err(|_| ConfigError::Invalid("idle_timeout must be seconds".into()))?;
         }
         set(&mut c.limits, file.limits);
+        if let Some(secs) = self.reconnect_grace.or(file.reconnect_grace) {
+            c.reconnect_grace = Duration::try_from_secs_f64(secs)
+                .map_err(|_| ConfigError::Invalid("reconnect_grace must be seconds".into()))?;
+        }
         // Flags win.
         set(&mut c.bind, self.bind);
         set(&mut c.level, self.level.clone().map(Some));

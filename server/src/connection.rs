@@ -30,7 +30,8 @@ use std::time::{Duration, Instant};
 
 use ledge_shared::protocol::{
     check_version, write_frame, ClientControl, CloseCode, FrameDecoder, InputPacket, Message,
-    NoticeKind, PlayerId, ProtocolError, RejectReason, ServerControl, PROTOCOL_VERSION,
+    NoticeKind, PlayerId, ProtocolError, RejectReason, ServerControl, SessionToken,
+    PROTOCOL_VERSION,
 };
 use quinn::{Connection, RecvStream, SendStream};
 use tokio::sync::{mpsc, watch};
@@ -41,6 +42,7 @@ use crate::metrics::{Channel, ClientBytes, DropReason, KickLabel, KickReason, Me
 use crate::ratelimit::TokenBucket;
 use crate::room::{self, ClientLink, JoinError, Outbound, PlayerInbox, RoomHandle};
 use crate::rooms::Rooms;
+use crate::sessions::Sessions;
 
 /// How long a client has from connecting to finishing its `Hello`.
 pub const HELLO_TIMEOUT: Duration = Duration::from_secs(5);
@@ -75,6 +77,8 @@ pub const SHUTDOWN_LINGER: Duration = Duration::from_secs(1);
 pub struct Shared {
     /// The open rooms.
     pub rooms: Rooms,
+    /// Sessions, for resuming a lost connection's player.
+    pub sessions: Sessions,
     /// The level bundle clients download ([`ClientControl::GetLevel`]).
     pub level_bundle: Arc<Vec<u8>>,
     /// Metrics.
@@ -141,18 +145,30 @@ enum End {
     Close(CloseCode, String),
 }
 
-/// Removes the player from its room, and its metric series, however the
-/// session ends.
+/// Ends the player's membership however the session ends: a lost
+/// connection keeps the player for a resume ([`Sessions::lose`]), any
+/// other end removes it from its room; its metric series go either way.
 struct Membership<'a> {
     room: RoomHandle,
     player_id: PlayerId,
-    metrics: &'a Metrics,
+    generation: u32,
+    token: SessionToken,
+    shared: &'a Shared,
+    /// The connection was lost (rather than left, kicked or shut down).
+    lost: bool,
 }
 
 impl Drop for Membership<'_> {
     fn drop(&mut self) {
-        self.room.leave(self.player_id);
-        self.metrics.forget_client(self.player_id.0);
+        let sessions = &self.shared.sessions;
+        if self.lost && !*self.shared.shutdown.borrow() {
+            self.room.detach(self.player_id, self.generation);
+            sessions.lose(&self.token, self.generation, Instant::now());
+        } else {
+            self.room.leave(self.player_id, self.generation);
+            sessions.end(&self.token, self.generation);
+        }
+        self.shared.metrics.forget_client(self.player_id.0);
     }
 }
 
@@ -193,26 +209,55 @@ async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
         return Err(End::Close(CloseCode::Rejected, reason.to_string()));
     }
 
-    let player_id = PlayerId(shared.next_player.fetch_add(1, Ordering::Relaxed));
-    let bytes = shared.metrics.client(player_id.0);
     let (control, queue) = mpsc::channel(CONTROL_QUEUE);
-    let link = ClientLink {
+    let link = |player_id: PlayerId| ClientLink {
         connection: connection.clone(),
         control: control.clone(),
-        bytes: bytes.clone(),
+        bytes: shared.metrics.client(player_id.0),
     };
-    let (room, joined) = match join(shared, wanted_room, player_id, name, link).await {
-        Ok(joined) => joined,
-        Err(reason) => {
-            shared.metrics.forget_client(player_id.0);
-            reject(&mut send, &reason).await;
-            return Err(End::Close(CloseCode::Rejected, reason.to_string()));
+    // A resumed session gets its player back; an unknown or expired token
+    // (or a player gone meanwhile) joins as new.
+    let resumed = match first.resume_token() {
+        Some(token) => match shared.sessions.find(&token, Instant::now()) {
+            Some(parked) => parked
+                .room
+                .rejoin(parked.player_id, link(parked.player_id))
+                .await
+                .map(|joined| (parked.room, joined, token)),
+            None => None,
+        },
+        None => None,
+    };
+    let (room, mut joined, token) = match resumed {
+        Some(resumed) => {
+            shared.metrics.sessions_resumed.inc();
+            resumed
+        }
+        None => {
+            let player_id = PlayerId(shared.next_player.fetch_add(1, Ordering::Relaxed));
+            match join(shared, wanted_room, player_id, name, link(player_id)).await {
+                Ok((room, joined)) => (room, joined, shared.sessions.new_token()),
+                Err(reason) => {
+                    shared.metrics.forget_client(player_id.0);
+                    reject(&mut send, &reason).await;
+                    return Err(End::Close(CloseCode::Rejected, reason.to_string()));
+                }
+            }
         }
     };
-    let membership = Membership {
+    let player_id = joined.welcome.player_id;
+    let bytes = shared.metrics.client(player_id.0);
+    shared
+        .sessions
+        .start(token, room.clone(), player_id, joined.generation);
+    joined.welcome.session_token = token;
+    let mut membership = Membership {
         room,
         player_id,
-        metrics: &shared.metrics,
+        generation: joined.generation,
+        token,
+        shared,
+        lost: true,
     };
     let mut frame = Vec::new();
     write_frame(&ServerControl::Welcome(joined.welcome), &mut frame)
@@ -257,6 +302,7 @@ async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
         ),
         Ending::Lost(_) => (None, Duration::ZERO),
     };
+    membership.lost = matches!(ending, Ending::Lost(_));
     if !linger.is_zero() {
         let goodbye = async {
             if let Some(kind) = notice {
@@ -543,6 +589,7 @@ impl Client<'_> {
             match message {
                 ClientControl::Hello { .. }
                 | ClientControl::HelloRoom { .. }
+                | ClientControl::Resume { .. }
                 | ClientControl::ListRooms { .. } => {
                     return Err(Ending::malformed("second hello".into()));
                 }

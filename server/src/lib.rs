@@ -18,6 +18,7 @@
 //! * [`room`]: the game, its tick loop and snapshot sending;
 //! * [`rooms`]: the open rooms, opened by name up to the cap, closed when
 //!   idle;
+//! * [`sessions`]: players kept after a lost connection, for a resume;
 //! * [`record`]: optional match recording (inputs, joins, hashes per tick);
 //! * [`connection`]: one client's handshake, control stream and datagrams;
 //! * [`ratelimit`]: token buckets;
@@ -38,6 +39,7 @@ pub mod record;
 pub mod room;
 pub mod rooms;
 pub mod server;
+pub mod sessions;
 pub mod snapshots;
 pub mod tls;
 

@@ -132,6 +132,10 @@ pub struct Metrics {
     pub players: Family<RoomLabel, Gauge>,
     /// Open rooms.
     pub rooms: Gauge,
+    /// Sessions resumed after a lost connection (same player back).
+    pub sessions_resumed: Counter,
+    /// Lost players removed after the reconnect grace time.
+    pub sessions_expired: Counter,
     /// Level bundle downloads started (a resumed one counts again).
     pub level_downloads: Counter,
     /// Level bundle downloads sent to their end.
@@ -206,6 +210,8 @@ impl Metrics {
             missed_ticks: Family::default(),
             players: Family::default(),
             rooms: Gauge::default(),
+            sessions_resumed: Counter::default(),
+            sessions_expired: Counter::default(),
             level_downloads: Counter::default(),
             level_downloads_completed: Counter::default(),
             level_download_bytes: Counter::default(),
@@ -236,6 +242,16 @@ impl Metrics {
         );
         r.register("players", "Players in the room", m.players.clone());
         r.register("rooms", "Open rooms", m.rooms.clone());
+        r.register(
+            "sessions_resumed",
+            "Sessions resumed after a lost connection",
+            m.sessions_resumed.clone(),
+        );
+        r.register(
+            "sessions_expired",
+            "Lost players removed after the reconnect grace time",
+            m.sessions_expired.clone(),
+        );
         r.register(
             "level_downloads",
             "Level bundle downloads started (resumed ones included)",

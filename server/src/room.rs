@@ -22,8 +22,8 @@ use std::time::{Duration, Instant};
 use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
-    encode_sim_config, write_frame, InputPacket, LevelOffer, NetTiming, Outgoing, PlayerId,
-    RejectReason, RosterEntry, ServerControl, Welcome, MAX_ROSTER,
+    encode_sim_config, write_frame, CloseCode, InputPacket, LevelOffer, NetTiming, Outgoing,
+    PlayerId, RejectReason, RosterEntry, ServerControl, SessionToken, Welcome, MAX_ROSTER,
 };
 use prometheus_client::metrics::counter::Counter;
 use prometheus_client::metrics::histogram::Histogram;
@@ -160,10 +160,14 @@ pub fn lock(inbox: &Mutex<PlayerInbox>) -> MutexGuard<'_, PlayerInbox> {
 /// A successful join.
 #[derive(Debug)]
 pub struct Joined {
-    /// What to send the client.
+    /// What to send the client (its `session_token` is the connection's to
+    /// fill in).
     pub welcome: Welcome,
     /// Where the connection puts the client's inputs.
     pub inbox: Arc<Mutex<PlayerInbox>>,
+    /// Which connection holds the player: 0 on joining, one more on each
+    /// resume. Leaves and detaches of an older generation are ignored.
+    pub generation: u32,
 }
 
 /// Why a join failed.
@@ -188,6 +192,16 @@ enum Command {
     },
     Leave {
         player_id: PlayerId,
+        generation: u32,
+    },
+    Detach {
+        player_id: PlayerId,
+        generation: u32,
+    },
+    Rejoin {
+        player_id: PlayerId,
+        link: ClientLink,
+        reply: oneshot::Sender<Option<Joined>>,
     },
     Chat {
         from: PlayerId,
@@ -246,9 +260,38 @@ impl RoomHandle {
         }
     }
 
-    /// Removes a player (no-op if unknown or the room has stopped).
-    pub fn leave(&self, player_id: PlayerId) {
-        let _ = self.commands.send(Command::Leave { player_id });
+    /// Removes a player, if connection `generation` still holds it (no-op
+    /// if unknown or the room has stopped).
+    pub fn leave(&self, player_id: PlayerId, generation: u32) {
+        let _ = self.commands.send(Command::Leave {
+            player_id,
+            generation,
+        });
+    }
+
+    /// Keeps a player whose connection (of `generation`) was lost: it stays
+    /// in the game, standing still, and gets nothing sent until
+    /// [`RoomHandle::rejoin`] or [`RoomHandle::leave`].
+    pub fn detach(&self, player_id: PlayerId, generation: u32) {
+        let _ = self.commands.send(Command::Detach {
+            player_id,
+            generation,
+        });
+    }
+
+    /// Gives player `player_id` to a new connection (a resumed session):
+    /// the same body, a new link and inbox, a new generation; the old
+    /// connection, if still open, is closed. `None` if the player is gone.
+    pub async fn rejoin(&self, player_id: PlayerId, link: ClientLink) -> Option<Joined> {
+        let (reply, answer) = oneshot::channel();
+        self.commands
+            .send(Command::Rejoin {
+                player_id,
+                link,
+                reply,
+            })
+            .ok()?;
+        answer.await.ok().flatten()
     }
 
     /// Relays a chat line to everyone in the room.
@@ -327,6 +370,10 @@ struct Member {
     last_applied: Option<u64>,
     /// A snapshot sent on the control stream and when, until acknowledged.
     stream_pending: Option<(u64, Instant)>,
+    /// Which connection holds it ([`Joined::generation`]).
+    generation: u32,
+    /// A connection holds it (false: lost, kept for a resume).
+    attached: bool,
 }
 
 /// The room task's state.
@@ -402,7 +449,47 @@ impl Room {
                     self.remove(player_id);
                 }
             }
-            Command::Leave { player_id } => self.remove(player_id),
+            Command::Leave {
+                player_id,
+                generation,
+            } => {
+                if self
+                    .members
+                    .get(&player_id)
+                    .is_some_and(|m| m.generation == generation)
+                {
+                    self.remove(player_id);
+                }
+            }
+            Command::Detach {
+                player_id,
+                generation,
+            } => {
+                let tick = self.game.tick();
+                let window = self.config.input_window;
+                if let Some(m) = self.members.get_mut(&player_id) {
+                    if m.generation == generation && m.attached {
+                        info!(room = %self.config.name, %player_id, "connection lost; keeping the player");
+                        m.attached = false;
+                        m.buttons = Buttons::NONE;
+                        m.inbox = Arc::new(Mutex::new(PlayerInbox::new(window, tick)));
+                    }
+                }
+            }
+            Command::Rejoin {
+                player_id,
+                link,
+                reply,
+            } => {
+                let rejoined = self.rejoin(player_id, link);
+                if let Err(Some(joined)) = reply.send(rejoined) {
+                    // The resumer is gone already: it is lost again.
+                    let m = self.members.get_mut(&player_id);
+                    if let Some(m) = m.filter(|m| m.generation == joined.generation) {
+                        m.attached = false;
+                    }
+                }
+            }
             Command::Chat { from, text } => {
                 let mut frame = Vec::new();
                 if write_frame(&ServerControl::Chat { from, text }, &mut frame).is_err() {
@@ -446,36 +533,86 @@ impl Room {
                 buttons: Buttons::NONE,
                 last_applied: None,
                 stream_pending: None,
+                generation: 0,
+                attached: true,
             },
         );
         self.players.store(self.members.len(), Ordering::Relaxed);
         self.players_gauge.set(self.members.len() as i64);
         self.announce_join(player_id);
         Ok(Joined {
-            welcome: Welcome {
-                player_id,
-                room: self.config.name.clone(),
-                level_id: self.config.level_id.clone(),
-                level_hash: self.config.level_hash,
-                level: self.config.level,
-                server_tick: tick,
-                timing: NetTiming {
-                    tick_rate: self.config.tick_rate,
-                    snapshot_interval: self.config.snapshot_interval,
-                    input_redundancy: self.config.input_redundancy,
-                },
-                // The game's constants, so the client predicts with exactly
-                // the server's rules (a GameConfig is a few dozen bytes).
-                sim_config: match encode_sim_config(self.game.config()) {
-                    Ok(bytes) => bytes,
-                    Err(e) => {
-                        warn!("cannot send the game config: {e}");
-                        Vec::new()
-                    }
-                },
-            },
+            welcome: self.welcome(player_id, tick),
             inbox,
+            generation: 0,
         })
+    }
+
+    /// Hands a kept (or still attached) player to a new connection.
+    fn rejoin(&mut self, player_id: PlayerId, link: ClientLink) -> Option<Joined> {
+        let tick = self.game.tick();
+        let inbox = Arc::new(Mutex::new(PlayerInbox::new(self.config.input_window, tick)));
+        let m = self.members.get_mut(&player_id)?;
+        if m.attached {
+            // The client gave up on it before we noticed.
+            crate::connection::close(&m.link.connection, CloseCode::Normal, "resumed elsewhere");
+        }
+        m.link = link;
+        m.inbox = inbox.clone();
+        m.buttons = Buttons::NONE;
+        m.last_applied = None;
+        m.stream_pending = None;
+        m.generation += 1;
+        m.attached = true;
+        let generation = m.generation;
+        info!(room = %self.config.name, %player_id, generation, tick, "player resumed");
+        // The room as it is now: who joined and left meanwhile.
+        let players = self
+            .members
+            .iter()
+            .take(MAX_ROSTER)
+            .map(|(&id, m)| RosterEntry {
+                id,
+                name: m.name.clone(),
+            })
+            .collect();
+        let mut frame = Vec::new();
+        if write_frame(&ServerControl::Roster { players }, &mut frame).is_ok() {
+            if let Some(m) = self.members.get(&player_id) {
+                self.send_control(m, frame);
+            }
+        }
+        Some(Joined {
+            welcome: self.welcome(player_id, tick),
+            inbox,
+            generation,
+        })
+    }
+
+    /// The `Welcome` for player `player_id` at `tick`.
+    fn welcome(&self, player_id: PlayerId, tick: u64) -> Welcome {
+        Welcome {
+            player_id,
+            room: self.config.name.clone(),
+            level_id: self.config.level_id.clone(),
+            level_hash: self.config.level_hash,
+            level: self.config.level,
+            server_tick: tick,
+            timing: NetTiming {
+                tick_rate: self.config.tick_rate,
+                snapshot_interval: self.config.snapshot_interval,
+                input_redundancy: self.config.input_redundancy,
+            },
+            // The game's constants, so the client predicts with exactly
+            // the server's rules (a GameConfig is a few dozen bytes).
+            sim_config: match encode_sim_config(self.game.config()) {
+                Ok(bytes) => bytes,
+                Err(e) => {
+                    warn!("cannot send the game config: {e}");
+                    Vec::new()
+                }
+            },
+            session_token: SessionToken::default(),
+        }
     }
 
     fn remove(&mut self, player_id: PlayerId) {
@@ -531,7 +668,7 @@ impl Room {
             return;
         }
         let now = Instant::now();
-        for m in self.members.values_mut() {
+        for m in self.members.values_mut().filter(|m| m.attached) {
             let (ack, timing) = {
                 let mut inbox = lock(&m.inbox);
                 (inbox.ack, inbox.take_timing())

@@ -24,14 +24,16 @@ use crate::metrics::{self, Metrics};
 use crate::record::Recorder;
 use crate::room::RoomConfig;
 use crate::rooms::Rooms;
+use crate::sessions::Sessions;
 use crate::snapshots::DEFAULT_HISTORY;
 use crate::tls::{self, TlsError};
 
 /// How long shutdown waits for connection tasks, then for the endpoint.
 const SHUTDOWN_GRACE: Duration = Duration::from_secs(3);
 
-/// How often idle rooms opened by name are looked for and closed.
-const ROOM_SWEEP: Duration = Duration::from_secs(5);
+/// How often lost players past the reconnect grace time and idle rooms
+/// opened by name are looked for (and removed, closed).
+const SWEEP: Duration = Duration::from_secs(1);
 
 /// Why the server could not start.
 #[derive(Debug, thiserror::Error)]
@@ -302,6 +304,7 @@ impl Server {
         });
         let shared = Arc::new(Shared {
             rooms,
+            sessions: Sessions::new(config.reconnect_grace),
             level_bundle,
             metrics: metrics.clone(),
             limits: config.limits,
@@ -320,13 +323,19 @@ impl Server {
             "listening"
         );
         let mut connections = JoinSet::new();
-        let mut sweep = tokio::time::interval(ROOM_SWEEP);
+        let mut sweep = tokio::time::interval(SWEEP);
         loop {
             tokio::select! {
                 // `shutdown` lives until the end of `run`, so this never errs.
                 () = stopped(&mut stop) => break,
                 _ = sweep.tick() => {
-                    shared.rooms.close_idle(Instant::now());
+                    let now = Instant::now();
+                    for lost in shared.sessions.expire(now) {
+                        info!(player = %lost.player_id, room = %lost.room.name(), "reconnect grace over; the player leaves");
+                        metrics.sessions_expired.inc();
+                        lost.room.leave(lost.player_id, lost.generation);
+                    }
+                    shared.rooms.close_idle(now);
                 }
                 incoming = endpoint.accept() => match incoming {
                     Some(incoming) => {

@@ -203,6 +203,7 @@ fn server_control() -> impl Strategy<Value = ServerControl> {
                         sha256: [id as u8; 32],
                         size: server_tick % (MAX_LEVEL_BUNDLE + 1),
                     },
+                    session_token: SessionToken([level_hash as u8; 16]),
                     sim_config,
                 })
             },

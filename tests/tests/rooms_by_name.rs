@@ -16,6 +16,7 @@ async fn join_room(server: &TestServer, name: &str, room: &str) -> Result<Sessio
     let options = JoinOptions {
         player_name: name.into(),
         room: Some(room.into()),
+        resume: None,
     };
     connect_with(server.addr, "localhost", server.fingerprint, &options).await
 }

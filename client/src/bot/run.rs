@@ -142,6 +142,7 @@ pub async fn connect_and_run(
     let join = JoinOptions {
         player_name: options.name.clone(),
         room: options.room.clone(),
+        resume: None,
     };
     match connect_trusted(server, trust, &join).await {
         Ok((session, _)) => run_bot(session, brain, options).await,

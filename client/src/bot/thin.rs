@@ -44,6 +44,7 @@ pub async fn run_thin(
     let join = JoinOptions {
         player_name: options.name.clone(),
         room: options.room.clone(),
+        resume: None,
     };
     let mut session = match connect_trusted(server, trust, &join).await {
         Ok((session, _)) => session,

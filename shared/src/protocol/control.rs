@@ -292,6 +292,14 @@ pub enum ClientControl {
         /// The room to join: 1..=[`MAX_ID_LEN`] bytes, no control characters.
         room: String,
     },
+    /// Instead of a hello, as the first message: asks for the server's
+    /// rooms. The server answers [`ServerControl::Rooms`] (or a
+    /// [`ServerControl::Reject`] for another version) and closes normally.
+    /// Added in protocol version 5.
+    ListRooms {
+        /// The client's [`PROTOCOL_VERSION`], checked by the server.
+        version: u32,
+    },
     /// Asks for the level bundle the [`Welcome`] offered, from byte
     /// `offset` on (0, or how much a cut download already has): the server
     /// opens a unidirectional stream and writes the bundle's bytes from
@@ -300,13 +308,21 @@ pub enum ClientControl {
         /// First byte wanted; at most the bundle's size.
         offset: u64,
     },
-    /// Instead of a hello, as the first message: asks for the server's
-    /// rooms. The server answers [`ServerControl::Rooms`] (or a
-    /// [`ServerControl::Reject`] for another version) and closes normally.
-    /// Added in protocol version 5.
-    ListRooms {
+    /// Instead of a hello, as the first message, after a lost connection:
+    /// asks for the player the [`Welcome::session_token`] names (same id,
+    /// position, coins, checkpoint), which the server keeps for its
+    /// reconnect grace time. An unknown or expired token joins as a new
+    /// player, like [`ClientControl::HelloRoom`] (or `Hello` without a
+    /// room). Added in protocol version 5.
+    Resume {
         /// The client's [`PROTOCOL_VERSION`], checked by the server.
         version: u32,
+        /// Display name, checked by [`check_name`] (for a new player).
+        name: String,
+        /// The room for a new player (`None`: any), checked like a room name.
+        room: Option<String>,
+        /// The token of the session to resume.
+        token: SessionToken,
     },
 }
 
@@ -321,8 +337,35 @@ impl ClientControl {
                 name,
                 room,
             } => Some((*version, name, Some(room))),
+            ClientControl::Resume {
+                version,
+                name,
+                room,
+                ..
+            } => Some((*version, name, room.as_deref())),
             _ => None,
         }
+    }
+
+    /// The session token of a `Resume`.
+    pub fn resume_token(&self) -> Option<SessionToken> {
+        match self {
+            ClientControl::Resume { token, .. } => Some(*token),
+            _ => None,
+        }
+    }
+}
+
+/// Names a player's session to the server, so a client that lost its
+/// connection gets the same player back ([`ClientControl::Resume`]): 128
+/// random bits, unguessable, issued in the [`Welcome`].
+#[derive(Clone, Copy, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+pub struct SessionToken(pub [u8; 16]);
+
+impl fmt::Debug for SessionToken {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // A secret: never in logs.
+        f.write_str("SessionToken(..)")
     }
 }
 
@@ -336,6 +379,11 @@ impl Message for ClientControl {
             ClientControl::HelloRoom { name, room, .. } => {
                 check_name(name)?;
                 check_text("room name", room, 1, MAX_ID_LEN)
+            }
+            ClientControl::Resume { name, room, .. } => {
+                check_name(name)?;
+                room.as_deref()
+                    .map_or(Ok(()), |r| check_text("room name", r, 1, MAX_ID_LEN))
             }
             ClientControl::Chat { text } => check_text("chat text", text, 1, MAX_CHAT_LEN),
             ClientControl::Ping { .. }
@@ -411,6 +459,9 @@ pub struct Welcome {
     pub level_hash: u64,
     /// The level bundle: its hash and size (added in protocol version 5).
     pub level: LevelOffer,
+    /// Resumes this player after a lost connection
+    /// ([`ClientControl::Resume`]; added in protocol version 5).
+    pub session_token: SessionToken,
     /// The room's simulation tick when the player joined.
     pub server_tick: u64,
     /// Tick and snapshot rates.
@@ -730,5 +781,37 @@ mod tests {
         let over = bincode::serde::encode_to_vec(&over, bincode::config::standard()).unwrap();
         let err = ServerControl::decode(&over).unwrap_err().to_string();
         assert!(err.contains("more than 256 rooms"), "{err}");
+    }
+
+    #[test]
+    fn new_first_messages_keep_their_variant_numbers_and_resume_hides_its_token() {
+        let list = ClientControl::ListRooms { version: 5 };
+        let get = ClientControl::GetLevel { offset: 3 };
+        let resume = ClientControl::Resume {
+            version: PROTOCOL_VERSION,
+            name: "ana".into(),
+            room: Some("friends".into()),
+            token: SessionToken([7; 16]),
+        };
+        assert_eq!(list.encode().unwrap()[0], 5);
+        assert_eq!(get.encode().unwrap()[0], 6);
+        assert_eq!(resume.encode().unwrap()[0], 7);
+        assert_eq!(
+            ClientControl::decode(&resume.encode().unwrap()).unwrap(),
+            resume
+        );
+        assert_eq!(
+            resume.as_hello(),
+            Some((PROTOCOL_VERSION, "ana", Some("friends")))
+        );
+        assert_eq!(resume.resume_token(), Some(SessionToken([7; 16])));
+        assert!(!format!("{resume:?}").contains("7, 7"), "{resume:?}");
+        let bad = ClientControl::Resume {
+            version: PROTOCOL_VERSION,
+            name: String::new(),
+            room: None,
+            token: SessionToken::default(),
+        };
+        assert!(bad.encode().is_err());
     }
 }

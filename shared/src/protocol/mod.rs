@@ -31,7 +31,7 @@ pub use codec::Message;
 pub use control::{
     check_name, check_rooms, check_roster, check_text, check_version, decode_sim_config,
     encode_sim_config, ClientControl, CloseCode, LevelOffer, NetTiming, NoticeKind, PlayerId, RejectReason,
-    RoomInfo, RosterEntry, ServerControl, Welcome, MAX_CHAT_LEN, MAX_ID_LEN, MAX_NAME_LEN,
+    RoomInfo, RosterEntry, ServerControl, SessionToken, Welcome, MAX_CHAT_LEN, MAX_ID_LEN, MAX_NAME_LEN,
     MAX_LEVEL_BUNDLE, MAX_REASON_LEN, MAX_ROOMS, MAX_ROSTER, MAX_SIM_CONFIG_LEN,
 };
 pub use datagram::{fits, input_timing, InputPacket, Outgoing, Snapshot};
@@ -51,7 +51,8 @@ pub use snapshot::{
 /// 4: the room's roster: `ServerControl::Roster`, `PlayerJoined`,
 /// `PlayerLeft` (players' names).
 /// 5: rooms by name: `ClientControl::ListRooms`, `ServerControl::Rooms`;
-/// level download: `Welcome::level`, `ClientControl::GetLevel`.
+/// level download: `Welcome::level`, `ClientControl::GetLevel`; resuming a
+/// lost session: `Welcome::session_token`, `ClientControl::Resume`.
 pub const PROTOCOL_VERSION: u32 = 5;
 
 /// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
