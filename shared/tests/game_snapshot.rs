@@ -230,10 +230,12 @@ fn players_join_and_leave() {
     let ids: Vec<_> = g.players().map(|(id, _)| id).collect();
     assert_eq!(ids, vec![PlayerId(2), PlayerId(5)]);
     // Two spawns: player id modulo the spawn count picks one; players stand
-    // on the floor at its bottom.
+    // on the floor at its bottom, player 2 on spawn 0 itself, player 5 (the
+    // third id of spawn 1) on that spawn's third spot, one tile right
+    // (`game::spawn`).
     let pos: Vec<_> = g.players().map(|(_, p)| p).collect();
     assert_eq!(pos[0], IVec2::new(3 * T + T / 2, 19 * T - 8 * 256));
-    assert_eq!(pos[1], IVec2::new(5 * T + T / 2, 19 * T - 8 * 256));
+    assert_eq!(pos[1], IVec2::new(6 * T + T / 2, 19 * T - 8 * 256));
     let ev = g.step(&[]).to_vec();
     assert_eq!(
         ev,

@@ -713,15 +713,15 @@ mod tests {
     }
 
     /// The runner's buttons, tick by tick, until it wins (at most a minute),
-    /// in a game holding `idle` idle players besides it (ids below ours).
+    /// in a game holding `idle` idle players besides it (on their own spots
+    /// around the spawn; ours, player 1's, is the spawn itself).
     fn run_beside(idle: u32) -> (Vec<Buttons>, RunnerProgress, bool) {
         let level = default_level();
         let mut game = Game::from_level(&level).unwrap();
-        for i in 1..=idle {
-            game.add_player(PlayerId(i)).unwrap();
+        let me = PlayerId(1);
+        for id in 1..=idle + 1 {
+            game.add_player(PlayerId(id)).unwrap();
         }
-        let me = PlayerId(idle + 1);
-        game.add_player(me).unwrap();
         let mut runner = Runner::new(default_route());
         let mut pressed = Vec::new();
         for _ in 0..60 * 60 {

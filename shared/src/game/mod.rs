@@ -46,6 +46,7 @@ mod config;
 mod path;
 mod polygon_ground;
 mod rules;
+pub mod spawn;
 pub mod state;
 
 pub use config::{CarryMode, GameConfig, PlayerConfig, PlayerShape, FOOT_HEIGHT, FOOT_INSET};
@@ -312,6 +313,9 @@ pub struct Game {
     tick: u64,
     ents: Vec<Ent>,
     spawns: Vec<usize>,
+    /// Per spawn (as `spawns`), the player centres players take there
+    /// ([`spawn`]); never empty.
+    spawn_spots: Vec<Vec<IVec2>>,
     platforms: Vec<usize>,
     walkers: Vec<usize>,
     coins: Vec<usize>,
@@ -363,6 +367,7 @@ impl Game {
             tick: 0,
             ents: Vec::with_capacity(level.entities.len()),
             spawns: Vec::new(),
+            spawn_spots: Vec::new(),
             platforms: Vec::new(),
             walkers: Vec::new(),
             coins: Vec::new(),
@@ -489,6 +494,16 @@ impl Game {
         if g.spawns.is_empty() {
             return Err(GameError::NoSpawn(level.name.clone()));
         }
+        let ground = spawn::Ground {
+            map: g.tilemap(),
+            ents: &g.ents,
+            half: g.config.player.half,
+        };
+        g.spawn_spots = g
+            .spawns
+            .iter()
+            .map(|&i| ground.spots(g.stand_in(&g.ents[i])))
+            .collect();
         Ok(g)
     }
 
@@ -523,7 +538,8 @@ impl Game {
     }
 
     /// Adds a player at its spawn point (spawn `id % spawn count` in level
-    /// order); a [`GameEvent::Joined`] opens the next step's events.
+    /// order, on its own spot there: [`spawn`]); a [`GameEvent::Joined`]
+    /// opens the next step's events.
     pub fn add_player(&mut self, id: PlayerId) -> Result<(), GameError> {
         if id.0 >= ENTITY_ID_BASE {
             return Err(GameError::PlayerIdOutOfRange(id));
@@ -650,16 +666,24 @@ impl Game {
         self.world.body(b).map_or(IVec2::ZERO, |b| b.vel())
     }
 
-    /// Where player `id` with state `st` respawns: its checkpoint, else its
-    /// spawn; the player's box stands on the bottom of that entity's box,
-    /// centred in x.
+    /// Where player `id` with state `st` respawns: its checkpoint (the
+    /// player's box standing on the bottom of the checkpoint's box, centred
+    /// in x), else its own spot at its spawn ([`spawn`]: spawn
+    /// `id % spawns`, spot `(id - 1) / spawns` of that spawn's spots).
     fn respawn_point(&self, id: PlayerId, st: &PlayerState) -> IVec2 {
-        let i = if st.checkpoint != 0 {
-            st.checkpoint as usize - 1
-        } else {
-            self.spawns[id.0 as usize % self.spawns.len()]
-        };
-        let e = &self.ents[i];
+        if st.checkpoint != 0 {
+            return self.stand_in(&self.ents[st.checkpoint as usize - 1]);
+        }
+        // At most 32766 entities: the count fits u32.
+        let n = self.spawns.len() as u32;
+        let spots = &self.spawn_spots[(id.0 % n) as usize];
+        let k = id.0.wrapping_sub(1) / n % spots.len() as u32;
+        spots[k as usize]
+    }
+
+    /// The centre of a player standing on the bottom of entity `e`'s box,
+    /// centred in x.
+    fn stand_in(&self, e: &Ent) -> IVec2 {
         IVec2::new(e.pos.x, e.pos.y + e.half.y - self.config.player.half.y)
     }
 

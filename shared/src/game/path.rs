@@ -93,6 +93,16 @@ impl PathSchedule {
         self.period
     }
 
+    /// The smallest box holding every position of the platform's centre:
+    /// `(min, max)` per axis over the path's nodes (a leg runs straight
+    /// between two nodes).
+    pub fn bounds(&self) -> (IVec2, IVec2) {
+        let ends = self.legs.iter().map(|l| l.from + l.delta);
+        ends.fold((self.first, self.first), |(lo, hi), p| {
+            (lo.min(p), hi.max(p))
+        })
+    }
+
     /// The platform's centre at `tick`.
     pub fn at(&self, tick: u64) -> IVec2 {
         if self.period == 0 {

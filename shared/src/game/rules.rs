@@ -14,15 +14,15 @@ use crate::world::{BodyId, Event, Sides};
 
 /// A box by its edges, in `i64` units.
 #[derive(Debug, Clone, Copy)]
-struct Rect {
-    l: i64,
-    t: i64,
-    r: i64,
-    b: i64,
+pub(super) struct Rect {
+    pub(super) l: i64,
+    pub(super) t: i64,
+    pub(super) r: i64,
+    pub(super) b: i64,
 }
 
 impl Rect {
-    fn new(centre: IVec2, half: IVec2) -> Self {
+    pub(super) fn new(centre: IVec2, half: IVec2) -> Self {
         let (c, h) = (centre.as_i64vec2(), half.as_i64vec2());
         Rect {
             l: c.x - h.x,
@@ -33,7 +33,7 @@ impl Rect {
     }
 
     /// Interiors overlap.
-    fn overlaps(&self, o: &Rect) -> bool {
+    pub(super) fn overlaps(&self, o: &Rect) -> bool {
         self.l < o.r && o.l < self.r && self.t < o.b && o.t < self.b
     }
 }
