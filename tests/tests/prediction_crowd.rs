@@ -1,7 +1,8 @@
 //! Prediction in a crowd over real QUIC: runner bots (the `ledge-bot`
 //! default brain, which plans jumps by simulating the predicted game)
 //! predict the server exactly for a minute beside twelve idle players, six
-//! of them joining while the bots run.
+//! of them joining while the bots run. And players joining one room appear
+//! on spots of their own, never on one pixel.
 //!
 //! The idle players are thin: they send no-button inputs each tick and read
 //! the snapshots, without predicting, so the test costs little more than
@@ -15,12 +16,11 @@
 use std::time::{Duration, Instant};
 
 use ledge_client::bot::Runner;
-use ledge_client::clock::InputClock;
-use ledge_client::{Session, SessionEvent};
+use ledge_client::Session;
 use ledge_levels::default_route;
-use ledge_shared::input::Buttons;
-use ledge_tests::e2e::{bot_options, spawn_bot, task_panics, PlayerState};
-use ledge_tests::TestServer;
+use ledge_shared::game::GameConfig;
+use ledge_tests::e2e::{bot_options, spawn_bot, task_panics, watch, PlayerState};
+use ledge_tests::{snapshot_where, TestServer, WAIT};
 
 /// Predicting runner bots.
 const BOTS: usize = 4;
@@ -34,24 +34,13 @@ const PLAY: Duration = Duration::from_secs(60);
 /// An idle player on `session` until `until`: a no-button input each tick,
 /// every snapshot read (no prediction). Returns the snapshots received.
 async fn idle(mut session: Session, until: Instant) -> u64 {
-    let mut clock = InputClock::new(session.welcome(), Instant::now());
     let mut snapshots = 0;
-    while Instant::now() < until {
-        let _ = session.send_input(clock.input_tick(Instant::now()), Buttons::NONE);
-        let wait = clock
-            .until_next_tick(Instant::now())
-            .min(until.saturating_duration_since(Instant::now()));
-        let Ok(event) = tokio::time::timeout(wait, session.recv()).await else {
-            continue;
-        };
-        match event.expect("the idle player stays connected") {
-            SessionEvent::Snapshot(update) => {
-                snapshots += 1;
-                clock.observe(update.input_timing);
-            }
-            _ => continue,
-        }
-    }
+    let within = until.saturating_duration_since(Instant::now());
+    watch(&mut session, within, |_| {
+        snapshots += 1;
+        false
+    })
+    .await;
     session.close().await;
     snapshots
 }
@@ -119,4 +108,37 @@ async fn runner_bots_predict_exactly_beside_twelve_idle_players_for_a_minute() {
         panics_before,
         "a server or bot task panicked"
     );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn players_joining_one_room_appear_apart() {
+    let server = TestServer::start().await;
+    let mut sessions = Vec::new();
+    for i in 0..4 {
+        sessions.push(server.join(&format!("player-{i}")).await);
+    }
+    let ids: Vec<u32> = sessions.iter().map(|s| s.welcome().player_id.0).collect();
+    // The first snapshot the last one gets that shows everyone: right after
+    // the joins.
+    let last = sessions.last_mut().unwrap();
+    let state = snapshot_where(last, WAIT, |s| ids.iter().all(|&id| s.get(id).is_some())).await;
+    let at: Vec<_> = ids.iter().map(|&id| state.get(id).unwrap().pos).collect();
+    eprintln!("players {ids:?} at {at:?} (tick {})", state.tick);
+    let half = GameConfig::default().player.half;
+    for i in 0..at.len() {
+        assert_eq!(at[i].y, at[0].y, "on one floor: {at:?}");
+        for j in 0..i {
+            assert_ne!(
+                at[i], at[j],
+                "players {} and {} on one pixel",
+                ids[i], ids[j]
+            );
+        }
+    }
+    // The first two stand side by side, apart.
+    assert!((at[1].x - at[0].x).abs() >= 2 * half.x, "{at:?}");
+    for s in sessions {
+        s.close().await;
+    }
+    server.stop().await.unwrap();
 }
