@@ -19,21 +19,30 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::thread;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use ledge_levels::LevelBundle;
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::{Fingerprint, NoticeKind, PlayerId, Welcome};
+use ledge_shared::protocol::{CloseCode, Fingerprint, NoticeKind, PlayerId, Welcome};
 use tokio::sync::oneshot;
 
 use crate::bundle::{fetch_level, FetchOptions, Fetched, LevelCache};
 use crate::error::ClientError;
 use crate::netstats::TransportSample;
-use crate::session::{JoinOptions, SessionEvent, SnapshotUpdate};
+use crate::session::{JoinOptions, Session, SessionEvent, SnapshotUpdate};
 use crate::trust::{connect_trusted, Trust};
 
 /// How often the background thread pings the server.
 const PING_INTERVAL: Duration = Duration::from_secs(1);
+/// How long a client keeps trying to reconnect after losing a joined
+/// session (the server's default reconnect grace).
+pub const RECONNECT_FOR: Duration = Duration::from_secs(30);
+/// Longest one reconnect attempt may take.
+const RECONNECT_ATTEMPT: Duration = Duration::from_secs(3);
+/// First wait between reconnect attempts (doubling up to the max).
+const RECONNECT_BACKOFF: Duration = Duration::from_millis(250);
+/// Longest wait between reconnect attempts.
+const RECONNECT_BACKOFF_MAX: Duration = Duration::from_secs(2);
 /// How often the background thread reads QUIC's counters.
 const TRANSPORT_INTERVAL: Duration = Duration::from_millis(250);
 /// Events waiting for the front end; more are dropped.
@@ -132,6 +141,13 @@ pub enum NetEvent {
     /// trusted (a wrong pin, or a known host whose certificate changed);
     /// the message says what to do. The thread has ended.
     Untrusted(String),
+    /// The connection was lost; reconnecting (attempt 0: just lost). Then
+    /// [`NetEvent::Connected`] (the same player, if the server still kept
+    /// it) or [`NetEvent::Disconnected`].
+    Reconnecting {
+        /// Failed attempts so far.
+        attempt: u32,
+    },
     /// An established session ended; the thread has ended.
     Disconnected(String),
 }
@@ -278,23 +294,38 @@ async fn run(
     mut commands: tokio::sync::mpsc::Receiver<NetCommand>,
     mut quit: oneshot::Receiver<()>,
 ) {
-    let connecting = async {
-        let join = JoinOptions {
-            player_name: request.player_name.clone(),
-            room: options.room.clone(),
-            resume: None,
-        };
-        let trust = options
-            .trust
-            .clone()
-            .unwrap_or(Trust::Pinned(request.cert_fingerprint));
-        connect_trusted(&request.server, &trust, &join).await
+    let trust = options
+        .trust
+        .clone()
+        .unwrap_or(Trust::Pinned(request.cert_fingerprint));
+    let mut join = JoinOptions {
+        player_name: request.player_name.clone(),
+        room: options.room.clone(),
+        resume: None,
     };
-    let mut session = tokio::select! {
-        _ = &mut quit => return,
-        result = connecting => match result {
-            Ok((session, _)) => session,
-            Err(e) => {
+    // Set once joined: then a lost connection is resumed.
+    let mut lost: Option<(Instant, u32)> = None;
+    let mut joined_once = false;
+    loop {
+        let connecting = async {
+            let attempt = connect_trusted(&request.server, &trust, &join);
+            if joined_once {
+                // A reconnect attempt through a dead link must not hang for
+                // the whole QUIC idle timeout.
+                tokio::time::timeout(RECONNECT_ATTEMPT, attempt)
+                    .await
+                    .unwrap_or(Err(ClientError::Timeout))
+            } else {
+                attempt.await
+            }
+        };
+        let result = tokio::select! {
+            _ = &mut quit => return,
+            result = connecting => result,
+        };
+        let mut session = match (result, lost) {
+            (Ok((session, _)), _) => session,
+            (Err(e), None) => {
                 let untrusted = matches!(
                     e,
                     ClientError::Trust(_) | ClientError::FingerprintMismatch { .. }
@@ -306,57 +337,134 @@ async fn run(
                 });
                 return;
             }
-        },
-    };
-    let sample = |s: &crate::session::Session| {
-        if let Ok(mut slot) = events.transport.lock() {
-            *slot = Some(TransportSample::of(s.connection()));
-        }
-    };
-    let roster = |s: &crate::session::Session| {
-        if let Ok(mut slot) = events.players.lock() {
-            slot.clone_from(s.players());
-        }
-    };
-    sample(&session);
-    if options.download_level {
-        let fetch = FetchOptions {
-            cache: options.level_cache.clone().map(LevelCache::new),
-            cut_after: None,
-        };
-        let total = session.welcome().level.size;
-        let mut shown = 0;
-        let fetched = fetch_level(&mut session, &fetch, |got, total| {
-            // A few dozen updates, not one per read.
-            if got == total || got >= shown + total / 32 {
-                shown = got;
-                events.send(NetEvent::LevelProgress { got, total });
+            (Err(e), Some((since, attempt))) => {
+                if !reconnectable(&e) || since.elapsed() >= RECONNECT_FOR {
+                    events.send(NetEvent::Disconnected(format!(
+                        "lost the connection and could not reconnect within {} s: {e}",
+                        RECONNECT_FOR.as_secs()
+                    )));
+                    return;
+                }
+                let attempt = attempt + 1;
+                lost = Some((since, attempt));
+                events.send(NetEvent::Reconnecting { attempt });
+                let backoff = RECONNECT_BACKOFF * 2u32.pow(attempt.min(4));
+                tokio::select! {
+                    _ = &mut quit => return,
+                    () = tokio::time::sleep(backoff.min(RECONNECT_BACKOFF_MAX)) => {}
+                }
+                continue;
             }
-        });
-        let result = tokio::select! {
-            _ = &mut quit => return,
-            result = fetched => result,
         };
-        match result {
-            Ok((bundle, fetched)) => {
-                tracing::info!("{}", fetched.describe(total));
-                events.send(NetEvent::Level(Box::new(bundle), fetched));
+        join.resume = Some(session.welcome().session_token);
+        if let Some((since, _)) = lost.take() {
+            tracing::info!(
+                "reconnected after {:.1} s as player {}",
+                since.elapsed().as_secs_f32(),
+                session.welcome().player_id
+            );
+        }
+        if options.download_level && !joined_once {
+            let fetch = FetchOptions {
+                cache: options.level_cache.clone().map(LevelCache::new),
+                cut_after: None,
+            };
+            let total = session.welcome().level.size;
+            let mut shown = 0;
+            let fetched = fetch_level(&mut session, &fetch, |got, total| {
+                // A few dozen updates, not one per read.
+                if got == total || got >= shown + total / 32 {
+                    shown = got;
+                    events.send(NetEvent::LevelProgress { got, total });
+                }
+            });
+            let result = tokio::select! {
+                _ = &mut quit => return,
+                result = fetched => result,
+            };
+            match result {
+                Ok((bundle, fetched)) => {
+                    tracing::info!("{}", fetched.describe(total));
+                    events.send(NetEvent::Level(Box::new(bundle), fetched));
+                }
+                Err(e) => {
+                    events.send(NetEvent::Failed(e.to_string()));
+                    session.close().await;
+                    return;
+                }
             }
-            Err(e) => {
-                events.send(NetEvent::Failed(e.to_string()));
+        }
+        joined_once = true;
+        match serve(&mut session, &events, &mut commands, &mut quit).await {
+            Served::Quit => {
                 session.close().await;
+                return;
+            }
+            Served::Failed(e) if reconnectable(&e) => {
+                tracing::info!("connection lost ({e}); reconnecting");
+                events.send(NetEvent::Reconnecting { attempt: 0 });
+                lost = Some((Instant::now(), 0));
+            }
+            Served::Failed(e) => {
+                events.send(NetEvent::Disconnected(e.to_string()));
                 return;
             }
         }
     }
+}
+
+/// How a joined session's loop ended.
+enum Served {
+    /// The front end is gone or asked to quit.
+    Quit,
+    /// The session failed.
+    Failed(ClientError),
+}
+
+/// Whether a session that failed with `e` may come back by reconnecting:
+/// a lost link or a server going away (it may be restarting), not a kick,
+/// a refusal or a protocol error.
+fn reconnectable(e: &ClientError) -> bool {
+    match e {
+        ClientError::Connection(_)
+        | ClientError::Timeout
+        | ClientError::Stream(_)
+        | ClientError::StreamEnded
+        | ClientError::Socket(_) => true,
+        ClientError::ClosedByServer { code, .. } => {
+            matches!(code, Some(CloseCode::ServerShutdown | CloseCode::Timeout))
+        }
+        _ => false,
+    }
+}
+
+/// Runs a joined session: inputs and chat out, events in, until it fails
+/// or the front end quits.
+async fn serve(
+    session: &mut Session,
+    events: &Events,
+    commands: &mut tokio::sync::mpsc::Receiver<NetCommand>,
+    quit: &mut oneshot::Receiver<()>,
+) -> Served {
+    let sample = |s: &Session| {
+        if let Ok(mut slot) = events.transport.lock() {
+            *slot = Some(TransportSample::of(s.connection()));
+        }
+    };
+    let roster = |s: &Session| {
+        if let Ok(mut slot) = events.players.lock() {
+            slot.clone_from(s.players());
+        }
+    };
+    sample(session);
     events.send(NetEvent::Connected(session.welcome().clone()));
     let mut ticker = tokio::time::interval(PING_INTERVAL);
     let mut transport_ticker = tokio::time::interval(TRANSPORT_INTERVAL);
     loop {
         let result = tokio::select! {
-            _ = &mut quit => break,
+            _ = &mut *quit => return Served::Quit,
             _ = transport_ticker.tick() => {
-                sample(&session);
+                sample(session);
                 Ok(true)
             }
             command = commands.recv() => match command {
@@ -369,7 +477,7 @@ async fn run(
                     Ok(true)
                 }
                 Some(NetCommand::Chat(text)) => session.chat(&text).await.map(|()| true),
-                None => break,
+                None => return Served::Quit,
             },
             _ = ticker.tick() => session.send_ping().await.map(|_| true),
             event = session.recv() => event.map(|event| match event {
@@ -379,25 +487,21 @@ async fn run(
                 SessionEvent::Pong { rtt: Some(rtt), .. } => events.send(NetEvent::Rtt(rtt)),
                 SessionEvent::Pong { rtt: None, .. } => true,
                 SessionEvent::PlayerJoined { id, name } => {
-                    roster(&session);
+                    roster(session);
                     events.send(NetEvent::PlayerJoined { id, name })
                 }
                 SessionEvent::PlayerLeft { id, .. } => {
-                    roster(&session);
+                    roster(session);
                     events.send(NetEvent::PlayerLeft { id })
                 }
             }),
         };
         match result {
             Ok(true) => {}
-            Ok(false) => break,
-            Err(e) => {
-                events.send(NetEvent::Disconnected(e.to_string()));
-                return;
-            }
+            Ok(false) => return Served::Quit,
+            Err(e) => return Served::Failed(e),
         }
     }
-    session.close().await;
 }
 
 /// What a front end shows about the network.
@@ -408,6 +512,11 @@ pub enum NetStatus {
     Offline,
     /// Connecting to the named server.
     Connecting(String),
+    /// The connection was lost; reconnecting.
+    Reconnecting {
+        /// Failed attempts so far.
+        attempt: u32,
+    },
     /// Joined; downloading the server's level.
     Downloading {
         /// Bytes so far.
@@ -438,6 +547,7 @@ impl NetStatus {
                 rtt: Some(rtt),
             },
             (_, NetEvent::LevelProgress { got, total }) => NetStatus::Downloading { got, total },
+            (_, NetEvent::Reconnecting { attempt }) => NetStatus::Reconnecting { attempt },
             (
                 status,
                 NetEvent::Rtt(_)
@@ -461,6 +571,14 @@ impl fmt::Display for NetStatus {
         match self {
             NetStatus::Offline => write!(f, "offline (local simulation)"),
             NetStatus::Connecting(server) => write!(f, "connecting to {server}..."),
+            NetStatus::Reconnecting { attempt: 0 } => write!(f, "connection lost: reconnecting..."),
+            NetStatus::Reconnecting { attempt } => {
+                write!(
+                    f,
+                    "connection lost: reconnecting... (attempt {})",
+                    attempt + 1
+                )
+            }
             NetStatus::Downloading { got, total } => write!(
                 f,
                 "downloading the level: {} of {} KiB",

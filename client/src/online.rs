@@ -286,6 +286,7 @@ impl OnlineGame {
             NetEvent::Untrusted(reason) => self.untrusted = Some(reason.clone()),
             NetEvent::Failed(_)
             | NetEvent::Disconnected(_)
+            | NetEvent::Reconnecting { .. }
             | NetEvent::LevelProgress { .. }
             | NetEvent::Level(..) => {}
         }

@@ -1,10 +1,13 @@
 //! A joined window knows within a second when the server goes silent: a
 //! GUI front end ([`OnlineGame`]) behind a relay that drops everything says
 //! the connection is stalled (not "online" for the 10 s QUIC waits before
-//! it gives up), and stops saying so when snapshots come back.
+//! it gives up), and stops saying so when snapshots come back; after a
+//! loss long enough to end the connection it reconnects by itself and gets
+//! its player back.
 
 use std::time::{Duration, Instant};
 
+use ledge_client::background::NetStatus;
 use ledge_client::online::STALL_AFTER;
 use ledge_client::{OnlineGame, OnlineRequest, Trust};
 use ledge_shared::input::Buttons;
@@ -69,6 +72,46 @@ fn a_silent_server_is_noticed_within_a_second() {
         |o, now| o.stalled(now).is_none(),
     );
     assert!(online.game().is_some(), "still in the game");
+    drop(online);
+    runtime.block_on(async { server.stop().await.unwrap() });
+}
+
+#[test]
+fn a_gui_client_reconnects_by_itself_and_keeps_its_player() {
+    let runtime = tokio::runtime::Runtime::new().unwrap();
+    let server = runtime.block_on(TestServer::start());
+    let relay = runtime.block_on(UdpRelay::start(server.addr));
+    let request = OnlineRequest::new(
+        &relay.addr.to_string(),
+        Trust::Pinned(server.fingerprint),
+        "ada",
+    );
+    let mut online = OnlineGame::connect(request).unwrap();
+    play_until(&mut online, "joined", Duration::from_secs(10), |o, now| {
+        o.game().is_some_and(|g| g.synced()) && o.stalled(now).is_none()
+    });
+    let me = online.game().unwrap().me();
+
+    // 20 s of total loss: both ends time out (10 s) and the client keeps
+    // trying; the server keeps the player.
+    relay.blackhole();
+    play_until(
+        &mut online,
+        "reconnecting",
+        Duration::from_secs(15),
+        |o, _| matches!(o.status(), NetStatus::Reconnecting { .. }),
+    );
+    // The rest of the 20 s (the connection died after about 10 s).
+    std::thread::sleep(Duration::from_secs(9));
+    relay.restore();
+    play_until(&mut online, "back", Duration::from_secs(10), |o, now| {
+        matches!(o.status(), NetStatus::Connected { .. })
+            && o.game().is_some_and(|g| g.synced())
+            && o.stalled(now).is_none()
+    });
+    assert_eq!(online.game().unwrap().me(), me, "the same player");
+    let m = server.metrics();
+    assert_eq!(ledge_tests::metric(&m, "ledge_sessions_resumed_total"), 1.0);
     drop(online);
     runtime.block_on(async { server.stop().await.unwrap() });
 }

@@ -221,7 +221,7 @@ impl Play {
             None => format!("offline: {}", self.level.name),
             Some(NetStatus::Connected { welcome, .. }) => match self.stalled() {
                 Some(silent) => format!(
-                    "connection stalled: nothing from {} for {:.0} s",
+                    "reconnecting... (nothing from {} for {:.0} s)",
                     self.server,
                     silent.as_secs_f32()
                 ),
@@ -249,11 +249,17 @@ impl Play {
             }
             NetStatus::Connected { .. } => self.stalled().map(|silent| {
                 format!(
-                    "connection stalled: nothing from {} for {:.0} s (it gives up after 10 s)",
+                    "reconnecting... nothing from {} for {:.0} s",
                     self.server,
                     silent.as_secs_f32()
                 )
             }),
+            NetStatus::Reconnecting { attempt } => Some(format!(
+                "connection to {} lost: reconnecting... (attempt {}; your player is kept \
+                 for 30 s; Esc quits)",
+                self.server,
+                attempt + 1
+            )),
             _ => None,
         }
     }
