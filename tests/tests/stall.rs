@@ -3,13 +3,14 @@
 //! the connection is stalled (not "online" for the 10 s QUIC waits before
 //! it gives up), and stops saying so when snapshots come back; after a
 //! loss long enough to end the connection it reconnects by itself and gets
-//! its player back.
+//! its player back; when the server restarts it rejoins by itself.
 
 use std::time::{Duration, Instant};
 
 use ledge_client::background::NetStatus;
 use ledge_client::online::STALL_AFTER;
 use ledge_client::{OnlineGame, OnlineRequest, Trust};
+use ledge_server::{Server, ServerConfig};
 use ledge_shared::input::Buttons;
 use ledge_tests::{TestServer, UdpRelay};
 
@@ -114,4 +115,54 @@ fn a_gui_client_reconnects_by_itself_and_keeps_its_player() {
     assert_eq!(ledge_tests::metric(&m, "ledge_sessions_resumed_total"), 1.0);
     drop(online);
     runtime.block_on(async { server.stop().await.unwrap() });
+}
+
+#[test]
+fn a_gui_client_rejoins_a_restarted_server_by_itself() {
+    let runtime = tokio::runtime::Runtime::new().unwrap();
+    let certs = tempfile::tempdir().unwrap();
+    let config = |bind| ServerConfig {
+        bind,
+        cert_dir: certs.path().to_owned(),
+        ..ServerConfig::default()
+    };
+    let start = |config: ServerConfig| {
+        runtime.block_on(async {
+            let server = Server::bind(config).expect("binds");
+            let info = (
+                server.local_addr(),
+                server.fingerprint(),
+                server.shutdown_handle(),
+            );
+            (info, tokio::spawn(server.run()))
+        })
+    };
+    let ((addr, fingerprint, stop), task) = start(config("127.0.0.1:0".parse().unwrap()));
+    let request = OnlineRequest::new(&addr.to_string(), Trust::Pinned(fingerprint), "ada");
+    let mut online = OnlineGame::connect(request).unwrap();
+    play_until(&mut online, "joined", Duration::from_secs(10), |o, now| {
+        o.game().is_some_and(|g| g.synced()) && o.stalled(now).is_none()
+    });
+
+    // The host restarts the server (same port, same certificate).
+    stop.shutdown();
+    runtime.block_on(task).unwrap().unwrap();
+    play_until(
+        &mut online,
+        "reconnecting",
+        Duration::from_secs(5),
+        |o, _| matches!(o.status(), NetStatus::Reconnecting { .. }),
+    );
+    let ((_, again, stop), task) = start(config(addr));
+    assert_eq!(again, fingerprint, "the same certificate");
+    play_until(&mut online, "back", Duration::from_secs(15), |o, now| {
+        matches!(o.status(), NetStatus::Connected { .. })
+            && o.game().is_some_and(|g| g.synced())
+            && o.stalled(now).is_none()
+    });
+    // A restarted server has a fresh game and no sessions: a new player.
+    assert!(online.game().is_some());
+    drop(online);
+    stop.shutdown();
+    runtime.block_on(task).unwrap().unwrap();
 }
