@@ -257,7 +257,7 @@ async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
         generation: joined.generation,
         token,
         shared,
-        lost: true,
+        lost: false,
     };
     let mut frame = Vec::new();
     write_frame(&ServerControl::Welcome(joined.welcome), &mut frame)
