@@ -57,7 +57,11 @@ pub enum ProtocolError {
     },
     /// A delta names a baseline other than the one given to the decoder
     /// (`None`: no baseline / a full snapshot).
-    #[error("snapshot baseline mismatch: the delta needs {needed:?}, got {given:?}")]
+    #[error(
+        "snapshot baseline mismatch: the delta needs {}, got {}",
+        baseline_text(*needed),
+        baseline_text(*given)
+    )]
     BaselineMismatch {
         /// The baseline tick the delta was encoded against.
         needed: Option<u64>,
@@ -96,5 +100,13 @@ impl ProtocolError {
             len: len.try_into().unwrap_or(u64::MAX),
             max: max.try_into().unwrap_or(u64::MAX),
         }
+    }
+}
+
+/// A baseline tick in words (no `Some(..)` for a person to read).
+fn baseline_text(tick: Option<u64>) -> String {
+    match tick {
+        Some(t) => format!("the snapshot of tick {t}"),
+        None => "no baseline (a full snapshot)".to_owned(),
     }
 }
