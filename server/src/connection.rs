@@ -56,6 +56,10 @@ pub const CLIENT_MAX_FRAME: usize = 1024;
 /// level over and over.
 pub const MAX_LEVEL_DOWNLOADS: u32 = 4;
 
+/// Ticks an acknowledged snapshot may be ahead of the room's published
+/// tick (the room publishes its tick just after sending): more is forged.
+const ACK_SLACK: u64 = 64;
+
 /// Bytes of the level written to its stream at a time (and counted).
 const LEVEL_CHUNK: usize = 16 * 1024;
 
@@ -270,6 +274,7 @@ async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
     let writer = tokio::spawn(write_control(
         send,
         queue,
+        connection.clone(),
         shared.metrics.clone(),
         bytes.clone(),
     ));
@@ -669,11 +674,27 @@ impl Client<'_> {
             return self.strike_flood(now, "datagrams");
         }
         match InputPacket::decode(datagram) {
-            Ok(packet) => {
+            Ok(mut packet) => {
+                // An acknowledgement of a snapshot the room cannot have sent
+                // yet (e.g. u64::MAX) is a lie: believed, it would stick and
+                // cost the client every delta. Its inputs still count.
+                let sent_up_to = self.room.status().tick + ACK_SLACK;
+                let forged = packet.ack_snapshot.is_some_and(|ack| ack > sent_up_to);
+                if forged {
+                    packet.ack_snapshot = None;
+                }
                 let r = room::lock(&self.inbox).receive(&packet);
                 let m = &self.shared.metrics;
                 m.count_drops(DropReason::InputLate, u64::from(r.late));
                 m.count_drops(DropReason::InputTooEarly, u64::from(r.too_early));
+                if forged {
+                    m.malformed(Channel::Datagram);
+                    let e = ProtocolError::Malformed {
+                        what: "input datagram",
+                        detail: "acknowledges a snapshot never sent".into(),
+                    };
+                    return self.strike_malformed(now, "input datagram", &e);
+                }
                 Ok(())
             }
             Err(e) => {
@@ -713,9 +734,11 @@ impl Client<'_> {
 async fn write_control(
     mut send: SendStream,
     mut queue: mpsc::Receiver<Outbound>,
+    connection: Connection,
     metrics: Arc<Metrics>,
     bytes: ClientBytes,
 ) {
+    let mut close = None;
     while let Some(out) = queue.recv().await {
         match out {
             Outbound::Frame(frame) => {
@@ -725,10 +748,23 @@ async fn write_control(
                 metrics.sent(&bytes, Channel::Stream, frame.len());
             }
             Outbound::Finish => break,
+            Outbound::Close(code, reason) => {
+                close = Some((code, reason));
+                break;
+            }
         }
     }
     if send.finish().is_ok() {
-        let _ = send.stopped().await;
+        // Bounded when closing: the client may not read at all.
+        let stopped = send.stopped();
+        if close.is_some() {
+            let _ = tokio::time::timeout(KICK_LINGER, stopped).await;
+        } else {
+            let _ = stopped.await;
+        }
+    }
+    if let Some((code, reason)) = close {
+        self::close(&connection, code, &reason);
     }
 }
 

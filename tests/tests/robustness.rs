@@ -289,3 +289,34 @@ async fn connections_over_the_cap_are_refused() {
     assert_unaffected(&mut a).await;
     server.stop().await.unwrap();
 }
+
+#[tokio::test]
+async fn a_forged_ack_is_counted_as_malformed_not_believed() {
+    let server = TestServer::start().await;
+    let mut forger = server.join("forger").await;
+    let connection = forger.connection().clone();
+    // Acknowledges a snapshot the server never sent.
+    let lie = InputPacket::new(5, &[Buttons::NONE], Some(u64::MAX))
+        .encode()
+        .unwrap();
+    connection.send_datagram(lie.into()).unwrap();
+    let series = r#"ledge_malformed_messages_total{channel="Datagram"}"#;
+    let deadline = Instant::now() + WAIT;
+    while metric(&server.metrics(), series) < 1.0 {
+        assert!(Instant::now() < deadline, "the forged ack was not counted");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    // Not believed: the client's own acks still get it deltas.
+    let clock = ledge_client::InputClock::new(forger.welcome(), Instant::now());
+    let mut deltas = 0;
+    let until = Instant::now() + Duration::from_secs(2);
+    while Instant::now() < until && deltas < 5 {
+        let _ = forger.send_input(clock.input_tick(Instant::now()), Buttons::NONE);
+        let (update, _) = next_snapshot(&mut forger, WAIT).await;
+        deltas += usize::from(update.baseline_tick.is_some());
+    }
+    assert!(deltas >= 5, "only {deltas} delta snapshots after the lie");
+    assert_eq!(metric(&server.metrics(), series), 1.0);
+    forger.close().await;
+    server.stop().await.unwrap();
+}
