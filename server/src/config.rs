@@ -29,6 +29,9 @@ pub const DEFAULT_ROOMS: u32 = 1;
 /// Default most rooms at once, counting those players open by name (the
 /// cap is at least `rooms`).
 pub const DEFAULT_MAX_ROOMS: u32 = 16;
+/// Default time a joined player may send no input before it is removed
+/// (half of it while its room is full).
+pub const DEFAULT_IDLE_KICK: Duration = Duration::from_secs(30);
 /// Default time a player whose connection was lost is kept for a resume.
 pub const DEFAULT_RECONNECT_GRACE: Duration = Duration::from_secs(30);
 /// Default largest level bundle the server offers, MiB: a level (with its
@@ -124,6 +127,10 @@ pub struct ServerConfig {
     pub max_catch_up: u32,
     /// QUIC idle timeout: silent connections are dropped after it.
     pub idle_timeout: Duration,
+    /// A joined player that sends no input for this long is removed (half
+    /// of it while its room is full), so silent clients cannot hold
+    /// seats; a connected client sends an input every tick.
+    pub idle_kick: Duration,
     /// How long a player whose connection was lost stays in its room (still)
     /// for its client to resume it; then it leaves.
     pub reconnect_grace: Duration,
@@ -154,6 +161,7 @@ impl Default for ServerConfig {
             max_catch_up: DEFAULT_MAX_CATCH_UP,
             idle_timeout: DEFAULT_IDLE_TIMEOUT,
             reconnect_grace: DEFAULT_RECONNECT_GRACE,
+            idle_kick: DEFAULT_IDLE_KICK,
             limits: Limits::default(),
             record_ticks: None,
         }
@@ -202,6 +210,9 @@ impl ServerConfig {
         }
         if self.record_ticks == Some(0) {
             return bad("record_ticks must be at least 1 when set");
+        }
+        if self.idle_kick < Duration::from_millis(300) {
+            return bad("idle_kick must be at least 0.3 s");
         }
         if self.reconnect_grace > Duration::from_secs(3600) {
             return bad("reconnect_grace must be at most 3600 s");
@@ -334,6 +345,8 @@ struct FileConfig {
     idle_timeout: Option<f64>,
     /// Seconds.
     reconnect_grace: Option<f64>,
+    /// Seconds.
+    idle_kick: Option<f64>,
     limits: Option<Limits>,
 }
 
@@ -383,6 +396,10 @@ impl Cli {
                 .map_err(|_| ConfigError::Invalid("idle_timeout must be seconds".into()))?;
         }
         set(&mut c.limits, file.limits);
+        if let Some(secs) = file.idle_kick {
+            c.idle_kick = Duration::try_from_secs_f64(secs)
+                .map_err(|_| ConfigError::Invalid("idle_kick must be seconds".into()))?;
+        }
         if let Some(secs) = self.reconnect_grace.or(file.reconnect_grace) {
             c.reconnect_grace = Duration::try_from_secs_f64(secs)
                 .map_err(|_| ConfigError::Invalid("reconnect_grace must be seconds".into()))?;

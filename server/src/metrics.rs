@@ -102,6 +102,8 @@ pub enum KickReason {
     Malformed,
     /// Kept exceeding its rate limits.
     Flooding,
+    /// Joined, then sent no input for the idle time (a silent seat).
+    Idle,
 }
 
 /// Label: a kick reason.

@@ -22,8 +22,9 @@ use std::time::{Duration, Instant};
 use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
-    encode_sim_config, write_frame, CloseCode, InputPacket, LevelOffer, NetTiming, Outgoing,
-    PlayerId, RejectReason, RosterEntry, ServerControl, SessionToken, Welcome, MAX_ROSTER,
+    encode_sim_config, write_frame, CloseCode, InputPacket, LevelOffer, NetTiming, NoticeKind,
+    Outgoing, PlayerId, RejectReason, RosterEntry, ServerControl, SessionToken, Welcome,
+    MAX_ROSTER,
 };
 use prometheus_client::metrics::counter::Counter;
 use prometheus_client::metrics::histogram::Histogram;
@@ -34,7 +35,8 @@ use tracing::{debug, error, info, warn};
 use crate::clock::TickSchedule;
 use crate::inputs::{InputBuffer, Received};
 use crate::metrics::{
-    Channel, ClientBytes, DropReason, Metrics, RoomLabel, SnapshotKind, SnapshotLabel,
+    Channel, ClientBytes, DropReason, KickLabel, KickReason, Metrics, RoomLabel, SnapshotKind,
+    SnapshotLabel,
 };
 use crate::record::Recorder;
 use crate::snapshots::RoomSnapshots;
@@ -52,6 +54,10 @@ pub enum Outbound {
     /// Finish the stream after what was queued before, wait (briefly) until
     /// the client has it, and stop.
     Finish,
+    /// Like `Finish`, then close the connection with this code and reason
+    /// (the room removing a player: what was queued, a kick notice, arrives
+    /// first).
+    Close(CloseCode, String),
 }
 
 /// How a room runs.
@@ -81,6 +87,9 @@ pub struct RoomConfig {
     pub level: LevelOffer,
     /// Where to record the match (inputs, joins, leaves, hashes), if on.
     pub record: Option<Recorder>,
+    /// A player sending no input for this long is removed (half of it
+    /// while the room is full).
+    pub idle_kick: Duration,
 }
 
 /// The room's progress, published after every tick.
@@ -372,6 +381,8 @@ struct Member {
     stream_pending: Option<(u64, Instant)>,
     /// Which connection holds it ([`Joined::generation`]).
     generation: u32,
+    /// The tick of its last input (or of its joining).
+    heard_at: u64,
     /// A connection holds it (false: lost, kept for a resume).
     attached: bool,
 }
@@ -535,6 +546,7 @@ impl Room {
                 stream_pending: None,
                 generation: 0,
                 attached: true,
+                heard_at: tick,
             },
         );
         self.players.store(self.members.len(), Ordering::Relaxed);
@@ -563,6 +575,7 @@ impl Room {
         m.stream_pending = None;
         m.generation += 1;
         m.attached = true;
+        m.heard_at = tick;
         let generation = m.generation;
         info!(room = %self.config.name, %player_id, generation, tick, "player resumed");
         // The room as it is now: who joined and left meanwhile.
@@ -638,6 +651,7 @@ impl Room {
                 Some(buttons) => {
                     m.buttons = buttons;
                     m.last_applied = Some(tick);
+                    m.heard_at = tick;
                 }
                 None if inbox.received_any => {
                     self.starvation.inc();
@@ -647,6 +661,7 @@ impl Room {
             drop(inbox);
             self.inputs.push((id, m.buttons));
         }
+        self.remove_idle(tick);
         self.game.step(&self.inputs);
         if let Some(r) = &self.config.record {
             r.tick(tick, &self.inputs, || self.game.state_hash());
@@ -658,6 +673,55 @@ impl Room {
         let took = started.elapsed().as_secs_f64();
         self.tick_duration.observe(took);
         self.metrics.tick_duration_fine.observe(took);
+    }
+
+    /// Removes the connected players that sent no input for the idle time
+    /// (half of it while the room is full): a silent client must not
+    /// hold a seat. Each gets a `Notice{Kick}` and a close saying why.
+    fn remove_idle(&mut self, tick: u64) {
+        let mut limit = self.config.idle_kick;
+        if self.members.len() >= self.config.max_players {
+            limit /= 2;
+        }
+        let limit = (limit.as_secs_f64() * f64::from(self.config.tick_rate)) as u64;
+        let idle: Vec<PlayerId> = self
+            .members
+            .iter()
+            .filter(|(_, m)| m.attached && tick.saturating_sub(m.heard_at) > limit)
+            .map(|(&id, _)| id)
+            .collect();
+        if idle.is_empty() {
+            return;
+        }
+        let secs = self.config.idle_kick.as_secs_f32();
+        let reason = format!("no input for {secs:.0} s (or half of it in a full room)");
+        for id in idle {
+            if let Some(m) = self.members.get(&id) {
+                let mut frame = Vec::new();
+                let kick = ServerControl::Notice {
+                    kind: NoticeKind::Kick {
+                        reason: reason.clone(),
+                    },
+                };
+                if write_frame(&kick, &mut frame).is_ok() {
+                    self.send_control(m, frame);
+                }
+                let close = Outbound::Close(CloseCode::Kicked, reason.clone());
+                if m.link.control.try_send(close).is_err() {
+                    // Its queue is full (it reads nothing): close at once.
+                    crate::connection::close(&m.link.connection, CloseCode::Kicked, &reason);
+                }
+            }
+            info!(room = %self.config.name, player = %id, "removed: {reason}");
+            self.metrics
+                .kicks
+                .get_or_create(&KickLabel {
+                    reason: KickReason::Idle,
+                })
+                .inc();
+            self.remove(id);
+        }
+        self.inputs.retain(|(id, _)| self.members.contains_key(id));
     }
 
     fn send_snapshots(&mut self) {

@@ -214,6 +214,7 @@ mod tests {
             level_hash: 1,
             level: Default::default(),
             record: None,
+            idle_kick: std::time::Duration::from_secs(30),
         };
         let (metrics, _registry) = Metrics::new();
         Rooms::new(game, template, max_rooms, metrics)

@@ -286,6 +286,7 @@ impl Server {
             level_hash: levels::level_hash(&level),
             level: level_offer,
             record: None,
+            idle_kick: config.idle_kick,
         };
         let level_id = template.level_id.clone();
         let rooms = Rooms::new(
