@@ -475,6 +475,17 @@ enum Ending {
 }
 
 impl Ending {
+    /// The connection ended under the session: the client closing it on
+    /// purpose (it quit) is a leave; a timeout or reset is a loss, and the
+    /// player is kept for a resume.
+    fn gone(e: quinn::ConnectionError) -> Ending {
+        match e {
+            quinn::ConnectionError::ApplicationClosed(_)
+            | quinn::ConnectionError::ConnectionClosed(_) => Ending::Left,
+            e => Ending::Lost(e.to_string()),
+        }
+    }
+
     fn malformed(detail: String) -> Ending {
         Ending::Kick {
             code: CloseCode::ProtocolViolation,
@@ -558,11 +569,12 @@ impl Client<'_> {
                     }
                     // The client finished its side: it left.
                     Ok(None) => Err(Ending::Left),
+                    Err(quinn::ReadError::ConnectionLost(e)) => Err(Ending::gone(e)),
                     Err(e) => Err(Ending::Lost(e.to_string())),
                 },
                 datagram = connection.read_datagram() => match datagram {
                     Ok(datagram) => self.datagram(&datagram),
-                    Err(e) => Err(Ending::Lost(e.to_string())),
+                    Err(e) => Err(Ending::gone(e)),
                 },
             };
             if let Err(ending) = step {

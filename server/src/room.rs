@@ -22,9 +22,9 @@ use std::time::{Duration, Instant};
 use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
-    encode_sim_config, write_frame, CloseCode, InputPacket, LevelOffer, NetTiming, NoticeKind,
-    Outgoing, PlayerId, RejectReason, RosterEntry, ServerControl, SessionToken, Welcome,
-    MAX_ROSTER,
+    encode_sim_config, name_key, write_frame, CloseCode, InputPacket, LevelOffer, NetTiming,
+    NoticeKind, Outgoing, PlayerId, RejectReason, RosterEntry, ServerControl, SessionToken,
+    Welcome, MAX_ROSTER,
 };
 use prometheus_client::metrics::counter::Counter;
 use prometheus_client::metrics::histogram::Histogram;
@@ -522,6 +522,16 @@ impl Room {
     ) -> Result<Joined, RejectReason> {
         if self.members.len() >= self.config.max_players {
             return Err(RejectReason::RoomFull);
+        }
+        let key = name_key(&name);
+        if let Some(taken) = self.members.values().find(|m| name_key(&m.name) == key) {
+            return Err(RejectReason::Other {
+                reason: format!(
+                    "the name \"{name}\" is taken in this room (by \"{}\"; names must differ by \
+                     more than case or look-alike letters): choose another with --name",
+                    taken.name
+                ),
+            });
         }
         if let Err(e) = self.game.add_player(player_id) {
             warn!(%player_id, "game refused the player: {e}");

@@ -131,6 +131,18 @@ fn pair() -> impl Strategy<Value = (StateSnapshot, StateSnapshot)> {
         })
 }
 
+/// A valid player name: visible characters (no emoji), no space at either
+/// end, often multi-byte.
+fn name() -> impl Strategy<Value = String> {
+    text(MAX_NAME_LEN).prop_map(|s| {
+        let visible: String = s.chars().filter(|&c| c != '🙂').collect();
+        match visible.trim() {
+            "" => "x".to_owned(),
+            t => t.to_owned(),
+        }
+    })
+}
+
 /// Valid text of 1..=max bytes (no control characters), often multi-byte.
 fn text(max: usize) -> impl Strategy<Value = String> {
     "[a-zA-Z0-9 _.!?é漢🙂-]{1,64}".prop_map(move |s| {
@@ -150,7 +162,7 @@ fn text(max: usize) -> impl Strategy<Value = String> {
 
 fn client_control() -> impl Strategy<Value = ClientControl> {
     prop_oneof![
-        (any::<u32>(), text(MAX_NAME_LEN))
+        (any::<u32>(), name())
             .prop_map(|(version, name)| ClientControl::Hello { version, name }),
         text(MAX_CHAT_LEN).prop_map(|text| ClientControl::Chat { text }),
         any::<u64>().prop_map(|nonce| ClientControl::Ping { nonce }),
@@ -232,7 +244,7 @@ fn server_control() -> impl Strategy<Value = ServerControl> {
         envelope().prop_map(ServerControl::FullState),
         any::<u64>().prop_map(|nonce| ServerControl::Pong { nonce }),
         roster(40).prop_map(|players| ServerControl::Roster { players }),
-        (any::<u32>(), text(MAX_NAME_LEN)).prop_map(|(id, name)| ServerControl::PlayerJoined(
+        (any::<u32>(), name()).prop_map(|(id, name)| ServerControl::PlayerJoined(
             RosterEntry {
                 id: PlayerId(id),
                 name
@@ -244,7 +256,7 @@ fn server_control() -> impl Strategy<Value = ServerControl> {
 
 /// A valid roster of up to `max_len` players: ids ascending, names valid.
 fn roster(max_len: usize) -> impl Strategy<Value = Vec<RosterEntry>> {
-    proptest::collection::btree_map(any::<u32>(), text(MAX_NAME_LEN), 0..max_len).prop_map(|m| {
+    proptest::collection::btree_map(any::<u32>(), name(), 0..max_len).prop_map(|m| {
         m.into_iter()
             .map(|(id, name)| RosterEntry {
                 id: PlayerId(id),

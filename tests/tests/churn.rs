@@ -106,8 +106,15 @@ async fn eventually(within: Duration, mut check: impl FnMut() -> bool) -> bool {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn fifty_players_come_and_go_and_the_server_returns_to_its_baseline() {
     let panics_before = task_panics();
-    // A short idle timeout so the players that vanish are dropped soon.
-    let server = TestServer::start_with(|c| c.idle_timeout = Duration::from_secs(2)).await;
+    // A short idle timeout and reconnect grace so the players that vanish
+    // are dropped soon (until then they are kept for a resume and hold a
+    // seat: room for them).
+    let server = TestServer::start_with(|c| {
+        c.idle_timeout = Duration::from_secs(2);
+        c.reconnect_grace = Duration::from_millis(500);
+        c.max_players = 32;
+    })
+    .await;
     let mut observer = server.join("observer").await;
     let mut ids = BTreeSet::from([observer.welcome().player_id.0]);
     let mut bots = Vec::new();

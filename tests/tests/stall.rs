@@ -128,7 +128,16 @@ fn a_gui_client_rejoins_a_restarted_server_by_itself() {
     };
     let start = |config: ServerConfig| {
         runtime.block_on(async {
-            let server = Server::bind(config).expect("binds");
+            // The old endpoint's driver may hold the port a moment after
+            // the old server stopped: retry, as a host's restart script would.
+            let deadline = Instant::now() + Duration::from_secs(5);
+            let server = loop {
+                match Server::bind(config.clone()) {
+                    Ok(server) => break server,
+                    Err(e) => assert!(Instant::now() < deadline, "cannot bind again: {e}"),
+                }
+                tokio::time::sleep(Duration::from_millis(100)).await;
+            };
             let info = (
                 server.local_addr(),
                 server.fingerprint(),

@@ -64,9 +64,43 @@ pub fn check_text(
     Ok(())
 }
 
-/// Checks a player name: 1..=[`MAX_NAME_LEN`] bytes, no control characters.
+/// Checks a player name: 1..=[`MAX_NAME_LEN`] bytes, no control
+/// characters, no space at either end, every non-ASCII character one that
+/// Unicode allows in identifiers (UTS 39: no invisible, format or bidi
+/// characters, no fillers such as U+3164), no square brackets and not
+/// "server" or "system" (server text is shown in brackets).
 pub fn check_name(name: &str) -> Result<(), ProtocolError> {
-    check_text("player name", name, 1, MAX_NAME_LEN)
+    use unicode_security::GeneralSecurityProfile;
+    check_text("player name", name, 1, MAX_NAME_LEN)?;
+    let bad = |problem| {
+        Err(ProtocolError::InvalidString {
+            field: "player name",
+            problem,
+        })
+    };
+    if name.starts_with(char::is_whitespace) || name.ends_with(char::is_whitespace) {
+        return bad("starts or ends with a space");
+    }
+    if name
+        .chars()
+        .any(|c| !(c.is_ascii_graphic() || c == ' ' || c.identifier_allowed()))
+    {
+        return bad("contains an invisible, formatting or unusual character");
+    }
+    if name.contains(['[', ']']) || ["server", "system"].contains(&name_key(name).as_str()) {
+        return bad("looks like server text");
+    }
+    Ok(())
+}
+
+/// What two player names must differ in to be told apart: the UTS 39
+/// confusable skeleton of the lower-cased name, so "Bot-1", "bot-l" and
+/// "bоt-1" (a Cyrillic о) are one name.
+pub fn name_key(name: &str) -> String {
+    let lower = name.to_lowercase();
+    unicode_security::confusable_detection::skeleton(&lower)
+        .collect::<String>()
+        .to_lowercase()
 }
 
 /// Checks a peer's protocol version against [`PROTOCOL_VERSION`].
@@ -482,7 +516,7 @@ pub enum RejectReason {
         /// The version the client announced.
         client: u32,
     },
-    /// The name is empty, too long or contains control characters.
+    /// The name breaks [`check_name`]'s rules.
     InvalidName,
     /// The room is full.
     RoomFull,
@@ -504,7 +538,8 @@ impl fmt::Display for RejectReason {
             ),
             RejectReason::InvalidName => write!(
                 f,
-                "invalid player name (1..={MAX_NAME_LEN} bytes, no control characters)"
+                "invalid player name: 1 to {MAX_NAME_LEN} bytes of visible characters, no \
+                 space at either end, no brackets"
             ),
             RejectReason::RoomFull => f.write_str("the room is full"),
             RejectReason::ShuttingDown => f.write_str("the server is shutting down"),
@@ -813,5 +848,29 @@ mod tests {
             token: SessionToken::default(),
         };
         assert!(bad.encode().is_err());
+    }
+
+    #[test]
+    fn names_are_visible_and_told_apart_beyond_case_and_look_alikes() {
+        for ok in ["ana", "bot-1", "Zoë", "дима", "李", "a b", "<ana>"] {
+            assert!(check_name(ok).is_ok(), "{ok:?}");
+        }
+        for bad in [
+            "bot\u{200B}1",
+            "\u{202E}ana",
+            "\u{FEFF}ana",
+            "\u{3164}",
+            " ",
+            " ana",
+            "ana ",
+            "[server]",
+            "Server",
+            "ana\u{1F600}",
+        ] {
+            assert!(check_name(bad).is_err(), "{bad:?}");
+        }
+        assert_eq!(name_key("Bot-1"), name_key("bot-l"));
+        assert_eq!(name_key("bot-1"), name_key("b\u{043E}t-1"));
+        assert_ne!(name_key("bot-1"), name_key("bot-2"));
     }
 }

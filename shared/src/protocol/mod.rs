@@ -30,10 +30,10 @@ mod varint;
 pub use codec::Message;
 pub use control::{
     check_name, check_rooms, check_roster, check_text, check_version, decode_sim_config,
-    encode_sim_config, ClientControl, CloseCode, LevelOffer, NetTiming, NoticeKind, PlayerId,
-    RejectReason, RoomInfo, RosterEntry, ServerControl, SessionToken, Welcome, MAX_CHAT_LEN,
-    MAX_ID_LEN, MAX_LEVEL_BUNDLE, MAX_NAME_LEN, MAX_REASON_LEN, MAX_ROOMS, MAX_ROSTER,
-    MAX_SIM_CONFIG_LEN,
+    encode_sim_config, name_key, ClientControl, CloseCode, LevelOffer, NetTiming, NoticeKind,
+    PlayerId, RejectReason, RoomInfo, RosterEntry, ServerControl, SessionToken, Welcome,
+    MAX_CHAT_LEN, MAX_ID_LEN, MAX_LEVEL_BUNDLE, MAX_NAME_LEN, MAX_REASON_LEN, MAX_ROOMS,
+    MAX_ROSTER, MAX_SIM_CONFIG_LEN,
 };
 pub use datagram::{fits, input_timing, InputPacket, Outgoing, Snapshot};
 pub use error::ProtocolError;

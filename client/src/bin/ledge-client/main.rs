@@ -213,7 +213,12 @@ fn parse_name(s: &str) -> Result<String, String> {
             s.len()
         )
     } else {
-        "a player name cannot contain control characters".to_owned()
+        match check_name(s) {
+            Err(ledge_shared::protocol::ProtocolError::InvalidString { problem, .. }) => {
+                format!("the player name {problem}: use visible letters, digits and punctuation")
+            }
+            _ => "this player name is not allowed".to_owned(),
+        }
     })
 }
 
