@@ -162,8 +162,7 @@ fn text(max: usize) -> impl Strategy<Value = String> {
 
 fn client_control() -> impl Strategy<Value = ClientControl> {
     prop_oneof![
-        (any::<u32>(), name())
-            .prop_map(|(version, name)| ClientControl::Hello { version, name }),
+        (any::<u32>(), name()).prop_map(|(version, name)| ClientControl::Hello { version, name }),
         text(MAX_CHAT_LEN).prop_map(|text| ClientControl::Chat { text }),
         any::<u64>().prop_map(|nonce| ClientControl::Ping { nonce }),
         Just(ClientControl::Leave),
@@ -244,12 +243,10 @@ fn server_control() -> impl Strategy<Value = ServerControl> {
         envelope().prop_map(ServerControl::FullState),
         any::<u64>().prop_map(|nonce| ServerControl::Pong { nonce }),
         roster(40).prop_map(|players| ServerControl::Roster { players }),
-        (any::<u32>(), name()).prop_map(|(id, name)| ServerControl::PlayerJoined(
-            RosterEntry {
-                id: PlayerId(id),
-                name
-            }
-        )),
+        (any::<u32>(), name()).prop_map(|(id, name)| ServerControl::PlayerJoined(RosterEntry {
+            id: PlayerId(id),
+            name
+        })),
         any::<u32>().prop_map(|id| ServerControl::PlayerLeft { id: PlayerId(id) }),
     ]
 }
