@@ -124,6 +124,9 @@ pub struct PlayerInbox {
     pub ack: Option<u64>,
     /// Whether any input arrived yet (starvation counts only after).
     pub received_any: bool,
+    /// Input packets received (late or early ones too): the client is
+    /// there, whatever its timing.
+    pub packets: u64,
     /// Earliest arrival (most negative timing) since the last snapshot.
     timing_min: Option<i16>,
     /// Timing of the last packet.
@@ -136,6 +139,7 @@ impl PlayerInbox {
             inputs: InputBuffer::new(window, next_tick),
             ack: None,
             received_any: false,
+            packets: 0,
             timing_min: None,
             last_timing: 0,
         }
@@ -148,6 +152,7 @@ impl PlayerInbox {
             self.ack = Some(self.ack.map_or(ack, |a| a.max(ack)));
         }
         self.received_any = true;
+        self.packets += 1;
         self.last_timing = r.timing;
         self.timing_min = Some(self.timing_min.map_or(r.timing, |m| m.min(r.timing)));
         r
@@ -381,8 +386,10 @@ struct Member {
     stream_pending: Option<(u64, Instant)>,
     /// Which connection holds it ([`Joined::generation`]).
     generation: u32,
-    /// The tick of its last input (or of its joining).
+    /// The tick its last input packet was seen at (or of its joining).
     heard_at: u64,
+    /// Its inbox's packet count when last seen.
+    packets_seen: u64,
     /// A connection holds it (false: lost, kept for a resume).
     attached: bool,
 }
@@ -484,6 +491,7 @@ impl Room {
                         m.attached = false;
                         m.buttons = Buttons::NONE;
                         m.inbox = Arc::new(Mutex::new(PlayerInbox::new(window, tick)));
+                        m.packets_seen = 0;
                     }
                 }
             }
@@ -557,6 +565,7 @@ impl Room {
                 generation: 0,
                 attached: true,
                 heard_at: tick,
+                packets_seen: 0,
             },
         );
         self.players.store(self.members.len(), Ordering::Relaxed);
@@ -586,6 +595,7 @@ impl Room {
         m.generation += 1;
         m.attached = true;
         m.heard_at = tick;
+        m.packets_seen = 0;
         let generation = m.generation;
         info!(room = %self.config.name, %player_id, generation, tick, "player resumed");
         // The room as it is now: who joined and left meanwhile.
@@ -657,11 +667,14 @@ impl Room {
         self.inputs.clear();
         for (&id, m) in &mut self.members {
             let mut inbox = lock(&m.inbox);
+            if inbox.packets != m.packets_seen {
+                m.packets_seen = inbox.packets;
+                m.heard_at = tick;
+            }
             match inbox.inputs.take(tick) {
                 Some(buttons) => {
                     m.buttons = buttons;
                     m.last_applied = Some(tick);
-                    m.heard_at = tick;
                 }
                 None if inbox.received_any => {
                     self.starvation.inc();
