@@ -150,6 +150,15 @@ fn connection_text(error: &quinn::ConnectionError) -> String {
             "the server speaks another QUIC version: client and server versions differ".into()
         }
         E::LocallyClosed => "the connection was closed on our side".into(),
+        E::ConnectionClosed(close)
+            if close.error_code == quinn::TransportErrorCode::CONNECTION_REFUSED =>
+        {
+            "the server refused the connection: it is full, or your address (this machine, or \
+             everyone behind your router) already has as many connections as the server allows \
+             (4 unless its host sets --max-per-address). Close other ledge clients on your \
+             network, or try again in a few seconds"
+                .into()
+        }
         E::ApplicationClosed(close) => format!("the server closed the connection ({close})"),
         other => format!("the connection failed: {other}"),
     }

@@ -89,14 +89,24 @@ pub async fn dial_any_or(
     server_name: &str,
     pin: Option<Fingerprint>,
 ) -> Result<(Dialed, Fingerprint), ClientError> {
-    let (config, refused, presented) = client_config(pin)?;
     let local: SocketAddr = if addr.is_ipv6() {
         (Ipv6Addr::UNSPECIFIED, 0).into()
     } else {
         (Ipv4Addr::UNSPECIFIED, 0).into()
     };
-    let mut endpoint = quinn::Endpoint::client(local).map_err(ClientError::Socket)?;
-    endpoint.set_default_client_config(config);
+    dial_from(local, addr, server_name, pin).await
+}
+
+/// [`dial_any_or`] from the local address `local` (e.g. `127.0.0.2:0`:
+/// tests stand for another machine on a loopback address of its own).
+pub async fn dial_from(
+    local: SocketAddr,
+    addr: SocketAddr,
+    server_name: &str,
+    pin: Option<Fingerprint>,
+) -> Result<(Dialed, Fingerprint), ClientError> {
+    let (config, refused, presented) = client_config(pin)?;
+    let endpoint = bind(local, config)?;
     let connecting = endpoint.connect(addr, server_name)?;
     match connecting.await {
         Ok(connection) => {
@@ -124,6 +134,22 @@ pub async fn dial_any_or(
             })
         }
     }
+}
+
+/// A client endpoint bound to `local` whose connections trust only `pin`
+/// (any certificate when `None`): for connecting many times from one
+/// socket (the admission tests' attackers); players use [`dial`].
+pub fn endpoint(
+    local: SocketAddr,
+    pin: Option<Fingerprint>,
+) -> Result<quinn::Endpoint, ClientError> {
+    bind(local, client_config(pin)?.0)
+}
+
+fn bind(local: SocketAddr, config: quinn::ClientConfig) -> Result<quinn::Endpoint, ClientError> {
+    let mut endpoint = quinn::Endpoint::client(local).map_err(ClientError::Socket)?;
+    endpoint.set_default_client_config(config);
+    Ok(endpoint)
 }
 
 /// Resolves `HOST:PORT` (also `[v6]:PORT`) to an address and the host part

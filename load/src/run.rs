@@ -186,6 +186,9 @@ fn start_server(config: &RunConfig, cert_dir: &Path, stop: &Stop) -> anyhow::Res
         .args(["--rooms", &config.rooms().to_string()])
         .args(["--max-players", &config.max_players.to_string()])
         .args(["--max-connections", &(config.bots + 16).to_string()])
+        // Every bot connects from this machine's one address.
+        .args(["--max-per-address", &(config.bots + 16).to_string()])
+        .args(["--max-pending-per-address", "64", "--max-pending", "64"])
         .env("RUST_LOG", "info")
         .stdin(Stdio::null())
         .stdout(Stdio::piped())

@@ -14,6 +14,8 @@ use clap::Parser;
 use ledge_shared::protocol::{MAX_LEVEL_BUNDLE, MAX_ROOMS};
 use serde::Deserialize;
 
+use crate::admission::AdmissionConfig;
+
 /// Default UDP address the server listens on.
 pub const DEFAULT_BIND: &str = "0.0.0.0:4433";
 /// Default directory of the certificate and key.
@@ -136,6 +138,8 @@ pub struct ServerConfig {
     pub reconnect_grace: Duration,
     /// Per-client rate limits.
     pub limits: Limits,
+    /// Limits on new connections: per address, before the hello.
+    pub admission: AdmissionConfig,
     /// Record each room's match (inputs, joins and leaves, state hash per
     /// tick) for its first this many ticks; `None` (the default): off. Set
     /// programmatically (tests, tools); read with
@@ -163,6 +167,7 @@ impl Default for ServerConfig {
             reconnect_grace: DEFAULT_RECONNECT_GRACE,
             idle_kick: DEFAULT_IDLE_KICK,
             limits: Limits::default(),
+            admission: AdmissionConfig::default(),
             record_ticks: None,
         }
     }
@@ -237,6 +242,18 @@ impl ServerConfig {
         if l.datagram_burst < 1.0 || l.control_burst < 1.0 {
             return bad("datagram_burst and control_burst must be at least 1");
         }
+        let a = &self.admission;
+        if a.per_address == 0 || a.pending_per_address == 0 || a.pending == 0 {
+            return bad(
+                "admission: per_address, pending_per_address and pending must be at least 1",
+            );
+        }
+        if a.pending_per_address > a.per_address {
+            return bad("admission: pending_per_address must be at most per_address");
+        }
+        if !(Duration::from_millis(100)..=Duration::from_secs(60)).contains(&a.hello_timeout) {
+            return bad("admission: hello_timeout must be 0.1..=60 s");
+        }
         Ok(())
     }
 }
@@ -303,9 +320,26 @@ pub struct Cli {
     /// `--room NAME` [default: 16, or --rooms if more].
     #[arg(long, value_name = "N")]
     pub max_rooms: Option<u32>,
-    /// Most simultaneous connections [default: 256].
+    /// Most joined connections (players, room listings) [default: 256].
     #[arg(long, value_name = "N")]
     pub max_connections: Option<usize>,
+    /// Most connections from one address (an IPv4 address or an IPv6 /64);
+    /// raise it for many players behind one NAT, or bots on one machine
+    /// [default: 4].
+    #[arg(long, value_name = "N")]
+    pub max_per_address: Option<usize>,
+    /// Most connections from one address still in their handshake (before
+    /// the hello) [default: 2, or --max-per-address if less].
+    #[arg(long, value_name = "N")]
+    pub max_pending_per_address: Option<usize>,
+    /// Most connections in their handshake in all; when full, the oldest of
+    /// the address holding the most is closed for a newcomer [default: 32].
+    #[arg(long, value_name = "N")]
+    pub max_pending: Option<usize>,
+    /// Seconds a new connection has to finish its QUIC handshake and send
+    /// its hello [default: 2].
+    #[arg(long, value_name = "SECONDS")]
+    pub hello_timeout: Option<f64>,
     /// Seconds a player whose connection was lost is kept for its client to
     /// come back (same player, position, coins) [default: 30].
     #[arg(long, value_name = "SECONDS")]
@@ -348,6 +382,25 @@ struct FileConfig {
     /// Seconds.
     idle_kick: Option<f64>,
     limits: Option<Limits>,
+    admission: Option<FileAdmission>,
+}
+
+/// The file's `[admission]`: every key optional.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileAdmission {
+    per_address: Option<usize>,
+    pending_per_address: Option<usize>,
+    pending: Option<usize>,
+    /// Seconds.
+    hello_timeout: Option<f64>,
+    retry_above: Option<usize>,
+}
+
+/// Seconds from the file or a flag, as a duration; `key` names it.
+fn seconds(secs: f64, key: &str) -> Result<Duration, ConfigError> {
+    Duration::try_from_secs_f64(secs)
+        .map_err(|_| ConfigError::Invalid(format!("{key} must be seconds (not {secs})")))
 }
 
 impl Cli {
@@ -392,17 +445,30 @@ impl Cli {
         set(&mut c.metrics_bind, file.metrics_bind.map(Some));
         set(&mut c.max_catch_up, file.max_catch_up);
         if let Some(secs) = file.idle_timeout {
-            c.idle_timeout = Duration::try_from_secs_f64(secs)
-                .map_err(|_| ConfigError::Invalid("idle_timeout must be seconds".into()))?;
+            c.idle_timeout = seconds(secs, "idle_timeout")?;
         }
         set(&mut c.limits, file.limits);
+        let admission = file.admission.unwrap_or_default();
+        let a = &mut c.admission;
+        set(&mut a.per_address, admission.per_address);
+        set(&mut a.pending_per_address, admission.pending_per_address);
+        set(&mut a.pending, admission.pending);
+        set(&mut a.retry_above, admission.retry_above);
+        if let Some(secs) = self.hello_timeout.or(admission.hello_timeout) {
+            a.hello_timeout = seconds(secs, "hello_timeout")?;
+        }
+        set(&mut a.per_address, self.max_per_address);
+        set(&mut a.pending_per_address, self.max_pending_per_address);
+        set(&mut a.pending, self.max_pending);
+        // Unless set, the pending cap follows a smaller connection cap.
+        if admission.pending_per_address.is_none() && self.max_pending_per_address.is_none() {
+            a.pending_per_address = a.pending_per_address.min(a.per_address);
+        }
         if let Some(secs) = file.idle_kick {
-            c.idle_kick = Duration::try_from_secs_f64(secs)
-                .map_err(|_| ConfigError::Invalid("idle_kick must be seconds".into()))?;
+            c.idle_kick = seconds(secs, "idle_kick")?;
         }
         if let Some(secs) = self.reconnect_grace.or(file.reconnect_grace) {
-            c.reconnect_grace = Duration::try_from_secs_f64(secs)
-                .map_err(|_| ConfigError::Invalid("reconnect_grace must be seconds".into()))?;
+            c.reconnect_grace = seconds(secs, "reconnect_grace")?;
         }
         // Flags win.
         set(&mut c.bind, self.bind);
@@ -595,6 +661,68 @@ datagrams_per_second = 500.0
             let err = cli(args).resolve().unwrap_err();
             assert!(matches!(err, ConfigError::Invalid(_)), "{args:?}: {err}");
         }
+    }
+
+    #[test]
+    fn admission_limits_come_from_the_file_and_flags() {
+        let c = cli(&[]).resolve().unwrap();
+        assert_eq!(c.admission, AdmissionConfig::default());
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("server.toml");
+        std::fs::write(
+            &path,
+            "[admission]\nper_address = 8\npending = 16\nhello_timeout = 1.5\nretry_above = 0\n",
+        )
+        .unwrap();
+        let config = path.to_str().unwrap();
+        let a = cli(&["--config", config]).resolve().unwrap().admission;
+        assert_eq!((a.per_address, a.pending_per_address), (8, 2));
+        assert_eq!((a.pending, a.retry_above), (16, 0));
+        assert_eq!(a.hello_timeout, Duration::from_millis(1500));
+        let a = cli(&[
+            "--config",
+            config,
+            "--max-per-address",
+            "1",
+            "--hello-timeout",
+            "3",
+        ])
+        .resolve()
+        .unwrap()
+        .admission;
+        assert_eq!(
+            (a.per_address, a.pending_per_address),
+            (1, 1),
+            "pending follows"
+        );
+        assert_eq!(a.hello_timeout, Duration::from_secs(3));
+        let a = cli(&[
+            "--max-pending-per-address",
+            "5",
+            "--max-per-address",
+            "9",
+            "--max-pending",
+            "7",
+        ])
+        .resolve()
+        .unwrap()
+        .admission;
+        assert_eq!((a.per_address, a.pending_per_address, a.pending), (9, 5, 7));
+        for args in [
+            &["--max-per-address", "0"][..],
+            &["--max-pending", "0"],
+            &["--max-per-address", "2", "--max-pending-per-address", "3"],
+            &["--hello-timeout", "0.01"],
+            &["--hello-timeout", "61"],
+        ] {
+            let err = cli(args).resolve().unwrap_err();
+            assert!(matches!(err, ConfigError::Invalid(_)), "{args:?}: {err}");
+        }
+        std::fs::write(&path, "[admission]\nper_adress = 8\n").unwrap();
+        let err = cli(&["--config", path.to_str().unwrap()])
+            .resolve()
+            .unwrap_err();
+        assert!(matches!(err, ConfigError::Parse { .. }), "{err}");
     }
 
     #[test]

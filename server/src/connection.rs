@@ -24,7 +24,7 @@
 //! once with [`CloseCode::ProtocolViolation`]. Nothing here panics on
 //! input or buffers more than the bounded queues and windows.
 
-use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -37,15 +37,13 @@ use quinn::{Connection, RecvStream, SendStream};
 use tokio::sync::{mpsc, watch};
 use tracing::{debug, info, warn, Instrument};
 
+use crate::admission::{Admission, Refusal, Ticket};
 use crate::config::Limits;
 use crate::metrics::{Channel, ClientBytes, DropReason, KickLabel, KickReason, Metrics};
 use crate::ratelimit::TokenBucket;
 use crate::room::{self, ClientLink, JoinError, Outbound, PlayerInbox, RoomHandle};
 use crate::rooms::Rooms;
 use crate::sessions::Sessions;
-
-/// How long a client has from connecting to finishing its `Hello`.
-pub const HELLO_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// Largest control frame a client may send: every valid client message is
 /// far smaller (a chat line is at most 256 bytes).
@@ -91,39 +89,56 @@ pub struct Shared {
     pub limits: Limits,
     /// The next player id.
     pub next_player: AtomicU32,
-    /// Open connections (for the connection cap).
-    pub open: AtomicUsize,
+    /// Who may connect, and the pending pool ([`crate::admission`]).
+    pub admission: Arc<Admission>,
     /// Turns true when the server shuts down.
     pub shutdown: watch::Receiver<bool>,
 }
 
-/// Counts an open connection for as long as it lives.
+/// Counts an open connection (the `connections` gauge) while it lives.
 struct OpenGuard<'a>(&'a Shared);
 
 impl Drop for OpenGuard<'_> {
     fn drop(&mut self) {
-        self.0.open.fetch_sub(1, Ordering::Relaxed);
         self.0.metrics.connections.dec();
     }
 }
 
-/// Serves one incoming connection to its end (the caller already counted it
-/// in [`Shared::open`]). Errors are logged, not returned.
-pub async fn serve(incoming: quinn::Incoming, shared: Arc<Shared>) {
+/// Serves one admitted connection to its end; `ticket` counts it for
+/// admission. It has [`AdmissionConfig::hello_timeout`] from now to finish
+/// the QUIC handshake and send its hello, and is closed at once if evicted
+/// from the pending pool meanwhile. Errors are logged, not returned.
+///
+/// [`AdmissionConfig::hello_timeout`]: crate::admission::AdmissionConfig::hello_timeout
+pub async fn serve(incoming: quinn::Incoming, mut ticket: Ticket, shared: Arc<Shared>) {
     let _open = OpenGuard(&shared);
     shared.metrics.connections.inc();
     let remote = incoming.remote_address();
     let span = tracing::info_span!("conn", %remote);
+    let deadline = tokio::time::Instant::now() + shared.admission.config().hello_timeout;
     async {
-        let connection = match incoming.await {
-            Ok(connection) => connection,
-            Err(e) => {
-                debug!("handshake failed: {e}");
+        let handshake = tokio::time::timeout_at(deadline, incoming);
+        let connection = tokio::select! {
+            connection = handshake => match connection {
+                Ok(Ok(connection)) => connection,
+                Ok(Err(e)) => {
+                    debug!("handshake failed: {e}");
+                    return;
+                }
+                Err(_) => {
+                    shared.metrics.refused(Refusal::HelloTimeout);
+                    debug!("handshake not finished in time");
+                    return;
+                }
+            },
+            () = ticket.evicted() => {
+                debug!("evicted from the pending pool during the handshake");
                 return;
             }
         };
+        ticket.handshaken();
         debug!("connected");
-        match session(&connection, &shared).await {
+        match session(&connection, &shared, &mut ticket, deadline).await {
             Ok(()) => close(&connection, CloseCode::Normal, "bye"),
             Err(End::Closed(e)) => debug!("connection lost: {e}"),
             Err(End::Close(code, reason)) => {
@@ -138,6 +153,16 @@ pub async fn serve(incoming: quinn::Incoming, shared: Arc<Shared>) {
     }
     .instrument(span)
     .await
+}
+
+/// The end of a connection evicted from the pending pool.
+fn evicted() -> End {
+    End::Close(
+        CloseCode::Timeout,
+        "too many connections are waiting to join: the oldest of the address with the most \
+         was closed; connect again"
+            .into(),
+    )
 }
 
 /// How a session ended abnormally.
@@ -176,16 +201,28 @@ impl Drop for Membership<'_> {
     }
 }
 
-async fn session(connection: &Connection, shared: &Shared) -> Result<(), End> {
+async fn session(
+    connection: &Connection,
+    shared: &Shared,
+    ticket: &mut Ticket,
+    deadline: tokio::time::Instant,
+) -> Result<(), End> {
     let mut shutdown = shared.shutdown.clone();
     let (mut send, mut recv, hello, mut decoder) = tokio::select! {
-        handshake = tokio::time::timeout(HELLO_TIMEOUT, handshake(connection, shared)) => {
-            handshake.map_err(|_| End::Close(CloseCode::Timeout, "no hello in time".into()))??
+        handshake = tokio::time::timeout_at(deadline, handshake(connection, shared)) => {
+            handshake.map_err(|_| {
+                shared.metrics.refused(Refusal::HelloTimeout);
+                End::Close(CloseCode::Timeout, "no hello in time".into())
+            })??
         }
+        () = ticket.evicted() => return Err(evicted()),
         () = crate::server::stopped(&mut shutdown) => {
             return Err(End::Close(CloseCode::ServerShutdown, "server shutting down".into()))
         }
     };
+    if !ticket.join() {
+        return Err(evicted());
+    }
 
     let first = match hello {
         Ok(first) => first,
@@ -613,10 +650,9 @@ impl Client<'_> {
                 ClientControl::Chat { text } => self.room.chat(self.player_id, text),
                 ClientControl::Ping { nonce } => {
                     let mut frame = Vec::new();
-                    if write_frame(&ServerControl::Pong { nonce }, &mut frame).is_ok()
-                        && self.control.try_send(Outbound::Frame(frame)).is_err()
-                    {
-                        self.shared.metrics.count_drop(DropReason::ControlQueueFull);
+                    if write_frame(&ServerControl::Pong { nonce }, &mut frame).is_ok() {
+                        let sent = self.control.try_send(Outbound::Frame(frame));
+                        self.shared.metrics.count_queue_error(sent);
                     }
                 }
                 ClientControl::Leave => return Err(Ending::Left),

@@ -20,12 +20,15 @@
 //!   idle;
 //! * [`sessions`]: players kept after a lost connection, for a resume;
 //! * [`record`]: optional match recording (inputs, joins, hashes per tick);
+//! * [`admission`]: which new connections are taken on (per address, the
+//!   pending pool and its eviction, Retry under load);
 //! * [`connection`]: one client's handshake, control stream and datagrams;
 //! * [`ratelimit`]: token buckets;
 //! * [`metrics`]: Prometheus metrics and their HTTP endpoint;
 //! * [`server`]: the endpoint, accept loop and graceful shutdown.
 #![deny(missing_docs)]
 
+pub mod admission;
 pub mod cert;
 pub mod clock;
 pub mod config;

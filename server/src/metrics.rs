@@ -18,8 +18,10 @@ use prometheus_client::metrics::histogram::{exponential_buckets, Histogram};
 pub use prometheus_client::registry::Registry;
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::net::TcpListener;
-use tokio::sync::watch;
+use tokio::sync::{mpsc, watch};
 use tracing::{debug, warn};
+
+pub use crate::admission::Refusal;
 
 /// Label: a room.
 #[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
@@ -64,6 +66,9 @@ pub enum DropReason {
     InputTooEarly,
     /// A message for a client whose control queue was full.
     ControlQueueFull,
+    /// A message for a client whose control stream writer is gone: it
+    /// stopped reading the stream (or its session is ending).
+    ClientNotReading,
     /// A snapshot not sent because a stream snapshot is still unacknowledged.
     SnapshotDeferred,
     /// A snapshot datagram quinn refused to send.
@@ -75,6 +80,13 @@ pub enum DropReason {
 pub struct DropLabel {
     /// The reason.
     pub reason: DropReason,
+}
+
+/// Label: why a connection was refused ([`Refusal`]).
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct RefusalLabel {
+    /// The reason.
+    pub reason: Refusal,
 }
 
 /// Full or delta snapshot.
@@ -146,8 +158,13 @@ pub struct Metrics {
     pub level_download_bytes: Counter,
     /// Open connections (including handshakes).
     pub connections: Gauge,
-    /// Connections refused because of `max_connections`.
-    pub connections_refused: Counter,
+    /// Connections refused, or closed before their hello, by reason
+    /// ([`crate::admission`]).
+    pub connections_refused: Family<RefusalLabel, Counter>,
+    /// New connections sent a QUIC Retry (address validation under load).
+    pub retries: Counter,
+    /// Connections not yet past their hello.
+    pub pending_connections: Gauge,
     /// Bytes received per client.
     pub client_bytes_in: Family<ClientLabel, Counter>,
     /// Bytes sent per client.
@@ -218,7 +235,9 @@ impl Metrics {
             level_downloads_completed: Counter::default(),
             level_download_bytes: Counter::default(),
             connections: Gauge::default(),
-            connections_refused: Counter::default(),
+            connections_refused: Family::default(),
+            retries: Counter::default(),
+            pending_connections: Gauge::default(),
             client_bytes_in: Family::default(),
             client_bytes_out: Family::default(),
             bytes_in: Family::default(),
@@ -276,8 +295,18 @@ impl Metrics {
         );
         r.register(
             "connections_refused",
-            "Connections refused at the connection cap",
+            "Connections refused, or closed before their hello, by reason",
             m.connections_refused.clone(),
+        );
+        r.register(
+            "retries",
+            "New connections sent a QUIC Retry to validate their address",
+            m.retries.clone(),
+        );
+        r.register(
+            "pending_connections",
+            "Connections not yet past their hello",
+            m.pending_connections.clone(),
         );
         r.register(
             "client_bytes_in",
@@ -336,6 +365,28 @@ impl Metrics {
     /// Counts one dropped message.
     pub fn count_drop(&self, reason: DropReason) {
         self.dropped.get_or_create(&DropLabel { reason }).inc();
+    }
+
+    /// Counts a message that could not be queued for a client's control
+    /// stream: a full queue, or a client whose writer is gone because it
+    /// stopped reading the stream (or is leaving).
+    pub fn count_queue_error<T>(&self, sent: Result<(), mpsc::error::TrySendError<T>>) {
+        match sent {
+            Ok(()) => {}
+            Err(mpsc::error::TrySendError::Full(_)) => {
+                self.count_drop(DropReason::ControlQueueFull)
+            }
+            Err(mpsc::error::TrySendError::Closed(_)) => {
+                self.count_drop(DropReason::ClientNotReading)
+            }
+        }
+    }
+
+    /// Counts a connection refused, or closed before its hello.
+    pub fn refused(&self, reason: Refusal) {
+        self.connections_refused
+            .get_or_create(&RefusalLabel { reason })
+            .inc();
     }
 
     /// Counts `n` dropped messages.

@@ -823,10 +823,7 @@ impl Room {
                                 })
                                 .observe(len as f64);
                         }
-                        Err(mpsc::error::TrySendError::Full(_)) => {
-                            self.metrics.count_drop(DropReason::ControlQueueFull);
-                        }
-                        Err(mpsc::error::TrySendError::Closed(_)) => {}
+                        Err(e) => self.metrics.count_queue_error::<Outbound>(Err(e)),
                     }
                 }
             }
@@ -873,11 +870,8 @@ impl Room {
     /// Queues a frame for a member's control stream; drops it (counted)
     /// when that client's queue is full.
     fn send_control(&self, m: &Member, frame: Vec<u8>) {
-        if let Err(mpsc::error::TrySendError::Full(_)) =
-            m.link.control.try_send(Outbound::Frame(frame))
-        {
-            self.metrics.count_drop(DropReason::ControlQueueFull);
-        }
+        let sent = m.link.control.try_send(Outbound::Frame(frame));
+        self.metrics.count_queue_error(sent);
     }
 
     fn publish(&self) {

@@ -2,7 +2,7 @@
 //! graceful shutdown.
 
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
+use std::sync::atomic::AtomicU32;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -13,8 +13,9 @@ use ledge_shared::protocol::{CloseCode, LevelOffer, DEFAULT_INPUT_REDUNDANCY};
 use prometheus_client::registry::Registry;
 use tokio::sync::watch;
 use tokio::task::JoinSet;
-use tracing::{error, info, warn};
+use tracing::{debug, error, info, warn};
 
+use crate::admission::{Admission, Refusal, Verdict};
 use crate::cert::{CertError, Identity};
 use crate::config::{ConfigError, ServerConfig};
 use crate::connection::{self, Shared, SHUTDOWN_LINGER};
@@ -34,6 +35,10 @@ const SHUTDOWN_GRACE: Duration = Duration::from_secs(3);
 /// How often lost players past the reconnect grace time and idle rooms
 /// opened by name are looked for (and removed, closed).
 const SWEEP: Duration = Duration::from_secs(1);
+
+/// Shortest time between two warnings that connections are being refused
+/// (each refusal is logged at debug level).
+const REFUSAL_WARNING_EVERY: Duration = Duration::from_secs(10);
 
 /// Why the server could not start.
 #[derive(Debug, thiserror::Error)]
@@ -101,6 +106,82 @@ fn bind_hint(option: &str, addr: SocketAddr, error: &std::io::Error) -> String {
 /// the sender is gone).
 pub(crate) async fn stopped(flag: &mut watch::Receiver<bool>) {
     let _ = flag.wait_for(|&stop| stop).await;
+}
+
+/// Decides on a new connection ([`Admission::consider`]) and acts:
+/// a Retry, a refusal (counted), or a task serving it.
+fn admit(
+    incoming: quinn::Incoming,
+    shared: &Arc<Shared>,
+    connections: &mut JoinSet<()>,
+    refusals: &mut RefusalLog,
+) {
+    let remote = incoming.remote_address();
+    let verdict = shared.admission.consider(
+        remote.ip(),
+        incoming.remote_address_validated(),
+        incoming.may_retry(),
+    );
+    let metrics = &shared.metrics;
+    match verdict {
+        Verdict::Retry => {
+            metrics.retries.inc();
+            if let Err(e) = incoming.retry() {
+                debug!(%remote, "cannot send a Retry: {e}");
+                e.into_incoming().ignore();
+            }
+        }
+        Verdict::Refuse(reason) => {
+            metrics.refused(reason);
+            refusals.count(reason);
+            debug!(%remote, ?reason, "connection refused");
+            incoming.refuse();
+        }
+        Verdict::Admit { ticket, evicted } => {
+            if evicted {
+                metrics.refused(Refusal::Evicted);
+                refusals.count(Refusal::Evicted);
+            }
+            metrics
+                .pending_connections
+                .set(shared.admission.pending() as i64);
+            connections.spawn(connection::serve(incoming, ticket, shared.clone()));
+        }
+    }
+}
+
+/// Refusals since the last warning, so a flood of refused connections
+/// gives one log line every [`REFUSAL_WARNING_EVERY`], not one each.
+#[derive(Debug, Default)]
+struct RefusalLog {
+    since: u64,
+    reason: Option<Refusal>,
+    warned: Option<Instant>,
+}
+
+impl RefusalLog {
+    fn count(&mut self, reason: Refusal) {
+        self.since += 1;
+        self.reason = Some(reason);
+    }
+
+    /// Warns of the refusals counted, unless it did so recently.
+    fn warn(&mut self, now: Instant) {
+        let recently = self
+            .warned
+            .is_some_and(|at| now.duration_since(at) < REFUSAL_WARNING_EVERY);
+        if self.since == 0 || recently {
+            return;
+        }
+        warn!(
+            refused = self.since,
+            last_reason = ?self.reason,
+            "new connections refused (per-address caps, pending pool, server full); \
+             see ledge_connections_refused_total"
+        );
+        self.since = 0;
+        self.warned = Some(now);
+    }
 }
 
 /// A bound, not yet running server.
@@ -310,7 +391,7 @@ impl Server {
             metrics: metrics.clone(),
             limits: config.limits,
             next_player: AtomicU32::new(1),
-            open: AtomicUsize::new(0),
+            admission: Admission::new(config.admission, config.max_connections),
             shutdown: stop.clone(),
         });
 
@@ -325,6 +406,7 @@ impl Server {
         );
         let mut connections = JoinSet::new();
         let mut sweep = tokio::time::interval(SWEEP);
+        let mut refusals = RefusalLog::default();
         loop {
             tokio::select! {
                 // `shutdown` lives until the end of `run`, so this never errs.
@@ -337,18 +419,11 @@ impl Server {
                         lost.room.leave(lost.player_id, lost.generation);
                     }
                     shared.rooms.close_idle(now);
+                    metrics.pending_connections.set(shared.admission.pending() as i64);
+                    refusals.warn(now);
                 }
                 incoming = endpoint.accept() => match incoming {
-                    Some(incoming) => {
-                        if shared.open.load(Ordering::Relaxed) >= config.max_connections {
-                            metrics.connections_refused.inc();
-                            warn!(remote = %incoming.remote_address(), "connection cap reached; refusing");
-                            incoming.refuse();
-                            continue;
-                        }
-                        shared.open.fetch_add(1, Ordering::Relaxed);
-                        connections.spawn(connection::serve(incoming, shared.clone()));
-                    }
+                    Some(incoming) => admit(incoming, &shared, &mut connections, &mut refusals),
                     None => break,
                 },
                 Some(done) = connections.join_next(), if !connections.is_empty() => {

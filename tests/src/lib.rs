@@ -17,15 +17,76 @@ use std::time::{Duration, Instant};
 
 use ledge_client::netstats::TransportSample;
 use ledge_client::predict::Reconciled;
+use ledge_client::transport::{dial, Dialed};
 use ledge_client::{connect, ClientGame, Session, SessionEvent, SnapshotUpdate};
 use ledge_netsim::{LinkConfig, Loss, Relay, RelayConfig};
+use ledge_server::admission::AdmissionConfig;
 use ledge_server::metrics::Registry;
 use ledge_server::record::Recorder;
 use ledge_server::{Fingerprint, Server, ServerConfig, ServerError, ShutdownHandle};
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::StateSnapshot;
+use ledge_shared::protocol::{FrameDecoder, ServerControl, StateSnapshot, PROTOCOL_VERSION};
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::task::JoinHandle;
+
+/// A connection that sent a hand-made hello: its control stream and the
+/// server's first answer ([`raw_hello`]).
+#[derive(Debug)]
+pub struct RawHello {
+    /// The client's endpoint (kept open with the connection).
+    pub endpoint: quinn::Endpoint,
+    /// The connection.
+    pub connection: quinn::Connection,
+    /// The control stream's sending half.
+    pub send: quinn::SendStream,
+    /// The control stream's receiving half.
+    pub recv: quinn::RecvStream,
+    /// The server's first answer (`Welcome`, `Reject`).
+    pub answer: ServerControl,
+}
+
+/// Connects and sends a hello encoded by hand (variant 0, this build's
+/// version, then `name`'s length and bytes), so names the client library
+/// refuses to send reach the server; returns the server's first answer
+/// with the open stream.
+pub async fn raw_hello(server: &TestServer, name: &[u8]) -> RawHello {
+    let Dialed {
+        endpoint,
+        connection,
+    } = dial(server.addr, "localhost", server.fingerprint)
+        .await
+        .expect("dials the test server");
+    let (mut send, mut recv) = connection.open_bi().await.expect("control stream");
+    let mut payload = vec![0u8, PROTOCOL_VERSION as u8, name.len() as u8];
+    payload.extend_from_slice(name);
+    let mut frame = (payload.len() as u32).to_le_bytes().to_vec();
+    frame.extend_from_slice(&payload);
+    send.write_all(&frame).await.expect("hello sent");
+    let mut decoder = FrameDecoder::default();
+    let mut buf = [0u8; 1024];
+    let answer = tokio::time::timeout(WAIT, async {
+        loop {
+            if let Some(m) = decoder.pop_message::<ServerControl>() {
+                return m.expect("a valid answer");
+            }
+            let n = recv
+                .read(&mut buf)
+                .await
+                .expect("the stream reads")
+                .expect("an answer");
+            decoder.push(&buf[..n]).expect("a valid frame");
+        }
+    })
+    .await
+    .expect("an answer in time");
+    RawHello {
+        endpoint,
+        connection,
+        send,
+        recv,
+        answer,
+    }
+}
 
 /// How long [`TestServer::stop`] may take before it counts as hung.
 pub const STOP_TIMEOUT: Duration = Duration::from_secs(5);
@@ -66,6 +127,14 @@ impl TestServer {
         let mut config = ServerConfig {
             bind: SocketAddr::from(([127, 0, 0, 1], 0)),
             cert_dir: cert_dir.path().to_owned(),
+            // Tests stand for many machines on one loopback address; the
+            // admission tests (tests/admission.rs) restore the defaults.
+            admission: AdmissionConfig {
+                per_address: 4096,
+                pending_per_address: 256,
+                pending: 256,
+                ..AdmissionConfig::default()
+            },
             ..ServerConfig::default()
         };
         adjust(&mut config);

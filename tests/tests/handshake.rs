@@ -4,11 +4,11 @@ use std::time::{Duration, Instant};
 
 use ledge_client::transport::dial;
 use ledge_client::{connect, connect_with, handshake, ClientError, Fingerprint, JoinOptions};
+use ledge_shared::protocol::ServerControl;
 use ledge_shared::protocol::{
     ClientControl, CloseCode, NoticeKind, ProtocolError, RejectReason, PROTOCOL_VERSION,
 };
-use ledge_shared::protocol::{FrameDecoder, ServerControl};
-use ledge_tests::{next_snapshot, TestServer, WAIT};
+use ledge_tests::{next_snapshot, raw_hello, TestServer, WAIT};
 
 #[tokio::test]
 async fn welcome_reports_a_running_tick_loop() {
@@ -122,29 +122,8 @@ async fn an_invalid_name_is_refused_by_the_client_and_rejected_by_the_server() {
         "{err}"
     );
     // ...and a hand-made hello with a bad name gets a polite reject.
-    let dialed = dial(server.addr, "localhost", server.fingerprint)
-        .await
-        .unwrap();
-    let (mut send, mut recv) = dialed.connection.open_bi().await.unwrap();
     // Hello: variant 0, version, then a name with a newline in it.
-    let mut payload = vec![0u8, PROTOCOL_VERSION as u8, 3];
-    payload.extend_from_slice(b"a\nb");
-    let mut frame = (payload.len() as u32).to_le_bytes().to_vec();
-    frame.extend_from_slice(&payload);
-    send.write_all(&frame).await.unwrap();
-    let mut decoder = FrameDecoder::default();
-    let mut buf = [0u8; 1024];
-    let answer = tokio::time::timeout(WAIT, async {
-        loop {
-            if let Some(m) = decoder.pop_message::<ServerControl>() {
-                return m.unwrap();
-            }
-            let n = recv.read(&mut buf).await.unwrap().expect("an answer");
-            decoder.push(&buf[..n]).unwrap();
-        }
-    })
-    .await
-    .unwrap();
+    let answer = raw_hello(&server, b"a\nb").await.answer;
     assert_eq!(
         answer,
         ServerControl::Reject {

@@ -2,37 +2,14 @@
 //! look-alike letters, and no invisible or formatting characters; a
 //! refused name gets a reason.
 
-use ledge_client::transport::dial;
 use ledge_client::ClientError;
-use ledge_shared::protocol::{FrameDecoder, RejectReason, ServerControl, PROTOCOL_VERSION};
+use ledge_shared::protocol::{RejectReason, ServerControl};
 use ledge_tests::{TestServer, WAIT};
 
-/// Sends a hand-made hello with `name` (past the client's own checks)
-/// and returns the server's answer.
+/// The server's answer to a hand-made hello with `name` (past the
+/// client's own checks).
 async fn raw_hello(server: &TestServer, name: &str) -> ServerControl {
-    let dialed = dial(server.addr, "localhost", server.fingerprint)
-        .await
-        .unwrap();
-    let (mut send, mut recv) = dialed.connection.open_bi().await.unwrap();
-    // Hello: variant 0, the version, then the name's length and bytes.
-    let mut payload = vec![0u8, PROTOCOL_VERSION as u8, name.len() as u8];
-    payload.extend_from_slice(name.as_bytes());
-    let mut frame = (payload.len() as u32).to_le_bytes().to_vec();
-    frame.extend_from_slice(&payload);
-    send.write_all(&frame).await.unwrap();
-    let mut decoder = FrameDecoder::default();
-    let mut buf = [0u8; 1024];
-    tokio::time::timeout(WAIT, async {
-        loop {
-            if let Some(m) = decoder.pop_message::<ServerControl>() {
-                return m.unwrap();
-            }
-            let n = recv.read(&mut buf).await.unwrap().expect("an answer");
-            decoder.push(&buf[..n]).unwrap();
-        }
-    })
-    .await
-    .unwrap()
+    ledge_tests::raw_hello(server, name.as_bytes()).await.answer
 }
 
 #[tokio::test]

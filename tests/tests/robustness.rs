@@ -7,7 +7,9 @@ use std::time::{Duration, Instant};
 use ledge_client::transport::dial;
 use ledge_client::{connect, ClientError, Fingerprint, Session};
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::{CloseCode, InputPacket, Message, MAX_FRAME};
+use ledge_shared::protocol::{
+    write_frame, ClientControl, CloseCode, InputPacket, Message, ServerControl, MAX_FRAME,
+};
 use ledge_tests::{ids, metric, next_snapshot, snapshot_where, TestServer, UdpRelay, WAIT};
 
 /// The close code the server ended `connection` with.
@@ -287,8 +289,16 @@ async fn connections_over_the_cap_are_refused() {
         .await
         .expect_err("over the cap");
     assert!(matches!(err, ClientError::Connection(_)), "{err}");
+    assert!(
+        err.to_string()
+            .contains("the server refused the connection: it is full"),
+        "{err}"
+    );
     assert_eq!(
-        metric(&server.metrics(), "ledge_connections_refused_total"),
+        metric(
+            &server.metrics(),
+            r#"ledge_connections_refused_total{reason="ServerFull"}"#
+        ),
         1.0
     );
     assert_eq!(metric(&server.metrics(), "ledge_connections"), 2.0);
@@ -324,5 +334,44 @@ async fn a_forged_ack_is_counted_as_malformed_not_believed() {
     assert!(deltas >= 5, "only {deltas} delta snapshots after the lie");
     assert_eq!(metric(&server.metrics(), series), 1.0);
     forger.close().await;
+    server.stop().await.unwrap();
+}
+
+#[tokio::test]
+async fn pongs_to_a_client_that_stopped_reading_are_counted_as_that() {
+    let server = TestServer::start().await;
+    let mut bystander = server.join("bystander").await;
+    let mut raw = ledge_tests::raw_hello(&server, b"deaf").await;
+    assert!(
+        matches!(raw.answer, ServerControl::Welcome(_)),
+        "{:?}",
+        raw.answer
+    );
+    // Stop reading the control stream (STOP_SENDING), then keep pinging.
+    raw.recv.stop(0u32.into()).unwrap();
+    let ping = |nonce| {
+        let mut frame = Vec::new();
+        write_frame(&ClientControl::Ping { nonce }, &mut frame).unwrap();
+        frame
+    };
+    raw.send.write_all(&ping(0)).await.unwrap();
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    for nonce in 1..=10 {
+        raw.send.write_all(&ping(nonce)).await.unwrap();
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    let series = |reason: &str| format!("ledge_dropped_messages_total{{reason=\"{reason}\"}}");
+    let deadline = Instant::now() + WAIT;
+    while metric(&server.metrics(), &series("ClientNotReading")) < 10.0 {
+        assert!(
+            Instant::now() < deadline,
+            "pongs counted as not read:\n{}",
+            server.metrics()
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    assert_eq!(metric(&server.metrics(), &series("ControlQueueFull")), 0.0);
+    assert_unaffected(&mut bystander).await;
+    drop(raw);
     server.stop().await.unwrap();
 }
