@@ -170,12 +170,12 @@ impl RefusalLog {
         let recently = self
             .warned
             .is_some_and(|at| now.duration_since(at) < REFUSAL_WARNING_EVERY);
-        if self.since == 0 || recently {
+        let Some(reason) = self.reason.filter(|_| self.since > 0 && !recently) else {
             return;
-        }
+        };
         warn!(
             refused = self.since,
-            last_reason = ?self.reason,
+            last_reason = ?reason,
             "new connections refused (per-address caps, pending pool, server full); \
              see ledge_connections_refused_total"
         );
