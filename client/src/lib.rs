@@ -26,11 +26,14 @@
 //! * [`bundle`]: the server's level downloaded, cached by hash;
 //! * [`background`]: the network on its own thread, for GUI front ends;
 //! * [`timestep`]: fixed-step accumulator for render loops;
+//! * [`audio`]: sound effects, synthesized at start, played through ALSA
+//!   loaded at run time (off, never failing, without it);
 //! * [`error`]: what can fail ([`ClientError`]).
 //!
 //! `docs/CLIENT.md` describes the design and the figures.
 #![deny(missing_docs)]
 
+pub mod audio;
 pub mod background;
 pub mod bot;
 pub mod bundle;
