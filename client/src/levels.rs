@@ -2,7 +2,7 @@
 //!
 //! The server sends the level's id and content hash in `Welcome`; the
 //! client has the embedded default level and, optionally, level files. The
-//! hash is the server's: FNV-1a over the level's bincode encoding.
+//! hash is [`Level::content_hash`].
 
 use std::path::Path;
 
@@ -10,16 +10,6 @@ use ledge_shared::level::Level;
 use ledge_shared::protocol::Welcome;
 
 use crate::error::ClientError;
-
-/// FNV-1a over the bincode (standard configuration) encoding of `level`:
-/// the server's `level_hash`, sent in `Welcome`.
-pub fn level_hash(level: &Level) -> u64 {
-    let bytes = bincode::serde::encode_to_vec(level, bincode::config::standard())
-        .expect("a level always encodes");
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
-}
 
 /// The level `welcome` names: `file` if given (it must match), else the
 /// embedded default level. Refuses a level whose hash differs from the
@@ -44,7 +34,7 @@ pub fn level_for(welcome: &Welcome, file: Option<&Path>) -> Result<Level, Client
 
 /// Checks `level` (described as `source` in the error) is the server's.
 pub fn check_level(welcome: &Welcome, level: &Level, source: &str) -> Result<(), ClientError> {
-    let ours = level_hash(level);
+    let ours = level.content_hash();
     if ours == welcome.level_hash {
         Ok(())
     } else {

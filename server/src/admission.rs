@@ -31,8 +31,11 @@ use tokio::sync::Notify;
 
 /// Default most connections from one address.
 pub const DEFAULT_PER_ADDRESS: usize = 4;
-/// Default most pending (not yet joined) connections from one address.
-pub const DEFAULT_PENDING_PER_ADDRESS: usize = 2;
+/// Default most pending (not yet joined) connections from one address: as
+/// many as its connections, so players behind one router (or bots on one
+/// machine) may all start at once; the pending pool and its eviction keep
+/// one address from filling it.
+pub const DEFAULT_PENDING_PER_ADDRESS: usize = DEFAULT_PER_ADDRESS;
 /// Default size of the pending pool.
 pub const DEFAULT_PENDING: usize = 32;
 /// Default time from a connection's first packet to its hello.

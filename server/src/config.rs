@@ -329,7 +329,7 @@ pub struct Cli {
     #[arg(long, value_name = "N")]
     pub max_per_address: Option<usize>,
     /// Most connections from one address still in their handshake (before
-    /// the hello) [default: 2, or --max-per-address if less].
+    /// the hello) [default: as --max-per-address].
     #[arg(long, value_name = "N")]
     pub max_pending_per_address: Option<usize>,
     /// Most connections in their handshake in all; when full, the oldest of
@@ -460,9 +460,9 @@ impl Cli {
         set(&mut a.per_address, self.max_per_address);
         set(&mut a.pending_per_address, self.max_pending_per_address);
         set(&mut a.pending, self.max_pending);
-        // Unless set, the pending cap follows a smaller connection cap.
+        // Unless set, the pending cap follows the connection cap.
         if admission.pending_per_address.is_none() && self.max_pending_per_address.is_none() {
-            a.pending_per_address = a.pending_per_address.min(a.per_address);
+            a.pending_per_address = a.per_address;
         }
         if let Some(secs) = file.idle_kick {
             c.idle_kick = seconds(secs, "idle_kick")?;
@@ -676,7 +676,11 @@ datagrams_per_second = 500.0
         .unwrap();
         let config = path.to_str().unwrap();
         let a = cli(&["--config", config]).resolve().unwrap().admission;
-        assert_eq!((a.per_address, a.pending_per_address), (8, 2));
+        assert_eq!(
+            (a.per_address, a.pending_per_address),
+            (8, 8),
+            "pending follows"
+        );
         assert_eq!((a.pending, a.retry_above), (16, 0));
         assert_eq!(a.hello_timeout, Duration::from_millis(1500));
         let a = cli(&[

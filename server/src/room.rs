@@ -599,21 +599,7 @@ impl Room {
         let generation = m.generation;
         info!(room = %self.config.name, %player_id, generation, tick, "player resumed");
         // The room as it is now: who joined and left meanwhile.
-        let players = self
-            .members
-            .iter()
-            .take(MAX_ROSTER)
-            .map(|(&id, m)| RosterEntry {
-                id,
-                name: m.name.clone(),
-            })
-            .collect();
-        let mut frame = Vec::new();
-        if write_frame(&ServerControl::Roster { players }, &mut frame).is_ok() {
-            if let Some(m) = self.members.get(&player_id) {
-                self.send_control(m, frame);
-            }
-        }
+        self.send_roster(player_id);
         Some(Joined {
             welcome: self.welcome(player_id, tick),
             inbox,
@@ -834,19 +820,8 @@ impl Room {
     /// and so written right after its `Welcome`) and everyone else that it
     /// joined.
     fn announce_join(&self, id: PlayerId) {
-        let entry = |(&id, m): (&PlayerId, &Member)| RosterEntry {
-            id,
-            name: m.name.clone(),
-        };
-        let players = self.members.iter().take(MAX_ROSTER).map(entry).collect();
-        let mut frame = Vec::new();
-        if let (Some(m), Ok(())) = (
-            self.members.get(&id),
-            write_frame(&ServerControl::Roster { players }, &mut frame),
-        ) {
-            self.send_control(m, frame);
-        }
-        let Some(joined) = self.members.get_key_value(&id).map(entry) else {
+        self.send_roster(id);
+        let Some(joined) = self.members.get_key_value(&id).map(roster_entry) else {
             return;
         };
         let mut frame = Vec::new();
@@ -854,6 +829,23 @@ impl Room {
             for (_, m) in self.members.iter().filter(|(&other, _)| other != id) {
                 self.send_control(m, frame.clone());
             }
+        }
+    }
+
+    /// Queues a `Roster` of the room as it is now for member `id`.
+    fn send_roster(&self, id: PlayerId) {
+        let players = self
+            .members
+            .iter()
+            .take(MAX_ROSTER)
+            .map(roster_entry)
+            .collect();
+        let mut frame = Vec::new();
+        if let (Some(m), Ok(())) = (
+            self.members.get(&id),
+            write_frame(&ServerControl::Roster { players }, &mut frame),
+        ) {
+            self.send_control(m, frame);
         }
     }
 
@@ -880,5 +872,13 @@ impl Room {
             state_hash: self.game.state_hash(),
             players: self.members.len(),
         });
+    }
+}
+
+/// A member as the roster lists it.
+fn roster_entry((&id, m): (&PlayerId, &Member)) -> RosterEntry {
+    RosterEntry {
+        id,
+        name: m.name.clone(),
     }
 }

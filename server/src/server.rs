@@ -264,7 +264,7 @@ impl Server {
         let (metrics, registry) = Metrics::new();
         let recorders = match config.record_ticks {
             Some(limit) => {
-                let (id, hash) = (levels::level_id(&level), levels::level_hash(&level));
+                let (id, hash) = (levels::level_id(&level), level.content_hash());
                 (1..=config.rooms)
                     .map(|i| Recorder::new(&format!("room-{i}"), &id, hash, limit))
                     .collect()
@@ -364,7 +364,7 @@ impl Server {
             input_redundancy: DEFAULT_INPUT_REDUNDANCY,
             history: DEFAULT_HISTORY,
             level_id: levels::level_id(&level),
-            level_hash: levels::level_hash(&level),
+            level_hash: level.content_hash(),
             level: level_offer,
             record: None,
             idle_kick: config.idle_kick,

@@ -34,8 +34,16 @@ fn play_until(
     }
 }
 
-#[test]
-fn a_silent_server_is_noticed_within_a_second() {
+/// Plays until `online` has joined and is in sync.
+fn joined(online: &mut OnlineGame) {
+    play_until(online, "joined", Duration::from_secs(10), |o, now| {
+        o.game().is_some_and(|g| g.synced()) && o.stalled(now).is_none()
+    });
+}
+
+/// A server, a relay in front of it, and a GUI front end joined through
+/// the relay (on a runtime of the test's own: the front end blocks).
+fn join_through_relay() -> (tokio::runtime::Runtime, TestServer, UdpRelay, OnlineGame) {
     let runtime = tokio::runtime::Runtime::new().unwrap();
     let server = runtime.block_on(TestServer::start());
     let relay = runtime.block_on(UdpRelay::start(server.addr));
@@ -45,9 +53,13 @@ fn a_silent_server_is_noticed_within_a_second() {
         "ada",
     );
     let mut online = OnlineGame::connect(request).unwrap();
-    play_until(&mut online, "joined", Duration::from_secs(10), |o, now| {
-        o.game().is_some_and(|g| g.synced()) && o.stalled(now).is_none()
-    });
+    joined(&mut online);
+    (runtime, server, relay, online)
+}
+
+#[test]
+fn a_silent_server_is_noticed_within_a_second() {
+    let (runtime, server, relay, mut online) = join_through_relay();
 
     relay.blackhole();
     let cut = Instant::now();
@@ -79,18 +91,7 @@ fn a_silent_server_is_noticed_within_a_second() {
 
 #[test]
 fn a_gui_client_reconnects_by_itself_and_keeps_its_player() {
-    let runtime = tokio::runtime::Runtime::new().unwrap();
-    let server = runtime.block_on(TestServer::start());
-    let relay = runtime.block_on(UdpRelay::start(server.addr));
-    let request = OnlineRequest::new(
-        &relay.addr.to_string(),
-        Trust::Pinned(server.fingerprint),
-        "ada",
-    );
-    let mut online = OnlineGame::connect(request).unwrap();
-    play_until(&mut online, "joined", Duration::from_secs(10), |o, now| {
-        o.game().is_some_and(|g| g.synced()) && o.stalled(now).is_none()
-    });
+    let (runtime, server, relay, mut online) = join_through_relay();
     let me = online.game().unwrap().me();
 
     // 20 s of total loss: both ends time out (10 s) and the client keeps
@@ -149,9 +150,7 @@ fn a_gui_client_rejoins_a_restarted_server_by_itself() {
     let ((addr, fingerprint, stop), task) = start(config("127.0.0.1:0".parse().unwrap()));
     let request = OnlineRequest::new(&addr.to_string(), Trust::Pinned(fingerprint), "ada");
     let mut online = OnlineGame::connect(request).unwrap();
-    play_until(&mut online, "joined", Duration::from_secs(10), |o, now| {
-        o.game().is_some_and(|g| g.synced()) && o.stalled(now).is_none()
-    });
+    joined(&mut online);
 
     // The host restarts the server (same port, same certificate).
     stop.shutdown();

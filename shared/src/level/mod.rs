@@ -70,6 +70,17 @@ pub struct LevelFeatures {
 }
 
 impl Level {
+    /// A stable 64-bit hash of the level's content (FNV-1a over its bincode
+    /// encoding): server and client compare it to be sure they play the
+    /// same level.
+    pub fn content_hash(&self) -> u64 {
+        let bytes = bincode::serde::encode_to_vec(self, bincode::config::standard())
+            .expect("a level always encodes");
+        bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+        })
+    }
+
     /// The box holding everything in the level (units, `(top-left,
     /// bottom-right)`): the tile grid and every entity's box, moving
     /// platforms over their whole path. `None` for a level with nothing in
