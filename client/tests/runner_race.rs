@@ -115,7 +115,7 @@ fn race(warmup: u64) -> (BTreeMap<PlayerId, u64>, Vec<Client>) {
             last.insert(p, b);
         }
         for e in server.step(&applied) {
-            if let GameEvent::Won(p) = e {
+            if let GameEvent::Finished { player: p, .. } = e {
                 won.entry(*p).or_insert(now);
             }
         }

@@ -17,6 +17,15 @@ impl Buttons {
     pub const DOWN: u8 = 1 << 3;
     /// Jump.
     pub const JUMP: u8 = 1 << 4;
+    /// Restart the run: a press (held now, not last tick) puts the player
+    /// back at its spawn with a fresh run (see `Game`'s "Runs" docs in
+    /// `game/mod.rs`). Holding it does nothing more.
+    pub const RESTART: u8 = 1 << 5;
+
+    /// The buttons that play: the first tick holding any of them starts a
+    /// player's run timer. [`Buttons::RESTART`] and the unused bits 6 and 7
+    /// are not among them.
+    pub const PLAY: u8 = Self::LEFT | Self::RIGHT | Self::UP | Self::DOWN | Self::JUMP;
 
     /// No button held.
     pub const NONE: Buttons = Buttons(0);
@@ -25,6 +34,12 @@ impl Buttons {
     #[inline]
     pub fn held(self, mask: u8) -> bool {
         self.0 & mask == mask
+    }
+
+    /// Whether any of the buttons that play ([`Buttons::PLAY`]) is held.
+    #[inline]
+    pub fn plays(self) -> bool {
+        self.0 & Self::PLAY != 0
     }
 
     /// Horizontal direction held: -1, 0 or 1 (both cancel out).

@@ -72,8 +72,12 @@ fn full_level() -> Level {
     level(&rows, entities)
 }
 
-/// Player `id`'s buttons at `tick`: the scripted inputs, shifted per player.
+/// Player `id`'s buttons at `tick`: the scripted inputs, shifted per player,
+/// and now and then a restart.
 fn input(id: u32, tick: u64) -> Buttons {
+    if (tick + id as u64 * 977) % 2500 == 0 {
+        return Buttons(Buttons::RESTART);
+    }
     let b = scripted_inputs(tick + id as u64 * 40 * 17);
     // Run right more often than left, so players get around the level.
     if (tick / 40 + id as u64) % 3 == 0 {
@@ -133,6 +137,22 @@ fn restore_of_a_snapshot_reproduces_the_hash_and_the_next_600_ticks() {
     assert_eq!(b.snapshot(), snap);
     assert_eq!(b.entity_states(), all);
     assert_eq!(b.tick(), 300);
+    // The players' views (runs included) are the same; only the world's
+    // per-tick scratch (touched sides) is not restored.
+    let views = |g: &Game| {
+        g.player_views()
+            .map(|mut v| {
+                v.sides = Default::default();
+                v
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(views(&b), views(&a));
+    assert!(
+        a.player_views().any(|v| v.run_started),
+        "the runs started: {:?}",
+        views(&a)
+    );
 
     // The same game, rolled back after running on.
     let mut c = a.clone();
@@ -152,6 +172,7 @@ fn restore_of_a_snapshot_reproduces_the_hash_and_the_next_600_ticks() {
         assert_eq!(ea, ec, "tick {t}");
         assert_eq!(a.state_hash(), b.state_hash(), "tick {t}");
         assert_eq!(a.state_hash(), c.state_hash(), "tick {t}");
+        assert_eq!(views(&a), views(&c), "tick {t}");
         events += ea.len();
     }
     assert!(events > 20, "the run did things: {events} events");
@@ -160,10 +181,10 @@ fn restore_of_a_snapshot_reproduces_the_hash_and_the_next_600_ticks() {
 /// A 10,000-tick run with four players joining, leaving and rejoining;
 /// returns the final hash, the event counts by kind, and the snapshot at
 /// tick 5,000.
-fn long_run(restore_at_5000: Option<&StateSnapshot>) -> (u64, [usize; 8], StateSnapshot) {
+fn long_run(restore_at_5000: Option<&StateSnapshot>) -> (u64, [usize; 9], StateSnapshot) {
     let lv = full_level();
     let mut g = Game::from_level(&lv).unwrap();
-    let mut counts = [0usize; 8];
+    let mut counts = [0usize; 9];
     let mut mid = None;
     for t in 0..10_000u64 {
         match t {
@@ -188,10 +209,11 @@ fn long_run(restore_at_5000: Option<&StateSnapshot>) -> (u64, [usize; 8], StateS
                 GameEvent::Jumped(_) => 0,
                 GameEvent::CoinPicked { .. } => 1,
                 GameEvent::Checkpoint { .. } => 2,
-                GameEvent::Hurt { .. } => 3,
+                GameEvent::Died { .. } => 3,
                 GameEvent::Stomped { .. } | GameEvent::EnemySquished { .. } => 4,
                 GameEvent::Launched { .. } => 5,
                 GameEvent::Respawned { .. } => 6,
+                GameEvent::Restarted(_) => 8,
                 _ => 7,
             }] += 1;
         }
@@ -208,9 +230,11 @@ fn a_10000_tick_multiplayer_run_is_deterministic() {
     // Restored mid-run into a fresh game, it ends the same.
     let (h3, _, _) = long_run(Some(&mid));
     assert_eq!(h3, h1);
-    // The run exercised jumping, coins, hurting, springs and respawning.
+    // The run exercised jumping, coins, dying, springs, respawning and
+    // restarting.
     assert!(c1[0] > 50, "{c1:?}");
     assert!(c1[1] > 0 && c1[3] > 0 && c1[5] > 0 && c1[6] > 0, "{c1:?}");
+    assert!(c1[8] > 5, "{c1:?}");
 }
 
 #[test]

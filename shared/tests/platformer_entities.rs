@@ -63,7 +63,7 @@ fn stomping_a_walker_bounces_and_defeats_it() {
             for _ in 0..100 {
                 s.step(NONE);
                 assert!(
-                    !s.saw(|e| matches!(e, GameEvent::Hurt { .. })),
+                    !s.saw(|e| matches!(e, GameEvent::Died { .. })),
                     "{:?}",
                     s.events
                 );
@@ -73,7 +73,7 @@ fn stomping_a_walker_bounces_and_defeats_it() {
             return;
         }
         assert!(
-            !s.saw(|e| matches!(e, GameEvent::Hurt { .. })),
+            !s.saw(|e| matches!(e, GameEvent::Died { .. })),
             "tick {t}: {:?}",
             s.events
         );
@@ -81,22 +81,18 @@ fn stomping_a_walker_bounces_and_defeats_it() {
     panic!("never stomped");
 }
 
-/// Walks right (at most `ticks` ticks) until hurt: hurt by `cause`, then
-/// respawned at `respawn`, in that tick's events.
+/// Walks right (at most `ticks` ticks) until it dies: one death of `cause`
+/// (counted), dead for exactly the respawn delay, then respawned at
+/// `respawn`.
 fn walk_until_hurt(s: &mut Sim, ticks: u32, cause: HurtCause, respawn: IVec2) {
+    let deaths = s.view().deaths;
     for _ in 0..ticks {
         s.step(RIGHT);
-        if s.saw(|e| matches!(e, GameEvent::Hurt { .. })) {
-            assert_eq!(
-                s.events,
-                vec![
-                    GameEvent::Hurt { player: P1, cause },
-                    GameEvent::Respawned {
-                        player: P1,
-                        pos: respawn
-                    }
-                ]
-            );
+        if s.saw(|e| matches!(e, GameEvent::Died { .. })) {
+            assert_eq!(s.events, vec![GameEvent::Died { player: P1, cause }]);
+            assert_eq!(s.view().deaths, deaths + 1);
+            s.sit_out_death(RIGHT, respawn);
+            assert_eq!(s.view().deaths, deaths + 1);
             return;
         }
     }
@@ -300,7 +296,7 @@ fn a_checkpoint_changes_the_respawn_point_and_hazards_hurt() {
             RIGHT
         };
         s.step(b);
-        assert!(!s.saw(|e| matches!(e, GameEvent::Hurt { .. })), "tick {t}");
+        assert!(!s.saw(|e| matches!(e, GameEvent::Died { .. })), "tick {t}");
         if s.saw(|e| matches!(e, GameEvent::Checkpoint { .. })) {
             assert!(s.events.contains(&GameEvent::Checkpoint {
                 player: P1,
@@ -329,14 +325,16 @@ fn a_checkpoint_changes_the_respawn_point_and_hazards_hurt() {
             RIGHT
         };
         s.step(b);
-        if let Some(GameEvent::Hurt { cause, .. }) = s.events.first() {
+        if let Some(GameEvent::Died { cause, .. }) = s.events.first() {
             assert_eq!(*cause, HurtCause::Hazard(id_of(2)), "tick {t}");
             hurt = true;
             break;
         }
     }
     assert!(hurt);
+    s.sit_out_death(RIGHT, checkpoint);
     assert_eq!(s.pos(), checkpoint);
+    assert_eq!(s.view().deaths, 3);
 }
 
 #[test]
@@ -355,16 +353,17 @@ fn reaching_the_goal_raises_the_win_event_once() {
         wins += s
             .events
             .iter()
-            .filter(|e| **e == GameEvent::Won(P1))
+            .filter(|e| matches!(e, GameEvent::Finished { player: P1, .. }))
             .count();
     }
     assert_eq!(wins, 1);
     assert!(s.view().won);
+    assert_eq!(s.view().place, Some(1));
     assert_eq!(s.game.entities().next().unwrap().ty, EntityType::Goal);
 }
 
 #[test]
-fn a_player_who_falls_out_of_the_level_respawns() {
+fn a_player_who_falls_out_of_the_level_dies_and_respawns() {
     // A ledge with nothing below or beside it: walk off its right end.
     let lv = level(
         &["..........", "..........", "######....", ".........."],
@@ -378,21 +377,17 @@ fn a_player_who_falls_out_of_the_level_respawns() {
     let mut lowest = i32::MIN;
     for t in 0..2000 {
         s.step(RIGHT);
-        if s.saw(|e| matches!(e, GameEvent::Hurt { .. })) {
+        if s.saw(|e| matches!(e, GameEvent::Died { .. })) {
             assert_eq!(
                 s.events,
-                vec![
-                    GameEvent::Hurt {
-                        player: P1,
-                        cause: HurtCause::Fell
-                    },
-                    GameEvent::Respawned {
-                        player: P1,
-                        pos: spawn
-                    }
-                ],
+                vec![GameEvent::Died {
+                    player: P1,
+                    cause: HurtCause::Fell
+                }],
                 "tick {t}"
             );
+            assert_eq!(s.view().deaths, 1, "falling out is a death");
+            s.sit_out_death(RIGHT, spawn);
             // Not before its top passed the margin below the level: the
             // tick before, its top (8 px above its centre) was still above
             // the line, and less than one fall step (32 px) from it.

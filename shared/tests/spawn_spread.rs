@@ -181,12 +181,18 @@ fn a_player_without_a_checkpoint_respawns_on_its_own_spot_in_any_game() {
     other.restore(&fallen).unwrap();
     let events = other.step(&[]).to_vec();
     assert!(
-        events.contains(&GameEvent::Hurt {
+        events.contains(&GameEvent::Died {
             player: PlayerId(4),
             cause: HurtCause::Fell
         }),
         "{events:?}"
     );
+    // Dead for the respawn delay, then back on its own spot.
+    let delay = other.config().player.respawn_delay_ticks;
+    let mut events = events;
+    for _ in 0..delay {
+        events = other.step(&[]).to_vec();
+    }
     assert!(
         events.contains(&GameEvent::Respawned {
             player: PlayerId(4),

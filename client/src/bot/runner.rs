@@ -395,9 +395,8 @@ impl Candidate {
             let events = g.step(&[(me, press(t))]);
             let hurt = events.iter().any(|e| {
                 matches!(e,
-                    GameEvent::Hurt { player, .. } | GameEvent::Respawned { player, .. }
+                    GameEvent::Died { player, .. } | GameEvent::Respawned { player, .. }
                         if *player == me)
-                    || matches!(e, GameEvent::Squished(p) if *p == me)
             });
             // A plan must not count on a walker: it may be gone on the server.
             let stomped = events
@@ -541,6 +540,13 @@ mod tests {
     use ledge_shared::level::{EntityKind, Level};
 
     const PX: i32 = UNITS_PER_PX;
+
+    /// Whether `events` hold our player finishing its run.
+    fn finished(events: &[GameEvent], me: PlayerId) -> bool {
+        events
+            .iter()
+            .any(|e| matches!(e, GameEvent::Finished { player, .. } if *player == me))
+    }
     /// The walker trench of the default level: x from col 36 to col 44,
     /// floor at the top of row 27, route height (ground) at row 26.
     const TRENCH: (i32, i32) = (36 * 16 * PX, 44 * 16 * PX);
@@ -550,7 +556,7 @@ mod tests {
     fn play(game: &mut Game, me: PlayerId, runner: &mut Runner, ticks: u32) -> Option<u64> {
         for _ in 0..ticks {
             let b = runner.buttons(game, me);
-            if game.step(&[(me, b)]).contains(&GameEvent::Won(me)) {
+            if finished(game.step(&[(me, b)]), me) {
                 return Some(game.tick());
             }
         }
@@ -664,7 +670,7 @@ mod tests {
         for _ in 0..60 * 60 {
             let b = runner.buttons(&game, me);
             went_back |= runner.recovering() && runner.next == 1;
-            if game.step(&[(me, b)]).contains(&GameEvent::Won(me)) {
+            if finished(game.step(&[(me, b)]), me) {
                 won_at = Some(game.tick());
                 break;
             }
@@ -703,7 +709,7 @@ mod tests {
                 .iter()
                 .filter(|e| matches!(e, GameEvent::Stomped { player, .. } if *player == me))
                 .count();
-            if events.contains(&GameEvent::Won(me)) {
+            if finished(events, me) {
                 won = true;
                 break;
             }
@@ -727,7 +733,7 @@ mod tests {
         for _ in 0..60 * 60 {
             let b = runner.buttons(&game, me);
             pressed.push(b);
-            if game.step(&[(me, b)]).contains(&GameEvent::Won(me)) {
+            if finished(game.step(&[(me, b)]), me) {
                 return (pressed, runner.progress(), true);
             }
         }

@@ -138,7 +138,16 @@ pub struct PlayerConfig {
     pub carry_mode: CarryMode,
     /// How the player's body is modelled (default: one box).
     pub shape: PlayerShape,
+    /// Ticks a player stays dead before it respawns at its checkpoint
+    /// (default 24: 0.4 s at 60 ticks a second). While dead it neither
+    /// moves, collides, collects nor is hurt. 0: it respawns in the tick it
+    /// died. At most [`MAX_RESPAWN_DELAY_TICKS`].
+    pub respawn_delay_ticks: u16,
 }
+
+/// Largest [`PlayerConfig::respawn_delay_ticks`]: 1200 ticks (20 s at 60
+/// ticks a second, 1.2 s at the server's largest tick rate, 1000).
+pub const MAX_RESPAWN_DELAY_TICKS: u16 = 1200;
 
 impl Default for PlayerConfig {
     fn default() -> Self {
@@ -163,6 +172,7 @@ impl Default for PlayerConfig {
             stomp_tolerance: 1024,
             carry_mode: CarryMode::Add,
             shape: PlayerShape::Box,
+            respawn_delay_ticks: 24,
         }
     }
 }
@@ -171,7 +181,8 @@ impl PlayerConfig {
     /// Checks every value: sizes positive within the extent bound, speeds and
     /// accelerations in `[0, MAX_SPEED / 4]`, `max_run_speed`, `jump_speed`
     /// and `max_fall_speed` positive, `max_walkable_slope` in `[0, 4096]`
-    /// (up to 86 degrees), tick counts at most 254.
+    /// (up to 86 degrees), tick counts at most 254, `respawn_delay_ticks` at
+    /// most [`MAX_RESPAWN_DELAY_TICKS`].
     pub fn validate(&self) -> Result<(), String> {
         for (what, v) in [("half.x", self.half.x), ("half.y", self.half.y)] {
             if v <= 0 {
@@ -213,6 +224,12 @@ impl PlayerConfig {
             if v == u8::MAX {
                 return Err(format!("player {what} = {v} must be at most 254"));
             }
+        }
+        let v = self.respawn_delay_ticks;
+        if v > MAX_RESPAWN_DELAY_TICKS {
+            return Err(format!(
+                "player respawn_delay_ticks = {v} must be at most {MAX_RESPAWN_DELAY_TICKS}"
+            ));
         }
         Ok(())
     }

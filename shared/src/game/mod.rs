@@ -25,17 +25,55 @@
 //! walkers: walk, gravity
 //! world.step: carry riders, move, detect (colliders + tiles), restitute
 //! walkers: squished -> defeated; turn at walls and ledges
-//! players (id order): squished / hazard -> respawn; polygon slopes;
+//! players (id order): restart; run timer; dead -> count down, respawn;
+//!   squished / hazard / fell -> die; polygon slopes;
 //!   ceiling, wall, ground; ground snap; platform exit velocity;
-//!   enemies (stomp or hurt); springboards; coins; checkpoints; goal
+//!   enemies (stomp or die); springboards; coins; checkpoints; goal
 //! ```
 //! Events come out in that order (join and leave events first). The rules
 //! are described in `docs/PLATFORMER.md`.
 //!
+//! # Runs
+//! Each player has a run: what a results card and a room's results table
+//! show, decided here (server-authoritative, predicted like the rest).
+//! * **Timer.** It starts on the first tick whose buttons hold one that
+//!   plays ([`Buttons::PLAY`]; not restart) and counts every tick until it
+//!   finishes, that first tick and the finishing tick included, deaths and
+//!   dead time too: a finished run's ticks are the game tick after the
+//!   goal was reached minus the game tick before the first press.
+//! * **Death.** Hazard tiles and volumes, walkers, being squished and
+//!   falling [`FALL_MARGIN`] below the level kill ([`GameEvent::Died`]):
+//!   the death count goes up (not after finishing: a finished run's record
+//!   stays as it was), the body stops where it died and is suspended (it
+//!   neither moves, collides, collects nor is hurt) for
+//!   [`PlayerConfig::respawn_delay_ticks`] ticks ([`PlayerView::dead`]
+//!   counts them down), then it is put back at its respawn point at rest
+//!   ([`GameEvent::Respawned`]). With a delay of 0 that happens in the tick
+//!   it died.
+//! * **Finishing.** Reaching a goal finishes the run once
+//!   ([`GameEvent::Finished`]): the timer stops, and the run gets a
+//!   finishing order, one more than the largest of the players in the game.
+//!   A player's place ([`PlayerView::place`]) is 1 plus the number of
+//!   finished players in the game with a smaller order: players ranked by
+//!   finishing tick, ties (the same tick) by player id, because players are
+//!   stepped in id order. Places are among the players present: when one
+//!   ahead leaves or restarts, those behind move up. After finishing a
+//!   player keeps playing (and can still die and respawn).
+//! * **Restart.** A press of [`Buttons::RESTART`] (held now, not last tick),
+//!   also while dead or after finishing, restarts the run at the end of the
+//!   tick (the tick's movement is discarded; [`GameEvent::Restarted`], then
+//!   [`GameEvent::Respawned`]): the player is put at its own spawn spot at
+//!   rest, alive; its checkpoint is the spawn again; timer, deaths and
+//!   finish are cleared (the timer starts again with the next press); and
+//!   the coins it picked up are put back in the level for anyone to take,
+//!   so the new run counts its own coins. Walkers it defeated stay
+//!   defeated (they are the room's, like coins others took).
+//!
 //! # State
 //! Everything that lasts from one tick to the next is in the snapshot:
 //! players (position, velocity, flags and timers packed as in [`state`]),
-//! walkers and coins; platforms are flagged
+//! walkers, coins and one run record per player ([`kind::RUN`], id
+//! [`RUN_ID_BASE`] + player id); platforms are flagged
 //! [`EntityState::CLIENT_SIMULATED`] and recomputed from the tick. The
 //! world's per-tick scratch (touched sides, carriers, pushes) is rebuilt
 //! every tick, and a player's outcome never depends on other players' body
@@ -49,9 +87,12 @@ mod rules;
 pub mod spawn;
 pub mod state;
 
-pub use config::{CarryMode, GameConfig, PlayerConfig, PlayerShape, FOOT_HEIGHT, FOOT_INSET};
+pub use config::{
+    CarryMode, GameConfig, PlayerConfig, PlayerShape, FOOT_HEIGHT, FOOT_INSET,
+    MAX_RESPAWN_DELAY_TICKS,
+};
 pub use path::PathSchedule;
-pub use state::{kind, ENTITY_ID_BASE};
+pub use state::{kind, ENTITY_ID_BASE, RUN_ID_BASE};
 
 use crate::fixed::{check_coord, check_speed};
 use crate::input::Buttons;
@@ -62,7 +103,7 @@ use crate::tilemap::Tilemap;
 use crate::world::hash::Fnv1a;
 use crate::world::{BodyDesc, BodyId, ColliderDesc, OneWay, Sides, World, TILEMAP_LAYER};
 use glam::IVec2;
-use state::{coin_flags, platform_flags, walker_flags, PlayerState};
+use state::{coin_flags, platform_flags, walker_flags, PlayerState, RunState, RUN_MAX};
 use thiserror::Error;
 
 /// Collision layer of level geometry (blocks, platforms).
@@ -100,7 +141,7 @@ pub enum GameError {
     PlayerIdOutOfRange(PlayerId),
 }
 
-/// What hurt a player.
+/// What killed a player ([`GameEvent::Died`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum HurtCause {
     /// A walker's body (entity id).
@@ -111,10 +152,12 @@ pub enum HurtCause {
     Hazard(u32),
     /// Fell out of the level: [`FALL_MARGIN`] below everything in it.
     Fell,
+    /// Crushed: a platform pushed it into something solid.
+    Squished,
 }
 
 /// How far below the lowest thing in a level ([`Level::bounds`]) a player
-/// falls before it respawns: 16 tiles of 16 px, in units.
+/// falls before it dies: 16 tiles of 16 px, in units.
 pub const FALL_MARGIN: i32 = 256 * crate::fixed::UNITS_PER_PX;
 
 /// Something that happened in a tick, for the server, the HUD and tests.
@@ -145,15 +188,28 @@ pub enum GameEvent {
         /// The checkpoint's entity id.
         checkpoint: u32,
     },
-    /// A player reached a goal (once per player).
-    Won(PlayerId),
-    /// A player was hurt (a [`GameEvent::Respawned`] follows).
-    Hurt {
+    /// A player reached a goal: its run finished (once per run).
+    Finished {
         /// Who.
         player: PlayerId,
-        /// By what.
+        /// The run's ticks, from the first press to the goal, both ticks
+        /// included.
+        ticks: u32,
+        /// Its place in the room now (1: first).
+        place: u32,
+    },
+    /// A player died; a [`GameEvent::Respawned`] follows after
+    /// [`PlayerConfig::respawn_delay_ticks`] (in this tick when 0) unless it
+    /// restarts first.
+    Died {
+        /// Who.
+        player: PlayerId,
+        /// Of what.
         cause: HurtCause,
     },
+    /// A player restarted its run ([`Buttons::RESTART`]); a
+    /// [`GameEvent::Respawned`] at its spawn follows in this tick.
+    Restarted(PlayerId),
     /// A player landed on a walker's head: the walker is defeated and the
     /// player bounces.
     Stomped {
@@ -169,10 +225,8 @@ pub enum GameEvent {
         /// The springboard's entity id.
         springboard: u32,
     },
-    /// A player was crushed (a platform pushed it into something solid); a
-    /// [`GameEvent::Respawned`] follows.
-    Squished(PlayerId),
-    /// A player was put back at its respawn point.
+    /// A player was put back at its respawn point (after dying or
+    /// restarting).
     Respawned {
         /// Who.
         player: PlayerId,
@@ -267,10 +321,21 @@ pub struct PlayerView {
     pub facing_left: bool,
     /// Coins picked up.
     pub coins: u32,
-    /// Reached the goal.
+    /// Reached the goal: its run finished.
     pub won: bool,
     /// The checkpoint it respawns at (entity id), `None` for the level spawn.
     pub checkpoint: Option<u32>,
+    /// Deaths in this run.
+    pub deaths: u32,
+    /// The run's timer started (a button that plays was pressed).
+    pub run_started: bool,
+    /// The run's ticks: running, or final once finished.
+    pub run_ticks: u32,
+    /// Its place among the finished players in the game (1: first), `None`
+    /// until it finishes.
+    pub place: Option<u32>,
+    /// Dead: `Some(ticks until it respawns)`, at least 1; `None` alive.
+    pub dead: Option<u16>,
     /// Sides its box touched during the last step (a view of the world's
     /// per-tick scratch: not part of the state, empty after a restore).
     pub sides: Sides,
@@ -302,6 +367,9 @@ struct Player {
     id: PlayerId,
     body: BodyId,
     st: PlayerState,
+    run: RunState,
+    /// Per-step scratch: restart was pressed this tick.
+    restart: bool,
 }
 
 /// The running platformer.
@@ -551,7 +619,16 @@ impl Game {
         let st = PlayerState::default();
         let pos = self.respawn_point(id, &st);
         let body = self.new_player_body(pos)?;
-        self.players.insert(at, Player { id, body, st });
+        self.players.insert(
+            at,
+            Player {
+                id,
+                body,
+                st,
+                run: RunState::default(),
+                restart: false,
+            },
+        );
         self.pending.push(GameEvent::Joined(id));
         Ok(())
     }
@@ -617,6 +694,37 @@ impl Game {
         self.players.iter().map(|p| self.view_of(p))
     }
 
+    /// The room's results table: the views of the players that finished
+    /// their run, first place first.
+    pub fn results(&self) -> Vec<PlayerView> {
+        let mut v: Vec<PlayerView> = self
+            .players
+            .iter()
+            .filter(|p| p.run.order != 0)
+            .map(|p| self.view_of(p))
+            .collect();
+        v.sort_by_key(|p| (p.place, p.id));
+        v
+    }
+
+    /// The place of a run finished with `order` among the players in the
+    /// game: 1 plus the number of finished runs with a smaller order.
+    fn place_of(&self, order: u32) -> u32 {
+        let ahead = self
+            .players
+            .iter()
+            .filter(|q| q.run.order != 0 && q.run.order < order)
+            .count();
+        1 + ahead as u32
+    }
+
+    /// The finishing order of a run finishing now: one more than the
+    /// largest of the players in the game (at most [`RUN_MAX`]).
+    fn next_order(&self) -> u32 {
+        let top = self.players.iter().map(|q| q.run.order).max().unwrap_or(0);
+        (top + 1).min(RUN_MAX)
+    }
+
     fn view_of(&self, p: &Player) -> PlayerView {
         let b = self.world.body(p.body).expect("a player's body exists");
         PlayerView {
@@ -629,6 +737,11 @@ impl Game {
             coins: self.coins_of(p.id),
             won: p.st.won,
             checkpoint: (p.st.checkpoint != 0).then(|| ENTITY_ID_BASE + p.st.checkpoint as u32 - 1),
+            deaths: p.run.deaths,
+            run_started: p.run.started,
+            run_ticks: p.run.ticks,
+            place: (p.run.order != 0).then(|| self.place_of(p.run.order)),
+            dead: (p.st.dead > 0).then_some(p.st.dead),
             sides: b.sides(),
         }
     }
@@ -688,7 +801,8 @@ impl Game {
     }
 
     /// Calls `f` with every entity's state, ascending by id: players, then
-    /// walkers, coins and platforms (client-simulated) in level order.
+    /// walkers, coins and platforms (client-simulated) in level order, then
+    /// the players' run records.
     fn for_each_state(&self, mut f: impl FnMut(EntityState)) {
         for p in &self.players {
             f(EntityState {
@@ -738,6 +852,9 @@ impl Game {
                 _ => {}
             }
         }
+        for p in &self.players {
+            f(p.run.to_entity(p.id.0));
+        }
     }
 
     /// A platform's motion during the next step.
@@ -756,10 +873,11 @@ impl Game {
     }
 
     /// The exact state: every entity [`is_replicated`] keeps (players,
-    /// walkers, coins; platforms are recomputed from the tick).
+    /// walkers, coins, run records; platforms are recomputed from the
+    /// tick).
     pub fn snapshot(&self) -> StateSnapshot {
         let mut entities =
-            Vec::with_capacity(self.players.len() + self.walkers.len() + self.coins.len());
+            Vec::with_capacity(2 * self.players.len() + self.walkers.len() + self.coins.len());
         self.for_each_state(|e| {
             if is_replicated(&e) {
                 entities.push(e)
@@ -780,8 +898,22 @@ impl Game {
         let bad = |m: String| GameError::BadSnapshot(m);
         snapshot.validate().map_err(|e| bad(e.to_string()))?;
         let mut players: Vec<(PlayerId, &EntityState, PlayerState)> = Vec::new();
+        // Run records, ascending by player id like `players`.
+        let mut runs: Vec<(PlayerId, RunState)> = Vec::new();
         let mut found = vec![None::<&EntityState>; self.ents.len()];
         for e in &snapshot.entities {
+            if e.id >= RUN_ID_BASE {
+                if e.kind != kind::RUN {
+                    return Err(bad(format!(
+                        "entity {} has kind {}, not a run record",
+                        e.id, e.kind
+                    )));
+                }
+                let run = RunState::from_entity(e)
+                    .map_err(|m| bad(format!("run record {}: {m}", e.id)))?;
+                runs.push((PlayerId(e.id - RUN_ID_BASE), run));
+                continue;
+            }
             for (what, v) in [("x", e.pos.x), ("y", e.pos.y)] {
                 check_coord("position", v as i64)
                     .map_err(|x| bad(format!("entity {}: {what}: {x}", e.id)))?;
@@ -800,6 +932,12 @@ impl Game {
                 let st = PlayerState::unpack(e.flags, e.aux).ok_or_else(|| {
                     bad(format!("player {}: unknown flag bits {:#x}", e.id, e.flags))
                 })?;
+                if st.dead > self.config.player.respawn_delay_ticks {
+                    return Err(bad(format!(
+                        "player {}: dead for {} more ticks, the delay is {}",
+                        e.id, st.dead, self.config.player.respawn_delay_ticks
+                    )));
+                }
                 if st.checkpoint != 0 {
                     let ok = self
                         .ents
@@ -842,6 +980,25 @@ impl Game {
                 )));
             }
         }
+        // One run record per player (both lists ascend by id), finished
+        // exactly when the player is.
+        if runs.len() != players.len() {
+            return Err(bad(format!(
+                "{} run records for {} players",
+                runs.len(),
+                players.len()
+            )));
+        }
+        for ((id, _, st), (rid, run)) in players.iter().zip(&runs) {
+            if id != rid {
+                return Err(bad(format!("player {id} has no run record")));
+            }
+            if st.won != (run.order != 0) {
+                return Err(bad(format!(
+                    "player {id}: the won flag and the run's finishing order disagree"
+                )));
+            }
+        }
         // Valid: apply. Players first: drop those not in the snapshot, add
         // the new ones, then set every state.
         let old: Vec<Player> = std::mem::take(&mut self.players);
@@ -855,7 +1012,7 @@ impl Game {
                     .expect("a player's body exists");
             }
         }
-        for (id, e, st) in players {
+        for ((id, e, st), (_, run)) in players.into_iter().zip(runs) {
             let body = match kept.iter().find(|p| p.id == id) {
                 Some(p) => p.body,
                 None => self.new_player_body(e.pos)?,
@@ -864,7 +1021,16 @@ impl Game {
             self.world
                 .set_drop_through(body, false)
                 .expect("player body");
-            self.players.push(Player { id, body, st });
+            self.world
+                .set_enabled(body, st.dead == 0)
+                .expect("player body");
+            self.players.push(Player {
+                id,
+                body,
+                st,
+                run,
+                restart: false,
+            });
         }
         for (i, e) in found.iter().enumerate() {
             let Some(e) = e else { continue };

@@ -5,6 +5,7 @@ use glam::IVec2;
 
 use super::config::{CarryMode, PlayerConfig};
 use super::polygon_ground::{PolygonSolid, SLOPE_RUN, TOUCH};
+use super::state::{PlayerState, RunState, RUN_MAX};
 use super::{EntityType, Game, GameEvent, HurtCause, Player, ENTITY_ID_BASE};
 use crate::fixed::MAX_SPEED;
 use crate::input::Buttons;
@@ -117,10 +118,24 @@ impl Game {
         }
     }
 
-    /// Buttons to velocity, before the physics step.
+    /// Buttons to velocity, before the physics step; the run's input
+    /// (restart press, timer start) also while dead.
     fn player_before(&mut self, i: usize, b: Buttons) {
         let cfg = self.config.player;
         let mut p = self.players[i];
+        let restart = b.held(Buttons::RESTART);
+        p.restart = restart && !p.st.restart_held;
+        p.st.restart_held = restart;
+        if b.plays() {
+            p.run.started = true;
+        }
+        if p.st.dead > 0 {
+            // Suspended: no control, no timers; only the jump hold is
+            // tracked, so a jump held through the respawn is no new press.
+            p.st.jump_held = b.held(Buttons::JUMP);
+            self.players[i] = p;
+            return;
+        }
         let mut v = self.body_vel(p.body);
         let s = &mut p.st;
 
@@ -291,7 +306,7 @@ impl Game {
             .expect("zero velocity");
     }
 
-    /// Puts player `p` back at its respawn point, at rest.
+    /// Puts player `p` back at its respawn point, at rest and alive.
     fn respawn(&mut self, p: &mut Player) {
         let pos = self.respawn_point(p.id, &p.st);
         self.world
@@ -303,18 +318,81 @@ impl Game {
         self.world
             .set_drop_through(p.body, false)
             .expect("player body");
-        let s = &mut p.st;
-        s.grounded = false;
-        s.on_spring = false;
-        s.coyote = 0;
-        s.buffer = 0;
-        s.hold = 0;
-        s.drop = 0;
+        self.world.set_enabled(p.body, true).expect("player body");
+        clear_controller(&mut p.st);
+        p.st.dead = 0;
         self.events.push(GameEvent::Respawned { player: p.id, pos });
     }
 
-    /// The rules after the physics step, for player `i`.
+    /// Player `p` dies of `cause`: counted (unless its run finished), then
+    /// suspended where it is for the respawn delay, or respawned now when
+    /// the delay is 0.
+    fn die(&mut self, p: &mut Player, cause: HurtCause) {
+        self.events.push(GameEvent::Died {
+            player: p.id,
+            cause,
+        });
+        if p.run.order == 0 {
+            p.run.deaths = (p.run.deaths + 1).min(RUN_MAX);
+        }
+        let delay = self.config.player.respawn_delay_ticks;
+        if delay == 0 {
+            self.respawn(p);
+            return;
+        }
+        self.world
+            .set_velocity(p.body, IVec2::ZERO)
+            .expect("zero velocity");
+        self.world
+            .set_drop_through(p.body, false)
+            .expect("player body");
+        self.world.set_enabled(p.body, false).expect("player body");
+        clear_controller(&mut p.st);
+        p.st.dead = delay;
+    }
+
+    /// Player `p` restarts its run: its coins go back to the level, its
+    /// checkpoint, timer, deaths and finish are cleared, and it respawns at
+    /// its spawn spot (see "Runs" in the module docs of [`super`]).
+    fn restart(&mut self, p: &mut Player) {
+        self.events.push(GameEvent::Restarted(p.id));
+        for k in 0..self.coins.len() {
+            let c = self.coins[k];
+            if self.ents[c].collector == Some(p.id.0) {
+                self.ents[c].collector = None;
+            }
+        }
+        p.st.checkpoint = 0;
+        p.st.won = false;
+        p.run = RunState::default();
+        self.respawn(p);
+    }
+
+    /// The rules after the physics step, for player `i`: a restart; the
+    /// run's timer; a dead player's countdown; the rules of a live one.
     fn player_after(&mut self, i: usize) {
+        let mut p = self.players[i];
+        if p.restart {
+            p.restart = false;
+            self.restart(&mut p);
+            self.players[i] = p;
+            return;
+        }
+        p.run.tick();
+        if p.st.dead > 0 {
+            p.st.dead -= 1;
+            if p.st.dead == 0 {
+                self.respawn(&mut p);
+            }
+            self.players[i] = p;
+            return;
+        }
+        self.players[i] = p;
+        self.live_player_after(i);
+    }
+
+    /// The rules after the physics step, for live player `i`.
+    fn live_player_after(&mut self, i: usize) {
         let cfg = self.config.player;
         let mut p = self.players[i];
         let id = p.id;
@@ -326,8 +404,7 @@ impl Game {
         let dropping = body.drops_through();
 
         if self.squished.contains(&p.body.0) {
-            self.events.push(GameEvent::Squished(id));
-            self.respawn(&mut p);
+            self.die(&mut p, HurtCause::Squished);
             self.players[i] = p;
             return;
         }
@@ -343,8 +420,7 @@ impl Game {
                 .map(|&h| HurtCause::Hazard(ENTITY_ID_BASE + h as u32))
         };
         if let Some(cause) = hazard {
-            self.events.push(GameEvent::Hurt { player: id, cause });
-            self.respawn(&mut p);
+            self.die(&mut p, cause);
             self.players[i] = p;
             return;
         }
@@ -448,11 +524,7 @@ impl Game {
                 grounded = false;
                 self.events.push(GameEvent::Stomped { player: id, enemy });
             } else {
-                self.events.push(GameEvent::Hurt {
-                    player: id,
-                    cause: HurtCause::Enemy(enemy),
-                });
-                self.respawn(&mut p);
+                self.die(&mut p, HurtCause::Enemy(enemy));
                 self.players[i] = p;
                 return;
             }
@@ -509,7 +581,12 @@ impl Game {
                 .any(|&k| Rect::new(self.ents[k].pos, self.ents[k].half).overlaps(&r))
         {
             p.st.won = true;
-            self.events.push(GameEvent::Won(id));
+            p.run.order = self.next_order();
+            self.events.push(GameEvent::Finished {
+                player: id,
+                ticks: p.run.ticks,
+                place: self.place_of(p.run.order),
+            });
         }
 
         let s = &mut p.st;
@@ -684,6 +761,17 @@ impl Game {
         map.box_contacts(pos, half, moved, flags, out);
         out.iter().all(|c| c.is_trigger())
     }
+}
+
+/// Clears what a respawn or a death ends: ground, springboard contact and
+/// the four controller timers (facing and held buttons are kept).
+fn clear_controller(s: &mut PlayerState) {
+    s.grounded = false;
+    s.on_spring = false;
+    s.coyote = 0;
+    s.buffer = 0;
+    s.hold = 0;
+    s.drop = 0;
 }
 
 /// `v` with each component clamped to the speed bound.

@@ -54,7 +54,12 @@ pub use snapshot::{
 /// 5: rooms by name: `ClientControl::ListRooms`, `ServerControl::Rooms`;
 /// level download: `Welcome::level`, `ClientControl::GetLevel`; resuming a
 /// lost session: `Welcome::session_token`, `ClientControl::Resume`.
-pub const PROTOCOL_VERSION: u32 = 5;
+/// 6: runs (`game::state`): a run record per player in snapshots
+/// (`kind::RUN`, id `RUN_ID_BASE` + player id), the player flags `DEAD`
+/// (its `aux` then the respawn countdown) and `RESTART_HELD`, the input bit
+/// `Buttons::RESTART`, and `PlayerConfig::respawn_delay_ticks` in
+/// `Welcome::sim_config`.
+pub const PROTOCOL_VERSION: u32 = 6;
 
 /// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
 /// an unrelated QUIC peer. It names the application, not the version:

@@ -185,6 +185,34 @@ impl Sim {
         self.events.iter().any(f)
     }
 
+    /// After a death in the last step: steps with `b` through the respawn
+    /// delay, checking that the player stays dead where it died, with no
+    /// event, for exactly the configured delay, then respawns at `respawn`
+    /// (with a delay of 0 the respawn was in the death's tick).
+    pub fn sit_out_death(&mut self, b: Buttons, respawn: IVec2) {
+        let respawned = GameEvent::Respawned {
+            player: self.id,
+            pos: respawn,
+        };
+        let delay = self.game.config().player.respawn_delay_ticks;
+        if delay == 0 {
+            assert!(self.events.contains(&respawned), "{:?}", self.events);
+        }
+        let at = self.pos();
+        for left in (1..=delay).rev() {
+            assert_eq!(self.view().dead, Some(left), "{:?}", self.view());
+            assert_eq!(self.pos(), at, "dead players do not move");
+            assert_eq!(self.view().vel, IVec2::ZERO);
+            self.step(b);
+            if left > 1 {
+                assert_eq!(self.events, vec![], "{left} ticks left");
+            }
+        }
+        assert_eq!(self.events.last(), Some(&respawned));
+        assert_eq!(self.view().dead, None);
+        assert_eq!(self.pos(), respawn);
+    }
+
     /// Steps until the player is grounded (at most `n` ticks); panics if it
     /// never is.
     pub fn land(&mut self, n: usize) {
