@@ -28,6 +28,8 @@
 //! * [`timestep`]: fixed-step accumulator for render loops;
 //! * [`audio`]: sound effects, synthesized at start, played through ALSA
 //!   loaded at run time (off, never failing, without it);
+//! * [`cues`]: which sound effects to play, from frame-to-frame changes of
+//!   our player (so rollbacks never replay one);
 //! * [`error`]: what can fail ([`ClientError`]).
 //!
 //! `docs/CLIENT.md` describes the design and the figures.
@@ -38,6 +40,7 @@ pub mod background;
 pub mod bot;
 pub mod bundle;
 pub mod clock;
+pub mod cues;
 pub mod error;
 pub mod game;
 pub mod interp;
