@@ -341,3 +341,92 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
     }
     assert!(checked >= 4, "only {checked} background points checked");
 }
+
+/// The default HUD, offline: the screenshot's JSON reports our name, coins
+/// (of the level's), deaths and run ticks, equal to the simulation's after
+/// the same scripted ticks, and no network panel; the panel is drawn in
+/// the top-left corner.
+#[test]
+fn the_default_hud_shows_name_coins_deaths_and_timer_as_the_simulation_says() {
+    use ledge_shared::game::PlayerView;
+    use ledge_shared::level::EntityKind;
+    use ledge_shared::protocol::PlayerId;
+
+    let Some(xvfb) = common::xvfb_or_skip("the default HUD screenshot test") else {
+        return;
+    };
+    const HUD_TICKS: u64 = 200;
+    // Run right, jumping now and then, over the level's first coins.
+    const HUD_SCRIPT: &str = "0-199 -> right; 20-34 -> jump; 70-84 -> jump; 120-134 -> jump";
+    let out = tempfile::tempdir().unwrap();
+    let dir = common::screenshot_dir(out.path());
+    let png_path = dir.join("hud.png");
+    let mut command = Command::new(xvfb);
+    command
+        .args(["-a", "-s", "-screen 0 1280x720x24"])
+        .arg(env!("CARGO_BIN_EXE_ledge-client"))
+        .args(["--name", "ada"])
+        .args(["--script", HUD_SCRIPT])
+        .args(["--exit-after-ticks", &HUD_TICKS.to_string()])
+        .arg("--screenshot")
+        .arg(&png_path)
+        .args(["--window", "960x540"])
+        .env("LIBGL_ALWAYS_SOFTWARE", "1");
+    let out = run_to_end(command, CLIENT_TIMEOUT);
+    assert!(
+        out.status.success(),
+        "the client failed: {}; stderr:\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("hud.png.json")).expect("the screenshot's JSON"),
+    )
+    .expect("valid JSON");
+
+    // The same ticks in the simulation (offline: player 1, the script's
+    // buttons tick by tick).
+    let level = default_level();
+    let mut game = Game::from_level(&level).unwrap();
+    game.add_player(PlayerId(1)).unwrap();
+    let script = |t: u64| {
+        let mut b = 0;
+        if t < 200 {
+            b |= Buttons::RIGHT;
+        }
+        if (20..=34).contains(&t) || (70..=84).contains(&t) || (120..=134).contains(&t) {
+            b |= Buttons::JUMP;
+        }
+        Buttons(b)
+    };
+    for t in 0..HUD_TICKS {
+        game.step(&[(PlayerId(1), script(t))]);
+    }
+    let me: PlayerView = game.player(PlayerId(1)).unwrap();
+    let total = level
+        .entities
+        .iter()
+        .filter(|e| matches!(e.kind, EntityKind::Coin))
+        .count();
+    let hud = &json["hud"];
+    assert_eq!(hud["name"], "ada", "{json}");
+    assert_eq!(hud["coins"], me.coins, "{json}");
+    assert_eq!(hud["coins_total"], total as u64, "{json}");
+    assert_eq!(hud["deaths"], me.deaths, "{json}");
+    assert_eq!(hud["run_ticks"], me.run_ticks, "{json}");
+    assert_eq!(
+        me.run_ticks as u64, HUD_TICKS,
+        "the timer ran from the first press"
+    );
+    assert_eq!(hud["net_panel"], false, "{json}");
+    assert!(hud["place"].is_null(), "{json}");
+    assert_eq!(hud["time"], "0:03.33", "{json}");
+    eprintln!("HUD: {hud}");
+
+    // The panel is drawn top-left: darker than the sky behind it.
+    let img = Png::load(&png_path);
+    let sky = rgb(&json["colors"]["sky"]);
+    let [r, g, b] = img.rgb_at(12.0, 12.0).expect("inside");
+    let lum = |c: [u8; 3]| c.iter().map(|&v| u32::from(v)).sum::<u32>();
+    assert!(lum([r, g, b]) < lum(sky), "{:?} vs sky {sky:?}", [r, g, b]);
+}

@@ -1,6 +1,8 @@
-//! The heads-up display: connection, ping, loss, fps, bandwidth,
-//! corrections, coins; a net graph of the last two seconds (round-trip time
-//! and snapshot arrivals); the controls.
+//! The heads-up display: by default our name, coins (of the level's),
+//! deaths and the run timer, and a results card once finished; behind F3
+//! the network panel (connection, ping, loss, fps, bandwidth, corrections)
+//! and a net graph of the last two seconds (round-trip time and snapshot
+//! arrivals); the controls hint, fading after the first moves.
 
 use std::collections::VecDeque;
 
@@ -11,7 +13,6 @@ use macroquad::prelude::*;
 pub const GRAPH_SECONDS: f64 = 2.0;
 
 const FONT: f32 = 18.0;
-const LINE: f32 = 20.0;
 const PANEL: Color = Color::new(0.05, 0.06, 0.1, 0.62);
 const DIM: Color = Color::new(0.75, 0.8, 0.9, 1.0);
 
@@ -100,7 +101,7 @@ impl NetGraph {
 
 /// What the HUD shows.
 pub struct HudInfo<'a> {
-    /// Connection state, one line.
+    /// Connection state, one line (in the network panel).
     pub status: &'a str,
     /// Network figures, when online.
     pub net: Option<&'a NetStats>,
@@ -108,74 +109,212 @@ pub struct HudInfo<'a> {
     pub fps: i32,
     /// The simulation tick shown.
     pub tick: u64,
-    /// Our coins.
-    pub coins: u32,
-    /// Whether we reached the goal.
-    pub won: bool,
+    /// Our name.
+    pub name: &'a str,
+    /// Our run, once we are in the game.
+    pub run: Option<RunInfo>,
+    /// The network panel and graph (F3) are shown.
+    pub show_net: bool,
+    /// The controls hint's opacity, 0..=1 (it fades after the first moves).
+    pub hint_alpha: f32,
+    /// "sound off: why", for the first seconds after the start.
+    pub sound_notice: Option<&'a str>,
+    /// Sound muted (M).
+    pub muted: bool,
+    /// The restart key's name, for the hints.
+    pub restart_key: &'a str,
 }
 
-/// Draws the HUD; the net graph too when online.
-pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
-    let mut lines: Vec<(String, Color)> = vec![(info.status.to_owned(), WHITE)];
-    match info.net {
-        Some(n) => {
-            lines.push((
-                format!(
-                    "fps {}   ping {:.1} ms   jitter {:.1} ms   loss {:.1}%",
-                    info.fps,
-                    n.rtt_ms,
-                    n.jitter_ms,
-                    n.loss * 100.0
-                ),
-                WHITE,
-            ));
-            lines.push((
-                format!(
-                    "down {:.1} kB/s   up {:.1} kB/s   {:.0} snapshots/s",
-                    n.bytes_in_per_s / 1000.0,
-                    n.bytes_out_per_s / 1000.0,
-                    n.snapshot_hz
-                ),
-                DIM,
-            ));
-            lines.push((
-                format!(
-                    "corrections {} ({:.1}/s, last {:.1} px)   input margin {:.1} ticks",
-                    n.corrections, n.corrections_per_s, n.last_correction_px, n.input_margin_ticks
-                ),
-                DIM,
-            ));
-        }
-        None => lines.push((format!("fps {}", info.fps), WHITE)),
-    }
-    let mut score = format!("coins {}   tick {}", info.coins, info.tick);
-    if info.won {
-        score.push_str("   GOAL!");
-    }
-    lines.push((score, Color::new(1.0, 0.85, 0.25, 1.0)));
+/// Our run as the HUD shows it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RunInfo {
+    /// Coins picked up in this run.
+    pub coins: u32,
+    /// Coins in the level.
+    pub coins_total: u32,
+    /// Deaths in this run.
+    pub deaths: u32,
+    /// The run's ticks (frozen at the finish).
+    pub run_ticks: u32,
+    /// Simulation ticks per second.
+    pub tick_rate: u32,
+    /// Our place once finished.
+    pub place: Option<u32>,
+}
 
+/// `ticks` at `rate` ticks a second as `m:ss.cc` (hundredths rounded
+/// down; minutes grow past 59).
+pub fn run_time(ticks: u32, rate: u32) -> String {
+    let cs = u64::from(ticks) * 100 / u64::from(rate.max(1));
+    format!("{}:{:02}.{:02}", cs / 6000, cs / 100 % 60, cs % 100)
+}
+
+/// `1st`, `2nd`, `3rd`, `4th`, ... `11th`, `21st`.
+pub fn ordinal(n: u32) -> String {
+    let suffix = match (n % 10, n % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{n}{suffix}")
+}
+
+const GOLD: Color = Color::new(1.0, 0.85, 0.25, 1.0);
+
+/// A panel of `lines` with its top-left corner at `(x, y)`; returns its
+/// height.
+fn panel(lines: &[(String, Color, f32)], x: f32, y: f32) -> f32 {
     let width = lines
         .iter()
-        .map(|(l, _)| measure_text(l, None, FONT as u16, 1.0).width)
+        .map(|(l, _, size)| measure_text(l, None, *size as u16, 1.0).width)
         .fold(0.0, f32::max);
-    draw_rectangle(
-        8.0,
-        8.0,
-        width + 16.0,
-        lines.len() as f32 * LINE + 10.0,
-        PANEL,
+    let height: f32 = lines.iter().map(|(_, _, size)| size + 2.0).sum::<f32>() + 10.0;
+    draw_rectangle(x, y, width + 16.0, height, PANEL);
+    let mut baseline = y + 5.0;
+    for (l, c, size) in lines {
+        baseline += size + 2.0;
+        draw_text(l, x + 8.0, baseline - size * 0.22, *size, *c);
+    }
+    height
+}
+
+/// Draws the HUD: our name, coins, deaths and run timer; the network
+/// panel and graph when `show_net`; the controls hint; the results card
+/// once finished; sound notices.
+pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
+    let mut lines: Vec<(String, Color, f32)> = vec![(info.name.to_owned(), WHITE, 22.0)];
+    if let Some(run) = &info.run {
+        lines.push((
+            format!(
+                "coins {}/{}   deaths {}   {}",
+                run.coins,
+                run.coins_total,
+                run.deaths,
+                run_time(run.run_ticks, run.tick_rate)
+            ),
+            GOLD,
+            FONT,
+        ));
+    }
+    lines.push((format!("restart: {}", info.restart_key), DIM, 14.0));
+    let mut y = 8.0 + panel(&lines, 8.0, 8.0) + 6.0;
+    if info.muted {
+        y += panel(&[("muted (M)".to_owned(), DIM, 14.0)], 8.0, y) + 6.0;
+    }
+    if let Some(notice) = info.sound_notice {
+        y += panel(&[(notice.to_owned(), DIM, 14.0)], 8.0, y) + 6.0;
+    }
+    if info.show_net {
+        let mut net: Vec<(String, Color, f32)> = vec![(info.status.to_owned(), WHITE, FONT)];
+        match info.net {
+            Some(n) => {
+                net.push((
+                    format!(
+                        "fps {}   ping {:.1} ms   jitter {:.1} ms   loss {:.1}%",
+                        info.fps,
+                        n.rtt_ms,
+                        n.jitter_ms,
+                        n.loss * 100.0
+                    ),
+                    WHITE,
+                    FONT,
+                ));
+                net.push((
+                    format!(
+                        "down {:.1} kB/s   up {:.1} kB/s   {:.0} snapshots/s",
+                        n.bytes_in_per_s / 1000.0,
+                        n.bytes_out_per_s / 1000.0,
+                        n.snapshot_hz
+                    ),
+                    DIM,
+                    FONT,
+                ));
+                net.push((
+                    format!(
+                        "corrections {} ({:.1}/s, last {:.1} px)   input margin {:.1} ticks",
+                        n.corrections,
+                        n.corrections_per_s,
+                        n.last_correction_px,
+                        n.input_margin_ticks
+                    ),
+                    DIM,
+                    FONT,
+                ));
+            }
+            None => net.push((format!("fps {}", info.fps), WHITE, FONT)),
+        }
+        net.push((format!("tick {}", info.tick), DIM, FONT));
+        panel(&net, 8.0, y);
+        if info.net.is_some() {
+            graph.draw(now, screen_width() - 8.0, 8.0);
+        }
+    }
+    if let Some(run) = info.run.filter(|r| r.place.is_some()) {
+        results_card(&run, info.restart_key);
+    }
+    if info.hint_alpha > 0.0 {
+        let help = format!(
+            "arrows/WASD move   space/Z jump   down+jump drop   {} restart   M sound   F3 net   F2 HUD   Esc quit",
+            info.restart_key
+        );
+        let dims = measure_text(&help, None, 16, 1.0);
+        let (x, y) = (screen_width() - dims.width - 14.0, screen_height() - 10.0);
+        let a = info.hint_alpha.clamp(0.0, 1.0);
+        draw_rectangle(
+            x - 6.0,
+            y - 15.0,
+            dims.width + 12.0,
+            20.0,
+            Color {
+                a: PANEL.a * a,
+                ..PANEL
+            },
+        );
+        draw_text(&help, x, y, 16.0, Color { a, ..DIM });
+    }
+}
+
+/// The results card, centred: time, deaths, coins, place, how to run again.
+fn results_card(run: &RunInfo, restart_key: &str) {
+    let place = run.place.unwrap_or(0);
+    let lines = [
+        (format!("finished {}", ordinal(place)), GOLD, 30.0),
+        (run_time(run.run_ticks, run.tick_rate), WHITE, 40.0),
+        (
+            format!(
+                "deaths {}   coins {} of {}",
+                run.deaths, run.coins, run.coins_total
+            ),
+            WHITE,
+            20.0,
+        ),
+        (format!("{restart_key}: run again"), DIM, 18.0),
+    ];
+    let widest = lines
+        .iter()
+        .map(|(l, _, size)| measure_text(l, None, *size as u16, 1.0).width)
+        .fold(0.0f32, f32::max);
+    let (w, h) = (
+        widest + 48.0,
+        lines.iter().map(|l| l.2 * 1.3).sum::<f32>() + 24.0,
     );
-    for (i, (l, c)) in lines.iter().enumerate() {
-        draw_text(l, 16.0, 8.0 + 19.0 + i as f32 * LINE, FONT, *c);
+    let (x, y) = ((screen_width() - w) / 2.0, (screen_height() - h) * 0.3);
+    draw_rectangle(x, y, w, h, Color::new(0.05, 0.06, 0.1, 0.85));
+    draw_rectangle_lines(x, y, w, h, 2.0, GOLD);
+    let mut baseline = y + 12.0;
+    for (l, c, size) in &lines {
+        baseline += size * 1.3;
+        let lw = measure_text(l, None, *size as u16, 1.0).width;
+        draw_text(
+            l,
+            (screen_width() - lw) / 2.0,
+            baseline - size * 0.3,
+            *size,
+            *c,
+        );
     }
-    if info.net.is_some() {
-        graph.draw(now, screen_width() - 8.0, 8.0);
-    }
-    let help = "arrows/WASD move   space/Z jump   down+jump drop   F1 debug   F2 HUD   Esc quit";
-    let dims = measure_text(help, None, 16, 1.0);
-    let (x, y) = (screen_width() - dims.width - 14.0, screen_height() - 10.0);
-    draw_rectangle(x - 6.0, y - 15.0, dims.width + 12.0, 20.0, PANEL);
-    draw_text(help, x, y, 16.0, DIM);
 }
 
 /// Font sizes a banner tries, largest first, until its text fits the
@@ -326,8 +465,40 @@ pub fn wrap(text: &str, max: f32, width: impl Fn(&str) -> f32) -> Vec<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::{wrap, BannerLayout};
+    use super::{ordinal, run_time, wrap, BannerLayout};
     use macroquad::math::vec2;
+
+    #[test]
+    fn run_times_are_minutes_seconds_hundredths() {
+        assert_eq!(run_time(0, 60), "0:00.00");
+        assert_eq!(run_time(1, 60), "0:00.01");
+        assert_eq!(run_time(59, 60), "0:00.98");
+        assert_eq!(run_time(60, 60), "0:01.00");
+        assert_eq!(run_time(604, 60), "0:10.06");
+        assert_eq!(run_time(60 * 60 + 30, 60), "1:00.50");
+        assert_eq!(run_time(60 * 60 * 75, 60), "75:00.00");
+        assert_eq!(run_time(3, 30), "0:00.10");
+        assert_eq!(
+            run_time(u32::MAX, 0),
+            run_time(u32::MAX, 1),
+            "no division by 0"
+        );
+    }
+
+    #[test]
+    fn places_read_as_ordinals() {
+        let got: Vec<String> = [1, 2, 3, 4, 11, 12, 13, 21, 22, 101, 111]
+            .into_iter()
+            .map(ordinal)
+            .collect();
+        assert_eq!(
+            got,
+            [
+                "1st", "2nd", "3rd", "4th", "11th", "12th", "13th", "21st", "22nd", "101st",
+                "111th"
+            ]
+        );
+    }
 
     #[test]
     fn long_messages_wrap_between_words_and_never_exceed_the_width() {

@@ -19,10 +19,16 @@ up = ["Up", "W"]
 # Down + jump drops through one-way ledges.
 down = ["Down", "S"]
 jump = ["Space", "Z", "K"]
+# Restart the run: back to the spawn, timer, deaths and coins cleared.
+restart = ["R"]
+# Sound on/off.
+mute = ["M"]
 # Debug overlay: colliders, contacts and their MTVs, touched sides.
 debug = ["F1"]
-# Net graph and HUD on/off.
+# The whole HUD on/off.
 hud = ["F2"]
+# Network panel and graph on/off.
+net = ["F3"]
 quit = ["Escape"]
 "#;
 
@@ -35,20 +41,27 @@ struct KeyFile {
     up: Option<Vec<String>>,
     down: Option<Vec<String>>,
     jump: Option<Vec<String>>,
+    restart: Option<Vec<String>>,
+    mute: Option<Vec<String>>,
     debug: Option<Vec<String>>,
     hud: Option<Vec<String>>,
+    net: Option<Vec<String>>,
     quit: Option<Vec<String>>,
 }
 
 /// Keys for every action.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Bindings {
-    /// Keys holding each button, in [`Buttons`] bit order.
-    buttons: [(u8, Vec<KeyCode>); 5],
+    /// Keys holding each button, in [`Buttons`] bit order (restart last).
+    buttons: [(u8, Vec<KeyCode>); 6],
+    /// Toggles sound.
+    pub mute: Vec<KeyCode>,
     /// Toggles the debug overlay.
     pub debug: Vec<KeyCode>,
-    /// Toggles the HUD.
+    /// Toggles the whole HUD.
     pub hud: Vec<KeyCode>,
+    /// Toggles the network panel and graph.
+    pub net: Vec<KeyCode>,
     /// Quits.
     pub quit: Vec<KeyCode>,
 }
@@ -62,9 +75,12 @@ impl Default for Bindings {
                 (Buttons::UP, Vec::new()),
                 (Buttons::DOWN, Vec::new()),
                 (Buttons::JUMP, Vec::new()),
+                (Buttons::RESTART, Vec::new()),
             ],
+            mute: Vec::new(),
             debug: Vec::new(),
             hud: Vec::new(),
+            net: Vec::new(),
             quit: Vec::new(),
         };
         empty
@@ -95,19 +111,23 @@ impl Bindings {
             }
             Ok(())
         };
-        let [l, r, u, d, j] = &mut self.buttons;
+        let [l, r, u, d, j, restart] = &mut self.buttons;
         keys(file.left, &mut l.1)?;
         keys(file.right, &mut r.1)?;
         keys(file.up, &mut u.1)?;
         keys(file.down, &mut d.1)?;
         keys(file.jump, &mut j.1)?;
+        keys(file.restart, &mut restart.1)?;
+        keys(file.mute, &mut self.mute)?;
         keys(file.debug, &mut self.debug)?;
         keys(file.hud, &mut self.hud)?;
+        keys(file.net, &mut self.net)?;
         keys(file.quit, &mut self.quit)?;
         Ok(self)
     }
 
-    /// The buttons held on the keyboard right now.
+    /// The buttons held on the keyboard right now ([`Buttons::RESTART`]
+    /// too: the simulation restarts on the tick it is first held).
     pub fn held(&self) -> Buttons {
         let mut bits = 0;
         for (bit, keys) in &self.buttons {
@@ -116,6 +136,11 @@ impl Bindings {
             }
         }
         Buttons(bits)
+    }
+
+    /// The keys that restart the run.
+    pub fn restart_keys(&self) -> &[KeyCode] {
+        &self.buttons[5].1
     }
 
     /// Whether one of `keys` was pressed this frame.
@@ -251,7 +276,7 @@ pub fn key_by_name(name: &str) -> Option<KeyCode> {
 }
 
 /// Gamepads through gilrs: d-pad or left stick to move, south (A/cross)
-/// or east to jump, down + jump to drop through.
+/// or east to jump, down + jump to drop through, select to restart.
 #[cfg(feature = "gamepad")]
 pub struct Gamepads {
     gilrs: Option<gilrs::Gilrs>,
@@ -297,6 +322,9 @@ impl Gamepads {
             if pad.is_pressed(Button::South) || pad.is_pressed(Button::East) {
                 bits |= Buttons::JUMP;
             }
+            if pad.is_pressed(Button::Select) {
+                bits |= Buttons::RESTART;
+            }
         }
         Buttons(bits)
     }
@@ -329,7 +357,49 @@ mod tests {
         assert_eq!(b.buttons[0].1, [KeyCode::Left, KeyCode::A]);
         assert_eq!(b.buttons[4].1, [KeyCode::Space, KeyCode::Z, KeyCode::K]);
         assert_eq!(b.debug, [KeyCode::F1]);
+        assert_eq!(b.hud, [KeyCode::F2]);
+        assert_eq!(b.net, [KeyCode::F3]);
+        assert_eq!(b.mute, [KeyCode::M]);
+        assert_eq!(b.buttons[5], (Buttons::RESTART, vec![KeyCode::R]));
         assert_eq!(b.quit, [KeyCode::Escape]);
+    }
+
+    /// Every button bit is bound once, in bit order, and no key does two
+    /// things by default.
+    #[test]
+    fn defaults_bind_every_button_and_no_key_twice() {
+        let b = Bindings::default();
+        let bits: Vec<u8> = b.buttons.iter().map(|(bit, _)| *bit).collect();
+        assert_eq!(
+            bits,
+            [
+                Buttons::LEFT,
+                Buttons::RIGHT,
+                Buttons::UP,
+                Buttons::DOWN,
+                Buttons::JUMP,
+                Buttons::RESTART
+            ]
+        );
+        let mut all: Vec<KeyCode> = b.buttons.iter().flat_map(|(_, k)| k.clone()).collect();
+        for keys in [&b.mute, &b.debug, &b.hud, &b.net, &b.quit] {
+            all.extend(keys.iter().copied());
+        }
+        let n = all.len();
+        all.sort_by_key(|k| format!("{k:?}"));
+        all.dedup();
+        assert_eq!(all.len(), n, "a key bound twice: {all:?}");
+    }
+
+    #[test]
+    fn a_file_rebinds_restart_mute_and_net() {
+        let b = Bindings::default()
+            .with("restart = [\"Backspace\"]\nmute = [\"F9\"]\nnet = [\"Tab\"]")
+            .unwrap();
+        assert_eq!(b.buttons[5].1, [KeyCode::Backspace]);
+        assert_eq!(b.mute, [KeyCode::F9]);
+        assert_eq!(b.net, [KeyCode::Tab]);
+        assert_eq!(b.hud, [KeyCode::F2], "kept");
     }
 
     #[test]

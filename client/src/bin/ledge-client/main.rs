@@ -45,6 +45,8 @@ use std::sync::atomic::{AtomicI32, Ordering};
 use std::time::{Duration, Instant};
 
 use clap::Parser;
+use ledge_client::audio::{Audio, AudioStatus};
+use ledge_client::cues::Cues;
 use ledge_client::view::px2;
 use ledge_client::{Fingerprint, OnlineRequest, Trust};
 use ledge_shared::fixed::UNITS_PER_PX;
@@ -55,6 +57,33 @@ use camera::Camera;
 use keys::{Bindings, Gamepads};
 use render::{EntitySprite, PlayerSprite};
 use script::Script;
+
+/// How long "sound off: why" stays on screen, seconds from the start.
+const SOUND_NOTICE_SECONDS: f64 = 6.0;
+
+/// The controls hint stays this long after the first move, then fades
+/// out over [`HINT_FADE`] seconds.
+const HINT_STAYS: f64 = 4.0;
+const HINT_FADE: f64 = 1.5;
+
+/// The controls hint's opacity at `now`, the player having first moved at
+/// `first_move`.
+fn hint_alpha(first_move: Option<f64>, now: f64) -> f32 {
+    match first_move {
+        None => 1.0,
+        Some(t) => (1.0 - (now - t - HINT_STAYS) / HINT_FADE).clamp(0.0, 1.0) as f32,
+    }
+}
+
+/// Coins in `level`.
+fn coins_total(level: &ledge_shared::level::Level) -> u32 {
+    let coins = level
+        .entities
+        .iter()
+        .filter(|e| matches!(e.kind, ledge_shared::level::EntityKind::Coin))
+        .count();
+    u32::try_from(coins).unwrap_or(u32::MAX)
+}
 
 /// Frames are not drawn faster than this (no vsync under Xvfb).
 const MAX_FPS: f64 = 240.0;
@@ -97,8 +126,8 @@ static EXIT_CODE: AtomicI32 = AtomicI32::new(0);
 ///
 /// Keys (rebind with --keys FILE; --print-keys shows the defaults): arrows
 /// or WASD move, space, Z or K jump, down + jump drops through one-way
-/// ledges, F1 debug overlay, F2 HUD, Esc quits. Gamepads need the
-/// `gamepad` build feature.
+/// ledges, R restarts the run, M mutes, F1 debug overlay, F2 HUD on/off,
+/// F3 network panel, Esc quits. Gamepads need the `gamepad` build feature.
 #[derive(Debug, Parser)]
 #[command(version, after_help = EXIT_CODES)]
 struct Cli {
@@ -179,6 +208,16 @@ struct Cli {
     /// Start with the debug overlay (F1) on.
     #[arg(long)]
     debug: bool,
+    /// Start with the network panel and graph (F3) on.
+    #[arg(long)]
+    net: bool,
+    /// Sound volume, 0 to 100.
+    #[arg(long, value_name = "0..=100", default_value_t = 80,
+          value_parser = clap::value_parser!(u8).range(0..=100))]
+    volume: u8,
+    /// Start with sound muted (M toggles it).
+    #[arg(long)]
+    mute: bool,
     /// Window size, WIDTHxHEIGHT.
     #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = parse_size)]
     window: (i32, i32),
@@ -246,6 +285,10 @@ struct Setup {
     join_timeout: Duration,
     name: String,
     debug: bool,
+    net: bool,
+    /// Volume, 0..=1.
+    volume: f32,
+    mute: bool,
     look_at: Option<Vec2>,
     /// The level's art (textures are made when the window exists).
     level_art: ledge_levels::art::LevelArt,
@@ -361,6 +404,9 @@ fn run() -> anyhow::Result<()> {
         join_timeout: Duration::from_secs(cli.join_timeout),
         name: cli.name,
         debug: cli.debug,
+        net: cli.net,
+        volume: f32::from(cli.volume) / 100.0,
+        mute: cli.mute,
         look_at: cli.look_at.map(|(x, y)| vec2(x, y)),
         level_art,
         server,
@@ -450,6 +496,23 @@ async fn game(mut setup: Setup) {
     let mut graph = hud::NetGraph::default();
     let mut show_debug = setup.debug;
     let mut show_hud = true;
+    let mut show_net = setup.net;
+    // Sound: never fails; without a device it is off and says why.
+    let audio = Audio::start();
+    audio.set_volume(setup.volume);
+    audio.set_muted(setup.mute);
+    let sound_off = match audio.status() {
+        AudioStatus::Off { .. } => Some(audio.status().to_string()),
+        AudioStatus::Playing { .. } => None,
+    };
+    let mut cues = Cues::default();
+    // When the player first moved (the controls hint fades after it).
+    let mut first_move: Option<f64> = None;
+    let restart_key = setup
+        .bindings
+        .restart_keys()
+        .first()
+        .map_or_else(|| "-".to_owned(), |k| format!("{k:?}"));
     // Ticks of play so far: the script's clock and --exit-after-ticks'.
     let mut played: u64 = 0;
     let mut last_frame = Instant::now();
@@ -481,6 +544,12 @@ async fn game(mut setup: Setup) {
         if Bindings::pressed(&setup.bindings.hud) {
             show_hud = !show_hud;
         }
+        if Bindings::pressed(&setup.bindings.net) {
+            show_net = !show_net;
+        }
+        if Bindings::pressed(&setup.bindings.mute) {
+            audio.toggle_mute();
+        }
         let now = started.elapsed().as_secs_f64();
         let frame = last_frame.elapsed();
         last_frame = Instant::now();
@@ -492,10 +561,24 @@ async fn game(mut setup: Setup) {
         let script = &setup.script;
         let bindings = &setup.bindings;
         let base = played;
-        played += setup.play.update(remaining, |i| match script {
-            Some(script) => script.at(base + i),
-            None => Buttons(bindings.held().0 | pads.held().0),
+        let mut moved = false;
+        played += setup.play.update(remaining, |i| {
+            let b = match script {
+                Some(script) => script.at(base + i),
+                None => Buttons(bindings.held().0 | pads.held().0),
+            };
+            moved |= b.0 & Buttons::PLAY != 0;
+            b
         });
+        if moved && first_move.is_none() {
+            first_move = Some(now);
+        }
+        // Sounds from what changed since the last frame.
+        if let Some(g) = setup.play.game() {
+            for effect in cues.observe(g.game(), g.me()) {
+                audio.play(effect);
+            }
+        }
         for _ in 0..setup.play.take_arrivals() {
             graph.arrival(now);
         }
@@ -585,6 +668,19 @@ async fn game(mut setup: Setup) {
         }
         // A failure covers the scene; the HUD's figures mean nothing then.
         let failure = failed.as_deref().map(hud::failure);
+        let run = me.as_ref().map(|m| hud::RunInfo {
+            coins: m.coins,
+            coins_total: coins_total(level),
+            deaths: m.deaths,
+            run_ticks: m.run_ticks,
+            tick_rate: setup.play.tick_rate(),
+            place: m.place,
+        });
+        let name = local
+            .as_ref()
+            .and_then(|p| p.name.as_deref())
+            .unwrap_or(&setup.name)
+            .to_owned();
         if show_hud && failure.is_none() {
             let status = setup.play.status_line();
             let info = hud::HudInfo {
@@ -592,8 +688,13 @@ async fn game(mut setup: Setup) {
                 net: stats.as_ref(),
                 fps: get_fps(),
                 tick: frame_view.tick,
-                coins: me.as_ref().map_or(0, |m| m.coins),
-                won: me.as_ref().is_some_and(|m| m.won),
+                name: &name,
+                run,
+                show_net,
+                hint_alpha: hint_alpha(first_move, now),
+                sound_notice: sound_off.as_deref().filter(|_| now < SOUND_NOTICE_SECONDS),
+                muted: audio.is_muted(),
+                restart_key: &restart_key,
             };
             hud::draw(&info, &graph, now);
         }
@@ -628,6 +729,13 @@ async fn game(mut setup: Setup) {
                             size: p.size,
                         })
                         .collect(),
+                    hud: (show_hud && failure.is_none()).then(|| shot::HudShot {
+                        name: &name,
+                        run,
+                        net_panel: show_net,
+                        muted: audio.is_muted(),
+                        sound_notice: sound_off.as_deref().filter(|_| now < SOUND_NOTICE_SECONDS),
+                    }),
                     failure: failed.as_deref().zip(failure.as_ref()),
                 };
                 if let Err(e) = shot::save(path, &shot) {

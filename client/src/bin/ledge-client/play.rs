@@ -172,6 +172,13 @@ impl Play {
         }
     }
 
+    /// Simulation ticks per second (the server's; 60 offline).
+    pub fn tick_rate(&self) -> u32 {
+        self.game()
+            .and_then(ClientGame::welcome)
+            .map_or(60, |w| w.timing.tick_rate)
+    }
+
     /// Our predicted player.
     pub fn me(&self) -> Option<PlayerView> {
         let g = self.game()?;

@@ -8,7 +8,7 @@
 //!   after joining, or the first offline tick), starting at 0: `N` (one
 //!   tick), `N-M` (inclusive) or `N..M` (`M` excluded);
 //! * `BUTTONS` is a list of `left`, `right`, `up`, `down`, `jump` (or
-//!   `l r u d j`) joined by `+`, `,` or spaces; `none` or `-` for nothing.
+//!   `l r u d j`), `restart` joined by `+`, `,` or spaces; `none` or `-` for nothing.
 //!
 //! Ticks no entry covers hold nothing; where entries overlap, their buttons
 //! combine. `#` starts a comment.
@@ -120,10 +120,11 @@ fn parse_buttons(s: &str) -> Result<u8, String> {
             "up" | "u" => Buttons::UP,
             "down" | "d" => Buttons::DOWN,
             "jump" | "j" => Buttons::JUMP,
+            "restart" => Buttons::RESTART,
             "none" | "-" => 0,
             other => {
                 return Err(format!(
-                    "unknown button {other:?} (left, right, up, down, jump, none)"
+                    "unknown button {other:?} (left, right, up, down, jump, restart, none)"
                 ))
             }
         };

@@ -24,6 +24,12 @@
 //!   ],
 //!   "colors": {"sky": [r, g, b], "solid": [...], "grass": [...],
 //!              "local_player": [...], "one_way": [...]},
+//!   "hud": {                           // null when hidden (F2) or failed
+//!     "name": "ada", "coins": 2, "coins_total": 10, "deaths": 1,
+//!     "run_ticks": 412, "tick_rate": 60, "time": "0:06.86",
+//!     "place": null, "results_card": false,
+//!     "net_panel": false, "muted": false, "sound_notice": "sound off: ..."
+//!   },
 //!   "failure": {                       // null unless the session failed
 //!     "message": "cannot join ...",    // as printed on stderr
 //!     "font_size": 20.0,
@@ -62,8 +68,24 @@ pub struct Shot<'a> {
     pub drawn: Option<Vec2>,
     /// The other players drawn.
     pub remotes: Vec<RemoteShot<'a>>,
+    /// The HUD as drawn (`None` when hidden).
+    pub hud: Option<HudShot<'a>>,
     /// The session's failure and its banner as drawn, if it failed.
     pub failure: Option<(&'a str, &'a BannerLayout)>,
+}
+
+/// What the HUD showed.
+pub struct HudShot<'a> {
+    /// The name shown.
+    pub name: &'a str,
+    /// Our run (`None` before we are in the game).
+    pub run: Option<crate::hud::RunInfo>,
+    /// The network panel was shown.
+    pub net_panel: bool,
+    /// The muted marker was shown.
+    pub muted: bool,
+    /// The sound notice shown, if any.
+    pub sound_notice: Option<&'a str>,
 }
 
 /// A remote player as drawn.
@@ -194,6 +216,32 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
         rgb(palette::LOCAL_PLAYER),
         rgb(palette::PLANK),
     );
+    match &shot.hud {
+        Some(h) => {
+            let _ = writeln!(s, "  \"hud\": {{");
+            let _ = writeln!(s, "    \"name\": {},", json_string(h.name));
+            if let Some(r) = &h.run {
+                let _ = writeln!(s, "    \"coins\": {},", r.coins);
+                let _ = writeln!(s, "    \"coins_total\": {},", r.coins_total);
+                let _ = writeln!(s, "    \"deaths\": {},", r.deaths);
+                let _ = writeln!(s, "    \"run_ticks\": {},", r.run_ticks);
+                let _ = writeln!(s, "    \"tick_rate\": {},", r.tick_rate);
+                let time = crate::hud::run_time(r.run_ticks, r.tick_rate);
+                let _ = writeln!(s, "    \"time\": {},", json_string(&time));
+                let place = r.place.map_or("null".to_owned(), |p| p.to_string());
+                let _ = writeln!(s, "    \"place\": {place},");
+                let _ = writeln!(s, "    \"results_card\": {},", r.place.is_some());
+            }
+            let _ = writeln!(s, "    \"net_panel\": {},", h.net_panel);
+            let _ = writeln!(s, "    \"muted\": {},", h.muted);
+            let notice = h.sound_notice.map_or("null".to_owned(), json_string);
+            let _ = writeln!(s, "    \"sound_notice\": {notice}");
+            let _ = writeln!(s, "  }},");
+        }
+        None => {
+            let _ = writeln!(s, "  \"hud\": null,");
+        }
+    }
     match shot.failure {
         Some((message, layout)) => {
             let p = layout.panel;
@@ -247,9 +295,35 @@ mod tests {
                 pos: Vec2::new(10.0, 20.0),
                 size: Vec2::new(12.0, 16.0),
             }],
+            hud: Some(HudShot {
+                name: "ada \"x\"",
+                run: Some(crate::hud::RunInfo {
+                    coins: 2,
+                    coins_total: 10,
+                    deaths: 1,
+                    run_ticks: 604,
+                    tick_rate: 60,
+                    place: None,
+                }),
+                net_panel: false,
+                muted: true,
+                sound_notice: None,
+            }),
             failure: None,
         };
         let json = describe(&shot, Path::new("/tmp/a.png"), 960, 540);
+        let parsed: serde_json::Value = serde_json::from_str(&json).expect("JSON");
+        let hud = &parsed["hud"];
+        assert_eq!(hud["name"], "ada \"x\"");
+        assert_eq!(hud["coins"], 2);
+        assert_eq!(hud["coins_total"], 10);
+        assert_eq!(hud["deaths"], 1);
+        assert_eq!(hud["run_ticks"], 604);
+        assert_eq!(hud["time"], "0:10.06");
+        assert!(hud["place"].is_null());
+        assert_eq!(hud["net_panel"], false);
+        assert_eq!(hud["muted"], true);
+        assert!(hud["sound_notice"].is_null());
         assert!(
             json.contains("\"server_screen\": [190.000, 80.000]"),
             "{json}"
@@ -290,6 +364,7 @@ mod tests {
             server: None,
             drawn: None,
             remotes: Vec::new(),
+            hud: None,
             failure: Some((message, &layout)),
         };
         let json: serde_json::Value =
