@@ -14,6 +14,8 @@ use clap::Parser;
 use ledge_shared::protocol::{MAX_LEVEL_BUNDLE, MAX_ROOMS};
 use serde::Deserialize;
 
+use ledge_shared::game::{GameConfig, MAX_RESPAWN_DELAY_TICKS};
+
 use crate::admission::AdmissionConfig;
 
 /// Default UDP address the server listens on.
@@ -46,6 +48,11 @@ pub const DEFAULT_MAX_CATCH_UP: u32 = 15;
 /// Default QUIC idle timeout: a connection with no traffic for this long is
 /// dropped (clients send keep-alives every [`DEFAULT_IDLE_TIMEOUT`] / 3).
 pub const DEFAULT_IDLE_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Default time a dead player waits before it respawns.
+pub const DEFAULT_RESPAWN_DELAY: Duration = Duration::from_millis(400);
+/// Longest respawn delay.
+pub const MAX_RESPAWN_DELAY: Duration = Duration::from_secs(10);
 
 /// Per-client rate limits and abuse thresholds (the file's `[limits]`).
 ///
@@ -140,6 +147,9 @@ pub struct ServerConfig {
     pub limits: Limits,
     /// Limits on new connections: per address, before the hello.
     pub admission: AdmissionConfig,
+    /// How long a player who died stays dead before it respawns at its
+    /// checkpoint (rounded to whole ticks; clients learn it in `Welcome`).
+    pub respawn_delay: Duration,
     /// Record each room's match (inputs, joins and leaves, state hash per
     /// tick) for its first this many ticks; `None` (the default): off. Set
     /// programmatically (tests, tools); read with
@@ -168,12 +178,22 @@ impl Default for ServerConfig {
             idle_kick: DEFAULT_IDLE_KICK,
             limits: Limits::default(),
             admission: AdmissionConfig::default(),
+            respawn_delay: DEFAULT_RESPAWN_DELAY,
             record_ticks: None,
         }
     }
 }
 
 impl ServerConfig {
+    /// The game's configuration: the defaults with this server's respawn
+    /// delay in ticks.
+    pub fn game_config(&self) -> GameConfig {
+        let mut game = GameConfig::default();
+        let ticks = (self.respawn_delay.as_secs_f64() * f64::from(self.tick_rate)).round();
+        game.player.respawn_delay_ticks = ticks.min(f64::from(u16::MAX)) as u16;
+        game
+    }
+
     /// Ticks between two snapshots: `tick_rate / snapshot_rate`, rounded to
     /// the nearest whole tick, at least 1.
     pub fn snapshot_interval(&self) -> u32 {
@@ -221,6 +241,13 @@ impl ServerConfig {
         }
         if self.reconnect_grace > Duration::from_secs(3600) {
             return bad("reconnect_grace must be at most 3600 s");
+        }
+        let delay_ticks = self.game_config().player.respawn_delay_ticks;
+        if self.respawn_delay > MAX_RESPAWN_DELAY || delay_ticks > MAX_RESPAWN_DELAY_TICKS {
+            return Err(ConfigError::Invalid(format!(
+                "respawn_delay must be at most {} s and {MAX_RESPAWN_DELAY_TICKS} ticks",
+                MAX_RESPAWN_DELAY.as_secs()
+            )));
         }
         if self.idle_timeout < Duration::from_millis(100) {
             return bad("idle_timeout must be at least 0.1 s");
@@ -336,6 +363,10 @@ pub struct Cli {
     /// the address holding the most is closed for a newcomer [default: 32].
     #[arg(long, value_name = "N")]
     pub max_pending: Option<usize>,
+    /// Seconds a player who died stays dead before it respawns at its
+    /// checkpoint, at most 10 [default: 0.4].
+    #[arg(long, value_name = "SECONDS")]
+    pub respawn_delay: Option<f64>,
     /// Seconds a new connection has to finish its QUIC handshake and send
     /// its hello [default: 2].
     #[arg(long, value_name = "SECONDS")]
@@ -381,6 +412,8 @@ struct FileConfig {
     reconnect_grace: Option<f64>,
     /// Seconds.
     idle_kick: Option<f64>,
+    /// Seconds.
+    respawn_delay: Option<f64>,
     limits: Option<Limits>,
     admission: Option<FileAdmission>,
 }
@@ -466,6 +499,9 @@ impl Cli {
         }
         if let Some(secs) = file.idle_kick {
             c.idle_kick = seconds(secs, "idle_kick")?;
+        }
+        if let Some(secs) = self.respawn_delay.or(file.respawn_delay) {
+            c.respawn_delay = seconds(secs, "respawn_delay")?;
         }
         if let Some(secs) = self.reconnect_grace.or(file.reconnect_grace) {
             c.reconnect_grace = seconds(secs, "reconnect_grace")?;
@@ -727,6 +763,28 @@ datagrams_per_second = 500.0
             .resolve()
             .unwrap_err();
         assert!(matches!(err, ConfigError::Parse { .. }), "{err}");
+    }
+
+    #[test]
+    fn the_respawn_delay_is_whole_ticks_of_the_tick_rate() {
+        let c = cli(&[]).resolve().unwrap();
+        assert_eq!(c.game_config().player.respawn_delay_ticks, 24);
+        let c = cli(&[
+            "--respawn-delay",
+            "1",
+            "--tick-rate",
+            "120",
+            "--snapshot-rate",
+            "30",
+        ])
+        .resolve()
+        .unwrap();
+        assert_eq!(c.game_config().player.respawn_delay_ticks, 120);
+        assert!(c.game_config().player.validate().is_ok());
+        let c = cli(&["--respawn-delay", "0"]).resolve().unwrap();
+        assert_eq!(c.game_config().player.respawn_delay_ticks, 0);
+        let err = cli(&["--respawn-delay", "11"]).resolve().unwrap_err();
+        assert!(matches!(err, ConfigError::Invalid(_)), "{err}");
     }
 
     #[test]

@@ -227,7 +227,7 @@ impl Server {
     pub fn bind(config: ServerConfig) -> Result<Server, ServerError> {
         config.validate()?;
         let bundle = levels::load(config.level.as_deref(), config.level_settings.as_deref())?;
-        Game::from_level(&bundle.level)?;
+        Game::with_config(&bundle.level, config.game_config())?;
         let bundle_bytes = bundle.encode();
         if bundle_bytes.len() as u64 > config.max_level_mib << 20 {
             return Err(ServerError::LevelTooLarge {
@@ -371,7 +371,7 @@ impl Server {
         };
         let level_id = template.level_id.clone();
         let rooms = Rooms::new(
-            Game::from_level(&level)?,
+            Game::with_config(&level, config.game_config())?,
             template,
             config.max_rooms as usize,
             metrics.clone(),
