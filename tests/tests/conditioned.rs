@@ -115,7 +115,10 @@ const LOSS: f64 = 0.05;
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn at_150_ms_rtt_25_ms_jitter_and_5_percent_loss_play_stays_smooth() {
-    let server = TestServer::start().await;
+    // The pacer runs into the spikes now and then: a dead player stands
+    // still for the respawn delay, which is not a frozen drawing, so it
+    // respawns at once here.
+    let server = TestServer::start_with(|c| c.respawn_delay = Duration::ZERO).await;
     let link = LinkConfig::delay(ONE_WAY)
         .with_jitter(JITTER)
         .with_loss(Loss::Bernoulli { p: LOSS });
