@@ -41,7 +41,8 @@ pub const DEFAULT_RECONNECT_GRACE: Duration = Duration::from_secs(30);
 /// Default largest level bundle the server offers, MiB: a level (with its
 /// art) that encodes bigger is refused at start.
 pub const DEFAULT_MAX_LEVEL_MIB: u64 = 32;
-/// Default most simultaneous connections (players and handshakes).
+/// Default most joined connections (players, room listings); connections
+/// before their hello have a pool of their own ([`AdmissionConfig::pending`]).
 pub const DEFAULT_MAX_CONNECTIONS: usize = 256;
 /// Default bound on ticks run back to back after a stall (0.25 s at 60 Hz).
 pub const DEFAULT_MAX_CATCH_UP: u32 = 15;
@@ -124,7 +125,9 @@ pub struct ServerConfig {
     /// it while fewer are open (it closes once empty for a while). At least
     /// `rooms`, at most [`MAX_ROOMS`].
     pub max_rooms: u32,
-    /// Most simultaneous connections; more are refused at once.
+    /// Most joined connections; a newcomer while this many have joined is
+    /// refused at its first packet. Connections before their hello are
+    /// limited by [`ServerConfig::admission`].
     pub max_connections: usize,
     /// Largest level bundle (level and art, as clients download it), MiB;
     /// a bigger one stops the server at start. At most
