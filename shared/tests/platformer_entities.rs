@@ -5,26 +5,11 @@ mod platformer_kit;
 
 use glam::IVec2;
 use ledge_shared::game::{EntityType, GameEvent, HurtCause, ENTITY_ID_BASE, FALL_MARGIN};
-use ledge_shared::level::{EntityDef, EntityKind, Level};
+use ledge_shared::level::{EntityDef, EntityKind};
 use ledge_shared::protocol::PlayerId;
 use platformer_kit::*;
 
 const P1: PlayerId = PlayerId(1);
-
-/// A room 40 x 14 tiles, floor top at row 13, with `extra` rows patched in
-/// (row index, column, string).
-fn room(patches: &[(usize, usize, &str)], entities: Vec<EntityDef>) -> Level {
-    let mut rows = vec!["#".repeat(40)];
-    for _ in 0..12 {
-        rows.push(format!("#{}#", ".".repeat(38)));
-    }
-    rows.push("#".repeat(40));
-    for &(r, c, s) in patches {
-        rows[r].replace_range(c..c + s.len(), s);
-    }
-    let rows: Vec<&str> = rows.iter().map(|s| s.as_str()).collect();
-    level(&rows, entities)
-}
 
 const FLOOR: i32 = 13 * T;
 

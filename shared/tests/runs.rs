@@ -11,7 +11,7 @@ use ledge_shared::game::{
     MAX_RESPAWN_DELAY_TICKS, RUN_ID_BASE,
 };
 use ledge_shared::input::Buttons;
-use ledge_shared::level::{EntityDef, EntityKind, Level};
+use ledge_shared::level::{EntityKind, Level};
 use ledge_shared::protocol::{decode_delta, encode_delta, EntityState, PlayerId, StateSnapshot};
 use platformer_kit::*;
 
@@ -22,21 +22,6 @@ const UP: Buttons = Buttons(Buttons::UP);
 
 /// The floor's top: row 13.
 const FLOOR: i32 = 13 * T;
-
-/// A room 40 x 14 tiles, floor top at row 13, with `patches` (row, column,
-/// string) applied to the map.
-fn room(patches: &[(usize, usize, &str)], entities: Vec<EntityDef>) -> Level {
-    let mut rows = vec!["#".repeat(40)];
-    for _ in 0..12 {
-        rows.push(format!("#{}#", ".".repeat(38)));
-    }
-    rows.push("#".repeat(40));
-    for &(r, c, s) in patches {
-        rows[r].replace_range(c..c + s.len(), s);
-    }
-    let rows: Vec<&str> = rows.iter().map(|s| s.as_str()).collect();
-    level(&rows, entities)
-}
 
 /// The centre of a player standing on the floor in the tile of column `c`
 /// (where a checkpoint or spawn of one tile at row 12 puts it).

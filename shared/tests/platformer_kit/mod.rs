@@ -116,6 +116,21 @@ pub fn level(rows: &[&str], entities: Vec<EntityDef>) -> Level {
     }
 }
 
+/// A room 40 x 14 tiles (walls all round, floor top at row 13), with
+/// `patches` (row, column, string) applied to the map, and entities.
+pub fn room(patches: &[(usize, usize, &str)], entities: Vec<EntityDef>) -> Level {
+    let mut rows = vec!["#".repeat(40)];
+    for _ in 0..12 {
+        rows.push(format!("#{}#", ".".repeat(38)));
+    }
+    rows.push("#".repeat(40));
+    for &(r, c, s) in patches {
+        rows[r].replace_range(c..c + s.len(), s);
+    }
+    let rows: Vec<&str> = rows.iter().map(|s| s.as_str()).collect();
+    level(&rows, entities)
+}
+
 /// A level from a map at the origin with tiles of `size` units, and
 /// entities.
 pub fn level_sized(size: i32, rows: &[&str], entities: Vec<EntityDef>) -> Level {
