@@ -211,6 +211,9 @@ struct Cli {
     /// Start with the network panel and graph (F3) on.
     #[arg(long)]
     net: bool,
+    /// Start with the whole HUD (F2) off: clean screenshots of the level.
+    #[arg(long)]
+    no_hud: bool,
     /// Sound volume, 0 to 100.
     #[arg(long, value_name = "0..=100", default_value_t = 80,
           value_parser = clap::value_parser!(u8).range(0..=100))]
@@ -286,6 +289,8 @@ struct Setup {
     name: String,
     debug: bool,
     net: bool,
+    /// Start with the HUD shown.
+    hud: bool,
     /// Volume, 0..=1.
     volume: f32,
     mute: bool,
@@ -405,6 +410,7 @@ fn run() -> anyhow::Result<()> {
         name: cli.name,
         debug: cli.debug,
         net: cli.net,
+        hud: !cli.no_hud,
         volume: f32::from(cli.volume) / 100.0,
         mute: cli.mute,
         look_at: cli.look_at.map(|(x, y)| vec2(x, y)),
@@ -495,7 +501,7 @@ async fn game(mut setup: Setup) {
     let mut pads = Gamepads::new();
     let mut graph = hud::NetGraph::default();
     let mut show_debug = setup.debug;
-    let mut show_hud = true;
+    let mut show_hud = setup.hud;
     let mut show_net = setup.net;
     // Sound: never fails; without a device it is off and says why.
     let audio = Audio::start();
