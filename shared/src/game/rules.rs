@@ -312,16 +312,24 @@ impl Game {
         self.world
             .set_position(p.body, pos)
             .expect("respawn point in bounds");
+        self.still(p, true);
+        p.st.dead = 0;
+        self.events.push(GameEvent::Respawned { player: p.id, pos });
+    }
+
+    /// Stops player `p`'s body (no velocity, not dropping through, its
+    /// controller cleared) and enables it (alive) or suspends it (dead).
+    fn still(&mut self, p: &mut Player, enabled: bool) {
         self.world
             .set_velocity(p.body, IVec2::ZERO)
             .expect("zero velocity");
         self.world
             .set_drop_through(p.body, false)
             .expect("player body");
-        self.world.set_enabled(p.body, true).expect("player body");
+        self.world
+            .set_enabled(p.body, enabled)
+            .expect("player body");
         clear_controller(&mut p.st);
-        p.st.dead = 0;
-        self.events.push(GameEvent::Respawned { player: p.id, pos });
     }
 
     /// Player `p` dies of `cause`: counted (unless its run finished), then
@@ -340,14 +348,7 @@ impl Game {
             self.respawn(p);
             return;
         }
-        self.world
-            .set_velocity(p.body, IVec2::ZERO)
-            .expect("zero velocity");
-        self.world
-            .set_drop_through(p.body, false)
-            .expect("player body");
-        self.world.set_enabled(p.body, false).expect("player body");
-        clear_controller(&mut p.st);
+        self.still(p, false);
         p.st.dead = delay;
     }
 
