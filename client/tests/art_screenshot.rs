@@ -102,20 +102,14 @@ fn run_client(xvfb: &Path, map: &Path, look_at: (f64, f64), name: &str) -> (Png,
         .unwrap_or_else(|| out.path().to_owned());
     std::fs::create_dir_all(&dir).unwrap();
     let png_path = dir.join(name);
-    let mut command = Command::new(xvfb);
+    let mut command =
+        common::client_under_xvfb(xvfb, env!("CARGO_BIN_EXE_ledge-client"), 10, &png_path);
     command
-        .args(["-a", "-s", "-screen 0 1280x720x24"])
-        .arg(env!("CARGO_BIN_EXE_ledge-client"))
         .arg("--level")
         .arg(map)
-        .args(["--exit-after-ticks", "10"])
-        .arg("--screenshot")
-        .arg(&png_path)
         .args(["--look-at", &format!("{},{}", look_at.0, look_at.1)])
-        .args(["--window", "960x540"])
         // The level's art is compared cell by cell: nothing drawn over it.
-        .arg("--no-hud")
-        .env("LIBGL_ALWAYS_SOFTWARE", "1");
+        .arg("--no-hud");
     let out = run_to_end(command, CLIENT_TIMEOUT);
     let status = out.status;
     assert!(

@@ -10,7 +10,6 @@
 use std::net::SocketAddr;
 mod common;
 
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 use common::{pair, run_to_end, xvfb_run, Png};
@@ -111,19 +110,13 @@ fn the_client_draws_the_level_and_our_player_where_the_server_says() {
         .unwrap_or_else(|| out.path().to_owned());
     std::fs::create_dir_all(&dir).unwrap();
     let png_path = dir.join("shot.png");
-    let mut command = Command::new(xvfb);
+    let mut command =
+        common::client_under_xvfb(&xvfb, env!("CARGO_BIN_EXE_ledge-client"), TICKS, &png_path);
     command
-        .args(["-a", "-s", "-screen 0 1280x720x24"])
-        .arg(env!("CARGO_BIN_EXE_ledge-client"))
         .args(["--connect", &addr.to_string()])
         .args(["--cert-hash", &fingerprint.to_string()])
         .args(["--name", "shot"])
-        .args(["--script", SCRIPT])
-        .args(["--exit-after-ticks", &TICKS.to_string()])
-        .arg("--screenshot")
-        .arg(&png_path)
-        .args(["--window", "960x540"])
-        .env("LIBGL_ALWAYS_SOFTWARE", "1");
+        .args(["--script", SCRIPT]);
     let out = run_to_end(command, CLIENT_TIMEOUT);
     let status = out.status;
     runtime.block_on(bob.close());
@@ -361,17 +354,15 @@ fn the_default_hud_shows_name_coins_deaths_and_timer_as_the_simulation_says() {
     let out = tempfile::tempdir().unwrap();
     let dir = common::screenshot_dir(out.path());
     let png_path = dir.join("hud.png");
-    let mut command = Command::new(xvfb);
+    let mut command = common::client_under_xvfb(
+        &xvfb,
+        env!("CARGO_BIN_EXE_ledge-client"),
+        HUD_TICKS,
+        &png_path,
+    );
     command
-        .args(["-a", "-s", "-screen 0 1280x720x24"])
-        .arg(env!("CARGO_BIN_EXE_ledge-client"))
         .args(["--name", "ada"])
-        .args(["--script", HUD_SCRIPT])
-        .args(["--exit-after-ticks", &HUD_TICKS.to_string()])
-        .arg("--screenshot")
-        .arg(&png_path)
-        .args(["--window", "960x540"])
-        .env("LIBGL_ALWAYS_SOFTWARE", "1");
+        .args(["--script", HUD_SCRIPT]);
     let out = run_to_end(command, CLIENT_TIMEOUT);
     assert!(
         out.status.success(),

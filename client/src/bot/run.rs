@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use ledge_shared::game::state::player_flags;
+use ledge_shared::game::RUN_ID_BASE;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{NoticeKind, PlayerId};
 
@@ -85,6 +86,9 @@ pub struct BotReport {
     pub won: bool,
     /// The snapshot tick that first showed it.
     pub won_at_tick: Option<u64>,
+    /// The run's time in ticks at its first finish, as the server's run
+    /// record said.
+    pub finish_ticks: Option<u32>,
     /// The brain's progress note.
     pub progress: String,
     /// Why it stopped early (connection refused, closed by the server...).
@@ -251,6 +255,12 @@ pub async fn run_bot(
                     if mine.flags & player_flags::WON != 0 && !report.won {
                         report.won = true;
                         report.won_at_tick = Some(update.state.tick);
+                    }
+                }
+                if let Some(run) = update.state.get(RUN_ID_BASE + me.0) {
+                    // A finished run has its order; its ticks are final.
+                    if run.aux != 0 && report.finish_ticks.is_none() {
+                        report.finish_ticks = u32::try_from(run.pos.x).ok();
                     }
                 }
                 if let Some(r) = game.on_snapshot(&update) {

@@ -203,3 +203,25 @@ impl Png {
         Some([r, g, b])
     }
 }
+
+/// The client binary `bin` (the test's `env!("CARGO_BIN_EXE_ledge-client")`)
+/// under `xvfb` (a 1280x720 virtual screen), with a 960x540 window, drawn
+/// in software, taking a screenshot to `png` after `ticks` ticks of play:
+/// add the arguments of the game to play.
+pub fn client_under_xvfb(
+    xvfb: &std::path::Path,
+    bin: &str,
+    ticks: u64,
+    png: &std::path::Path,
+) -> Command {
+    let mut command = Command::new(xvfb);
+    command
+        .args(["-a", "-s", "-screen 0 1280x720x24"])
+        .arg(bin)
+        .args(["--exit-after-ticks", &ticks.to_string()])
+        .arg("--screenshot")
+        .arg(png)
+        .args(["--window", "960x540"])
+        .env("LIBGL_ALWAYS_SOFTWARE", "1");
+    command
+}

@@ -123,6 +123,30 @@ pub struct HudInfo<'a> {
     pub muted: bool,
     /// The restart key's name, for the hints.
     pub restart_key: &'a str,
+    /// The room's results: everyone in the game who finished, first place
+    /// first (drawn when someone besides us is in it).
+    pub results: &'a [ResultRow],
+}
+
+/// One line of the room's results table.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ResultRow {
+    /// 1: first.
+    pub place: u32,
+    /// The player's name (or `player #ID` until the roster says).
+    pub name: String,
+    /// The run's time, ticks.
+    pub ticks: u32,
+    /// Deaths in the run.
+    pub deaths: u32,
+    /// Our own run.
+    pub ours: bool,
+}
+
+/// Whether the room's results table is worth drawing: someone besides us
+/// finished (alone, the results card says it all).
+pub fn shows_table(results: &[ResultRow]) -> bool {
+    results.iter().any(|r| !r.ours)
 }
 
 /// Our run as the HUD shows it.
@@ -251,6 +275,16 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
             graph.draw(now, screen_width() - 8.0, 8.0);
         }
     }
+    let rate = info.run.map_or(60, |r| r.tick_rate);
+    if shows_table(info.results) {
+        // Top right, under the net graph when it is shown.
+        let top = if info.show_net && info.net.is_some() {
+            100.0
+        } else {
+            8.0
+        };
+        results_table(info.results, rate, top);
+    }
     if let Some(run) = info.run.filter(|r| r.place.is_some()) {
         results_card(&run, info.restart_key);
     }
@@ -274,6 +308,40 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
         );
         draw_text(&help, x, y, 16.0, Color { a, ..DIM });
     }
+}
+
+/// Rows of the results table drawn at most (the rest: "... and N more").
+pub const TABLE_ROWS: usize = 10;
+
+/// The room's results, top right: place, name, time, deaths; ours in gold.
+fn results_table(rows: &[ResultRow], rate: u32, top: f32) {
+    let mut lines: Vec<(String, Color, f32)> = vec![("finished".to_owned(), DIM, 14.0)];
+    for r in rows.iter().take(TABLE_ROWS) {
+        lines.push((
+            format!(
+                "{:>4}  {}  {}  {} {}",
+                ordinal(r.place),
+                run_time(r.ticks, rate),
+                r.name,
+                r.deaths,
+                if r.deaths == 1 { "death" } else { "deaths" }
+            ),
+            if r.ours { GOLD } else { WHITE },
+            16.0,
+        ));
+    }
+    if rows.len() > TABLE_ROWS {
+        lines.push((
+            format!("... and {} more", rows.len() - TABLE_ROWS),
+            DIM,
+            14.0,
+        ));
+    }
+    let width = lines
+        .iter()
+        .map(|(l, _, size)| measure_text(l, None, *size as u16, 1.0).width)
+        .fold(0.0, f32::max);
+    panel(&lines, screen_width() - width - 24.0, top);
 }
 
 /// The results card, centred: time, deaths, coins, place, how to run again.

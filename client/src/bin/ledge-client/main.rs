@@ -31,6 +31,7 @@
 mod art;
 mod camera;
 mod debug;
+mod fx;
 mod hud;
 mod keys;
 mod local;
@@ -512,6 +513,7 @@ async fn game(mut setup: Setup) {
         AudioStatus::Playing { .. } => None,
     };
     let mut cues = Cues::default();
+    let mut effects = fx::Fx::default();
     // When the player first moved (the controls hint fades after it).
     let mut first_move: Option<f64> = None;
     let restart_key = setup
@@ -579,11 +581,14 @@ async fn game(mut setup: Setup) {
         if moved && first_move.is_none() {
             first_move = Some(now);
         }
-        // Sounds from what changed since the last frame.
-        if let Some(g) = setup.play.game() {
-            for effect in cues.observe(g.game(), g.me()) {
-                audio.play(effect);
-            }
+        // Sounds (and our player's effects) from what changed since the
+        // last frame.
+        let cued = match setup.play.game() {
+            Some(g) => cues.observe(g.game(), g.me()),
+            None => Vec::new(),
+        };
+        for &effect in &cued {
+            audio.play(effect);
         }
         for _ in 0..setup.play.take_arrivals() {
             graph.arrival(now);
@@ -630,6 +635,36 @@ async fn game(mut setup: Setup) {
         });
         let screen = vec2(screen_width(), screen_height());
         let view = camera.update(focus, level_px, screen, frame.as_secs_f32());
+        // Effects: ours from the cues, the others' from what is drawn.
+        effects.local(
+            &cued,
+            local.as_ref().map(|p| fx::At {
+                pos: p.pos,
+                size: p.size,
+                tint: render::player_color(p.id, true),
+            }),
+        );
+        effects.watch(
+            &remotes
+                .iter()
+                .map(|p| fx::Watched {
+                    id: p.id,
+                    at: fx::At {
+                        pos: p.pos,
+                        size: p.size,
+                        tint: render::player_color(p.id, false),
+                    },
+                    dead: false,
+                    won: p.won,
+                })
+                .collect::<Vec<_>>(),
+        );
+        effects.update(frame.as_secs_f32());
+        // The shake moves the world, not the HUD.
+        let view = camera::View {
+            offset: view.offset + effects.shake(),
+            ..view
+        };
 
         // Draw: sky, tiles, entities, players, overlays.
         let time = now as f32;
@@ -667,6 +702,8 @@ async fn game(mut setup: Setup) {
             let label = p.name.as_deref().unwrap_or(&setup.name);
             render::draw_player(p, &view, render::player_color(p.id, true), label);
         }
+        effects.draw(&view);
+        effects.draw_flash();
         if show_debug {
             if let Some(game) = setup.play.game() {
                 debug::draw(game.game().world(), &view);
@@ -687,6 +724,27 @@ async fn game(mut setup: Setup) {
             .and_then(|p| p.name.as_deref())
             .unwrap_or(&setup.name)
             .to_owned();
+        // The room's results table, names from the roster.
+        let results: Vec<hud::ResultRow> = setup.play.game().map_or_else(Vec::new, |g| {
+            g.game()
+                .results()
+                .iter()
+                .map(|r| hud::ResultRow {
+                    place: r.place.unwrap_or(0),
+                    name: if r.id == g.me() {
+                        name.clone()
+                    } else {
+                        g.player_names()
+                            .get(&r.id)
+                            .cloned()
+                            .unwrap_or_else(|| format!("player #{}", r.id.0))
+                    },
+                    ticks: r.run_ticks,
+                    deaths: r.deaths,
+                    ours: r.id == g.me(),
+                })
+                .collect()
+        });
         if show_hud && failure.is_none() {
             let status = setup.play.status_line();
             let info = hud::HudInfo {
@@ -701,6 +759,7 @@ async fn game(mut setup: Setup) {
                 sound_notice: sound_off.as_deref().filter(|_| now < SOUND_NOTICE_SECONDS),
                 muted: audio.is_muted(),
                 restart_key: &restart_key,
+                results: &results,
             };
             hud::draw(&info, &graph, now);
         }
@@ -741,8 +800,16 @@ async fn game(mut setup: Setup) {
                         net_panel: show_net,
                         muted: audio.is_muted(),
                         sound_notice: sound_off.as_deref().filter(|_| now < SOUND_NOTICE_SECONDS),
+                        results: &results,
                     }),
                     failure: failed.as_deref().zip(failure.as_ref()),
+                    fx: shot::FxShot {
+                        particles: effects.particles().len(),
+                        shake: effects.shake().length(),
+                        flash: effects.flash().a,
+                        recent: effects.recent(),
+                        dead: me.as_ref().is_some_and(|m| m.dead.is_some()),
+                    },
                 };
                 if let Err(e) = shot::save(path, &shot) {
                     fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));

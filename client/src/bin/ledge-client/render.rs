@@ -60,6 +60,16 @@ pub mod palette {
     pub const WALKER: Color = rgb(170, 60, 160);
     /// Defeated walkers.
     pub const WALKER_DEAD: Color = Color::new(0.45, 0.45, 0.5, 0.7);
+    /// Dust kicked up by feet.
+    pub const DUST: Color = Color::new(0.93, 0.9, 0.84, 0.85);
+    /// The goal's confetti.
+    pub const CONFETTI: [Color; 5] = [
+        rgb(255, 208, 32),
+        rgb(255, 96, 96),
+        rgb(96, 200, 255),
+        rgb(120, 230, 110),
+        rgb(250, 250, 250),
+    ];
     /// Coins.
     pub const COIN: Color = rgb(252, 206, 40);
     /// Coin shine.

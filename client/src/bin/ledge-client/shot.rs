@@ -28,7 +28,16 @@
 //!     "name": "ada", "coins": 2, "coins_total": 10, "deaths": 1,
 //!     "run_ticks": 412, "tick_rate": 60, "time": "0:06.86",
 //!     "place": null, "results_card": false,
-//!     "net_panel": false, "muted": false, "sound_notice": "sound off: ..."
+//!     "net_panel": false, "muted": false, "sound_notice": "sound off: ...",
+//!     "results": [                     // the room's: everyone who finished
+//!       {"place": 1, "name": "bob", "ticks": 598, "deaths": 0, "ours": false}
+//!     ],
+//!     "results_table": true            // drawn (someone besides us finished)
+//!   },
+//!   "fx": {                            // visual effects on screen
+//!     "particles": 34, "shake_px": 2.5, "flash_alpha": 0.3,
+//!     "recent": ["Jump", "Hurt"],      // effects started lately, oldest first
+//!     "dead": true                     // our player waits to respawn
 //!   },
 //!   "failure": {                       // null unless the session failed
 //!     "message": "cannot join ...",    // as printed on stderr
@@ -72,6 +81,22 @@ pub struct Shot<'a> {
     pub hud: Option<HudShot<'a>>,
     /// The session's failure and its banner as drawn, if it failed.
     pub failure: Option<(&'a str, &'a BannerLayout)>,
+    /// The visual effects on screen.
+    pub fx: FxShot<'a>,
+}
+
+/// The visual effects on screen when the frame was taken.
+pub struct FxShot<'a> {
+    /// Particles alive.
+    pub particles: usize,
+    /// The screen shake's offset, screen px.
+    pub shake: f32,
+    /// The flash's opacity.
+    pub flash: f32,
+    /// The effects started lately, oldest first.
+    pub recent: &'a [ledge_client::audio::Effect],
+    /// Our player is dead (waiting to respawn).
+    pub dead: bool,
 }
 
 /// What the HUD showed.
@@ -86,6 +111,9 @@ pub struct HudShot<'a> {
     pub muted: bool,
     /// The sound notice shown, if any.
     pub sound_notice: Option<&'a str>,
+    /// The room's results (the table is drawn when someone besides us is
+    /// in it).
+    pub results: &'a [crate::hud::ResultRow],
 }
 
 /// A remote player as drawn.
@@ -235,13 +263,48 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
             let _ = writeln!(s, "    \"net_panel\": {},", h.net_panel);
             let _ = writeln!(s, "    \"muted\": {},", h.muted);
             let notice = h.sound_notice.map_or("null".to_owned(), json_string);
-            let _ = writeln!(s, "    \"sound_notice\": {notice}");
+            let _ = writeln!(s, "    \"sound_notice\": {notice},");
+            let rows: Vec<String> = h
+                .results
+                .iter()
+                .map(|r| {
+                    format!(
+                        "{{\"place\": {}, \"name\": {}, \"ticks\": {}, \"deaths\": {}, \"ours\": {}}}",
+                        r.place,
+                        json_string(&r.name),
+                        r.ticks,
+                        r.deaths,
+                        r.ours
+                    )
+                })
+                .collect();
+            let _ = writeln!(s, "    \"results\": [{}],", rows.join(", "));
+            let _ = writeln!(
+                s,
+                "    \"results_table\": {}",
+                crate::hud::shows_table(h.results)
+            );
             let _ = writeln!(s, "  }},");
         }
         None => {
             let _ = writeln!(s, "  \"hud\": null,");
         }
     }
+    let fx = &shot.fx;
+    let recent: Vec<String> = fx
+        .recent
+        .iter()
+        .map(|e| json_string(&format!("{e:?}")))
+        .collect();
+    let _ = writeln!(
+        s,
+        "  \"fx\": {{\"particles\": {}, \"shake_px\": {:.3}, \"flash_alpha\": {:.3}, \"recent\": [{}], \"dead\": {}}},",
+        fx.particles,
+        fx.shake,
+        fx.flash,
+        recent.join(", "),
+        fx.dead
+    );
     match shot.failure {
         Some((message, layout)) => {
             let p = layout.panel;
@@ -308,11 +371,38 @@ mod tests {
                 net_panel: false,
                 muted: true,
                 sound_notice: None,
+                results: &[
+                    crate::hud::ResultRow {
+                        place: 1,
+                        name: "bo".into(),
+                        ticks: 600,
+                        deaths: 0,
+                        ours: false,
+                    },
+                    crate::hud::ResultRow {
+                        place: 2,
+                        name: "ada \"x\"".into(),
+                        ticks: 604,
+                        deaths: 1,
+                        ours: true,
+                    },
+                ],
             }),
             failure: None,
+            fx: FxShot {
+                particles: 12,
+                shake: 1.5,
+                flash: 0.25,
+                recent: &[ledge_client::audio::Effect::Hurt],
+                dead: true,
+            },
         };
         let json = describe(&shot, Path::new("/tmp/a.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect("JSON");
+        assert_eq!(parsed["fx"]["particles"], 12);
+        assert_eq!(parsed["fx"]["recent"][0], "Hurt");
+        assert_eq!(parsed["fx"]["dead"], true);
+        assert_eq!(parsed["fx"]["flash_alpha"], 0.25);
         let hud = &parsed["hud"];
         assert_eq!(hud["name"], "ada \"x\"");
         assert_eq!(hud["coins"], 2);
@@ -324,6 +414,9 @@ mod tests {
         assert_eq!(hud["net_panel"], false);
         assert_eq!(hud["muted"], true);
         assert!(hud["sound_notice"].is_null());
+        assert_eq!(hud["results"][1]["name"], "ada \"x\"");
+        assert_eq!(hud["results"][0]["ticks"], 600);
+        assert_eq!(hud["results_table"], true);
         assert!(
             json.contains("\"server_screen\": [190.000, 80.000]"),
             "{json}"
@@ -366,6 +459,13 @@ mod tests {
             remotes: Vec::new(),
             hud: None,
             failure: Some((message, &layout)),
+            fx: FxShot {
+                particles: 0,
+                shake: 0.0,
+                flash: 0.0,
+                recent: &[],
+                dead: false,
+            },
         };
         let json: serde_json::Value =
             serde_json::from_str(&describe(&shot, Path::new("f.png"), 480, 270)).expect("JSON");
