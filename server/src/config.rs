@@ -17,6 +17,7 @@ use serde::Deserialize;
 use ledge_shared::game::{GameConfig, MAX_RESPAWN_DELAY_TICKS};
 
 use crate::admission::AdmissionConfig;
+use crate::fleet::FleetConfig;
 
 /// Default UDP address the server listens on.
 pub const DEFAULT_BIND: &str = "0.0.0.0:4433";
@@ -158,6 +159,10 @@ pub struct ServerConfig {
     /// programmatically (tests, tools); read with
     /// [`crate::Server::recorder`]. See [`crate::record`].
     pub record_ticks: Option<usize>,
+    /// Run as an Agones GameServer (`--agones`): the fleet logic's
+    /// settings; `None`: not under Agones. Needs the `agones` cargo
+    /// feature.
+    pub agones: Option<FleetConfig>,
 }
 
 impl Default for ServerConfig {
@@ -183,6 +188,7 @@ impl Default for ServerConfig {
             admission: AdmissionConfig::default(),
             respawn_delay: DEFAULT_RESPAWN_DELAY,
             record_ticks: None,
+            agones: None,
         }
     }
 }
@@ -283,6 +289,18 @@ impl ServerConfig {
         }
         if !(Duration::from_millis(100)..=Duration::from_secs(60)).contains(&a.hello_timeout) {
             return bad("admission: hello_timeout must be 0.1..=60 s");
+        }
+        if let Some(f) = &self.agones {
+            if !(Duration::from_millis(100)..=Duration::from_secs(60)).contains(&f.health_every) {
+                return bad("agones: health_every must be 0.1..=60 s");
+            }
+            if f.shutdown_after > Duration::from_secs(24 * 3600) {
+                return bad("agones: shutdown_after must be at most 86400 s");
+            }
+            if !(Duration::from_millis(100)..=Duration::from_secs(600)).contains(&f.connect_timeout)
+            {
+                return bad("agones: connect_timeout must be 0.1..=600 s");
+            }
         }
         Ok(())
     }
@@ -389,6 +407,21 @@ pub struct Cli {
     /// TCP address serving Prometheus metrics at /metrics [default: none].
     #[arg(long, value_name = "ADDR:PORT")]
     pub metrics_bind: Option<SocketAddr>,
+    /// Run as an Agones GameServer: say Ready through the SDK sidecar
+    /// (AGONES_SDK_GRPC_PORT, default 9357), send health pings while the
+    /// rooms tick, publish the rooms and players counters, the rooms list,
+    /// the full label and the certificate's fingerprint, and shut down
+    /// once Allocated and empty (docs/DEPLOY.md). Needs a server built with
+    /// the `agones` feature.
+    #[arg(long)]
+    pub agones: bool,
+    /// Under Agones, once Allocated: shut down after no player has been in
+    /// any room this long, in seconds [default: 60].
+    #[arg(long, value_name = "SECONDS", requires = "agones")]
+    pub agones_shutdown_after: Option<f64>,
+    /// Under Agones: seconds between health pings [default: 2].
+    #[arg(long, value_name = "SECONDS", requires = "agones")]
+    pub agones_health_every: Option<f64>,
 }
 
 /// The TOML file: every key optional.
@@ -419,6 +452,19 @@ struct FileConfig {
     respawn_delay: Option<f64>,
     limits: Option<Limits>,
     admission: Option<FileAdmission>,
+    agones: Option<FileAgones>,
+}
+
+/// The file's `[agones]`: present (even empty) means run under Agones.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileAgones {
+    /// Seconds.
+    shutdown_after: Option<f64>,
+    /// Seconds.
+    health_every: Option<f64>,
+    /// Seconds.
+    connect_timeout: Option<f64>,
 }
 
 /// The file's `[admission]`: every key optional.
@@ -526,6 +572,20 @@ impl Cli {
         set(&mut c.max_level_mib, self.max_level_mib);
         set(&mut c.cert_dir, self.cert_dir.clone());
         set(&mut c.metrics_bind, self.metrics_bind.map(Some));
+        if self.agones || file.agones.is_some() {
+            let from_file = file.agones.unwrap_or_default();
+            let mut fleet = FleetConfig::default();
+            if let Some(secs) = self.agones_shutdown_after.or(from_file.shutdown_after) {
+                fleet.shutdown_after = seconds(secs, "agones shutdown_after")?;
+            }
+            if let Some(secs) = self.agones_health_every.or(from_file.health_every) {
+                fleet.health_every = seconds(secs, "agones health_every")?;
+            }
+            if let Some(secs) = from_file.connect_timeout {
+                fleet.connect_timeout = seconds(secs, "agones connect_timeout")?;
+            }
+            c.agones = Some(fleet);
+        }
         c.validate()?;
         Ok(c)
     }
@@ -700,6 +760,41 @@ datagrams_per_second = 500.0
             let err = cli(args).resolve().unwrap_err();
             assert!(matches!(err, ConfigError::Invalid(_)), "{args:?}: {err}");
         }
+    }
+
+    #[test]
+    fn agones_comes_from_the_flag_or_the_file() {
+        assert_eq!(cli(&[]).resolve().unwrap().agones, None);
+        let f = cli(&["--agones"]).resolve().unwrap().agones.unwrap();
+        assert_eq!(f, FleetConfig::default());
+        let f = cli(&[
+            "--agones",
+            "--agones-shutdown-after",
+            "5",
+            "--agones-health-every",
+            "0.5",
+        ])
+        .resolve()
+        .unwrap()
+        .agones
+        .unwrap();
+        assert_eq!(f.shutdown_after, Duration::from_secs(5));
+        assert_eq!(f.health_every, Duration::from_millis(500));
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("server.toml");
+        std::fs::write(&path, "[agones]\nshutdown_after = 30\n").unwrap();
+        let config = path.to_str().unwrap();
+        let f = cli(&["--config", config])
+            .resolve()
+            .unwrap()
+            .agones
+            .unwrap();
+        assert_eq!(f.shutdown_after, Duration::from_secs(30));
+        // Out of range, or without --agones: refused.
+        assert!(cli(&["--agones", "--agones-health-every", "0"])
+            .resolve()
+            .is_err());
+        assert!(Cli::try_parse_from(["ledge-server", "--agones-shutdown-after", "5"]).is_err());
     }
 
     #[test]

@@ -25,15 +25,23 @@
 //! * [`connection`]: one client's handshake, control stream and datagrams;
 //! * [`ratelimit`]: token buckets;
 //! * [`metrics`]: Prometheus metrics and their HTTP endpoint;
+//! * [`fleet`]: what a server in an Agones fleet reports, and when
+//!   (sans-IO: counters, the rooms list, health, shutdown once allocated
+//!   and empty);
+//! * `agones` (cargo feature `agones`): the Agones SDK driver making the
+//!   fleet logic's calls;
 //! * [`server`]: the endpoint, accept loop and graceful shutdown.
 #![deny(missing_docs)]
 
 pub mod admission;
+#[cfg(feature = "agones")]
+pub mod agones;
 pub mod cert;
 pub mod clock;
 pub mod config;
 pub mod connection;
 pub mod fingerprint;
+pub mod fleet;
 pub mod inputs;
 pub mod levels;
 pub mod metrics;

@@ -17,6 +17,7 @@ use ledge_shared::protocol::{RejectReason, RoomInfo};
 use tokio::task::JoinHandle;
 use tracing::info;
 
+use crate::fleet::{Load, RoomLoad};
 use crate::metrics::Metrics;
 use crate::record::Recorder;
 use crate::room::{self, RoomConfig, RoomHandle};
@@ -116,6 +117,25 @@ impl Rooms {
                 capacity: u32::try_from(self.template.max_players).unwrap_or(u32::MAX),
             })
             .collect()
+    }
+
+    /// Every open room's load, in name order, and the caps (for the fleet
+    /// logic, [`crate::fleet`]).
+    pub fn load(&self) -> Load {
+        let rooms = lock(&self.open)
+            .iter()
+            .map(|e| RoomLoad {
+                name: e.handle.name().to_owned(),
+                players: u32::try_from(e.handle.players()).unwrap_or(u32::MAX),
+                tick: e.handle.status().tick,
+                permanent: e.permanent,
+            })
+            .collect();
+        Load {
+            rooms,
+            room_cap: u32::try_from(self.max_rooms).unwrap_or(u32::MAX),
+            players_per_room: u32::try_from(self.template.max_players).unwrap_or(u32::MAX),
+        }
     }
 
     /// Open rooms.

@@ -70,6 +70,10 @@ pub enum ServerError {
         /// The limit, MiB.
         max_mib: u64,
     },
+    /// `--agones` was asked of a server built without the `agones` feature,
+    /// or the Agones SDK sidecar did not answer.
+    #[error("{0}")]
+    Agones(String),
     /// A socket could not be bound.
     #[error("cannot bind {addr}: {source}; {}", bind_hint(option, *addr, source))]
     Bind {
@@ -226,6 +230,13 @@ impl Server {
     /// Must be called inside a tokio runtime (the sockets register with it).
     pub fn bind(config: ServerConfig) -> Result<Server, ServerError> {
         config.validate()?;
+        if config.agones.is_some() && !cfg!(feature = "agones") {
+            return Err(ServerError::Agones(
+                "--agones: this ledge-server was built without Agones support; build it with \
+                 `cargo build --release -p ledge-server --features agones` (deploy/Dockerfile does)"
+                    .into(),
+            ));
+        }
         let bundle = levels::load(config.level.as_deref(), config.level_settings.as_deref())?;
         Game::with_config(&bundle.level, config.game_config())?;
         let bundle_bytes = bundle.encode();
@@ -350,6 +361,7 @@ impl Server {
             metrics_listener,
             shutdown,
             recorders,
+            fingerprint,
             ..
         } = self;
         let mut stop = shutdown.subscribe();
@@ -395,6 +407,27 @@ impl Server {
             shutdown: stop.clone(),
         });
 
+        // Under Agones: the sidecar must answer before anything else; the
+        // fleet logic then says Ready with the rooms open.
+        #[cfg(feature = "agones")]
+        let agones_task = match config.agones {
+            Some(fleet) => {
+                let sdk = crate::agones::connect(&fleet)
+                    .await
+                    .map_err(|e| ServerError::Agones(e.to_string()))?;
+                Some(tokio::spawn(crate::agones::drive(
+                    sdk,
+                    crate::fleet::Fleet::new(fleet, &fingerprint.to_string()),
+                    shared.clone(),
+                    stop.clone(),
+                    ShutdownHandle(shutdown.clone()),
+                    fleet.health_every,
+                )))
+            }
+            None => None,
+        };
+        #[cfg(not(feature = "agones"))]
+        let _ = fingerprint;
         info!(
             %local_addr,
             level = %level_id,
@@ -463,6 +496,10 @@ impl Server {
             .is_err()
         {
             warn!("endpoint not idle after {SHUTDOWN_GRACE:?}");
+        }
+        #[cfg(feature = "agones")]
+        if let Some(task) = agones_task {
+            let _ = task.await;
         }
         // Rooms stop once their last handle is gone.
         let room_tasks = shared.rooms.close_all();
