@@ -166,9 +166,71 @@ async fn watch_states(mut sdk: Sdk, states: mpsc::UnboundedSender<String>) {
     }
 }
 
+/// Starts the driver on a thread of its own (with its own small runtime),
+/// once the sidecar answered: the health pings must not depend on the
+/// runtime whose tick loops they vouch for (a room blocking a worker
+/// thread must stop the pings, not the watchdog). Returns the thread, or
+/// why the sidecar could not be reached.
+pub async fn start(
+    config: FleetConfig,
+    fingerprint: String,
+    shared: Arc<Shared>,
+    stop: watch::Receiver<bool>,
+    shutdown: ShutdownHandle,
+) -> Result<std::thread::JoinHandle<()>, AgonesError> {
+    let (connected_tx, connected) = tokio::sync::oneshot::channel();
+    let thread = std::thread::Builder::new()
+        .name("agones".into())
+        .spawn(move || {
+            let runtime = match tokio::runtime::Builder::new_current_thread()
+                .enable_all()
+                .build()
+            {
+                Ok(runtime) => runtime,
+                Err(e) => {
+                    let _ = connected_tx.send(Err(AgonesError::Connect {
+                        port: sidecar_port(&config),
+                        secs: 0,
+                        reason: format!("cannot start its runtime: {e}"),
+                    }));
+                    return;
+                }
+            };
+            runtime.block_on(async move {
+                let sdk = match connect(&config).await {
+                    Ok(sdk) => sdk,
+                    Err(e) => {
+                        let _ = connected_tx.send(Err(e));
+                        return;
+                    }
+                };
+                let _ = connected_tx.send(Ok(()));
+                let fleet = Fleet::new(config, &fingerprint);
+                drive(sdk, fleet, shared, stop, shutdown, config.health_every).await;
+            });
+        })
+        .map_err(|e| AgonesError::Connect {
+            port: sidecar_port(&config),
+            secs: 0,
+            reason: format!("cannot start its thread: {e}"),
+        })?;
+    match connected.await {
+        Ok(Ok(())) => Ok(thread),
+        Ok(Err(e)) => {
+            let _ = thread.join();
+            Err(e)
+        }
+        Err(_) => Err(AgonesError::Connect {
+            port: sidecar_port(&config),
+            secs: 0,
+            reason: "its thread ended".into(),
+        }),
+    }
+}
+
 /// Runs the fleet logic against the sidecar until the server stops (or,
 /// after a `Shutdown` call, stops it). `stop` turns true at shutdown.
-pub async fn drive(
+async fn drive(
     mut sdk: Sdk,
     mut fleet: Fleet,
     shared: Arc<Shared>,

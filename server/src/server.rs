@@ -411,19 +411,17 @@ impl Server {
         // fleet logic then says Ready with the rooms open.
         #[cfg(feature = "agones")]
         let agones_task = match config.agones {
-            Some(fleet) => {
-                let sdk = crate::agones::connect(&fleet)
-                    .await
-                    .map_err(|e| ServerError::Agones(e.to_string()))?;
-                Some(tokio::spawn(crate::agones::drive(
-                    sdk,
-                    crate::fleet::Fleet::new(fleet, &fingerprint.to_string()),
+            Some(fleet) => Some(
+                crate::agones::start(
+                    fleet,
+                    fingerprint.to_string(),
                     shared.clone(),
                     stop.clone(),
                     ShutdownHandle(shutdown.clone()),
-                    fleet.health_every,
-                )))
-            }
+                )
+                .await
+                .map_err(|e| ServerError::Agones(e.to_string()))?,
+            ),
             None => None,
         };
         #[cfg(not(feature = "agones"))]
@@ -498,8 +496,9 @@ impl Server {
             warn!("endpoint not idle after {SHUTDOWN_GRACE:?}");
         }
         #[cfg(feature = "agones")]
-        if let Some(task) = agones_task {
-            let _ = task.await;
+        if let Some(thread) = agones_task {
+            // It sees `stop` and ends within a poll.
+            let _ = tokio::task::spawn_blocking(move || thread.join()).await;
         }
         // Rooms stop once their last handle is gone.
         let room_tasks = shared.rooms.close_all();

@@ -175,6 +175,15 @@ impl TestServer {
             .expect("server task did not panic")
     }
 
+    /// Waits up to `within` for the server to stop on its own (not asked
+    /// by the test) and returns what `run` returned; `None` while it runs.
+    pub async fn ended(&mut self, within: Duration) -> Option<Result<(), ServerError>> {
+        let task = self.task.as_mut()?;
+        let done = tokio::time::timeout(within, task).await.ok()?;
+        self.task = None;
+        Some(done.expect("server task did not panic"))
+    }
+
     /// Asks the server to shut down without waiting.
     pub fn begin_shutdown(&self) {
         self.shutdown.shutdown();
