@@ -10,8 +10,8 @@
 //! depend on the frame rate.
 //!
 //! [`spread`] fans out players drawn on top of each other (eight bots at
-//! the goal) so that each stays visible, with their name labels stepped
-//! upwards.
+//! the goal) so that each stays visible, and [`label_rows`] steps their
+//! name labels upwards so that none overprints another.
 
 use std::collections::BTreeMap;
 
@@ -368,32 +368,23 @@ impl Animator {
 pub const STACK_RADIUS: f32 = 4.0;
 /// Sideways distance between the players of a spread stack (px).
 pub const SPREAD_GAP: f32 = 8.0;
-
-/// Where [`spread`] draws one player.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Spot {
-    /// Centre to draw the player at (px).
-    pub pos: Vec2,
-    /// Which row its name label goes in: 0 where it always is, each row
-    /// above the one below it (players of a stack take different rows).
-    pub label_row: u32,
-}
+/// [`label_rows`] stacks labels at most this many rows high (more crowded
+/// labels share rows).
+pub const MAX_LABEL_ROWS: u32 = 16;
 
 /// Drawing positions for `players` (`(id, centre)`, any order) such that
 /// players nearly on top of each other stay visible: each stack (centres
 /// within [`STACK_RADIUS`], chained) is fanned out sideways
-/// [`SPREAD_GAP`] apart in id order, and its labels take one row each.
-/// `ours` (our player's id) is never moved: the others of its stack go
-/// right and left of it, alternately; a stack without it is centred on
-/// its members' mean. Players not in a stack keep their position and
-/// label row 0. Cosmetic only (the simulation never sees it);
-/// deterministic; the result is in `players`' order.
-pub fn spread(players: &[(PlayerId, Vec2)], ours: Option<PlayerId>) -> Vec<Spot> {
+/// [`SPREAD_GAP`] apart, left to right as they stand (by whole pixels,
+/// then by id: players on one pixel in id order). `ours` (our player's
+/// id) is never moved: the others of its stack go to its left and right
+/// as they stand. A stack without it is centred on its members' mean.
+/// Players not in a stack keep their position. Cosmetic only (the
+/// simulation never sees it); deterministic; the result is in `players`'
+/// order.
+pub fn spread(players: &[(PlayerId, Vec2)], ours: Option<PlayerId>) -> Vec<Vec2> {
     let n = players.len();
-    let mut spots: Vec<Spot> = players
-        .iter()
-        .map(|&(_, pos)| Spot { pos, label_row: 0 })
-        .collect();
+    let mut drawn: Vec<Vec2> = players.iter().map(|&(_, pos)| pos).collect();
     // Stacks: connected components of "within the radius" (union-find).
     let mut parent: Vec<usize> = (0..n).collect();
     fn root(parent: &mut [usize], mut i: usize) -> usize {
@@ -417,33 +408,63 @@ pub fn spread(players: &[(PlayerId, Vec2)], ours: Option<PlayerId>) -> Vec<Spot>
         stacks.entry(r).or_default().push(i);
     }
     for mut members in stacks.into_values().filter(|m| m.len() > 1) {
-        // Id order (then input order, for repeated ids).
-        members.sort_by_key(|&i| (players[i].0, i));
-        let anchor = members.iter().position(|&i| Some(players[i].0) == ours);
-        match anchor {
-            Some(a) => {
-                // Ours stays; the others alternate right, left, farther.
-                let ours_x = players[members[a]].1.x;
-                let others = members.iter().filter(|&&i| i != members[a]);
-                for (k, &i) in others.enumerate() {
-                    let step = (k / 2 + 1) as f32 * SPREAD_GAP;
-                    let dx = if k % 2 == 0 { step } else { -step };
-                    spots[i].pos.x = ours_x + dx;
-                    spots[i].label_row = k as u32 + 1;
-                }
-            }
-            None => {
-                let mean_x =
-                    members.iter().map(|&i| players[i].1.x).sum::<f32>() / members.len() as f32;
-                let mid = (members.len() - 1) as f32 / 2.0;
-                for (k, &i) in members.iter().enumerate() {
-                    spots[i].pos.x = mean_x + (k as f32 - mid) * SPREAD_GAP;
-                    spots[i].label_row = k as u32;
-                }
-            }
+        // Left to right (whole pixels, so that jitter does not reorder),
+        // then by id, then as given (repeated ids).
+        members.sort_by(|&i, &j| {
+            let key = |k: usize| (players[k].1.x.round(), players[k].0, k);
+            let (a, b) = (key(i), key(j));
+            a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2))
+        });
+        // Ours stays where it is; else the stack is centred on its mean.
+        let (anchor, anchor_x) = match members.iter().position(|&i| Some(players[i].0) == ours) {
+            Some(a) => (a as f32, players[members[a]].1.x),
+            None => (
+                (members.len() - 1) as f32 / 2.0,
+                members.iter().map(|&i| players[i].1.x).sum::<f32>() / members.len() as f32,
+            ),
+        };
+        for (k, &i) in members.iter().enumerate() {
+            drawn[i].x = anchor_x + (k as f32 - anchor) * SPREAD_GAP;
         }
     }
-    spots
+    drawn
+}
+
+/// A name label to place with [`label_rows`], in any one unit (screen
+/// pixels, say).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Label {
+    /// Horizontal centre.
+    pub x: f32,
+    /// Bottom edge in its lowest row (y down: rows go up from there).
+    pub bottom: f32,
+    /// Full width.
+    pub width: f32,
+}
+
+/// Rows for name labels so that none overprints another: label `i` is
+/// drawn `rows[i] * row_height` above its place. Labels are placed in the
+/// order given (put ours first, then by id), each in the lowest row where
+/// it overlaps no label placed before it (rows `row_height` tall), at most
+/// [`MAX_LABEL_ROWS`] high (beyond that, the lowest row). Labels of
+/// players far apart all stay in row 0.
+pub fn label_rows(labels: &[Label], row_height: f32) -> Vec<u32> {
+    let mut rows: Vec<u32> = Vec::with_capacity(labels.len());
+    for (i, a) in labels.iter().enumerate() {
+        // Labels placed before that this one could overlap sideways.
+        let near: Vec<(f32, u32)> = labels[..i]
+            .iter()
+            .zip(&rows)
+            .filter(|(b, _)| (a.x - b.x).abs() < (a.width + b.width) / 2.0)
+            .map(|(b, &r)| (b.bottom - r as f32 * row_height, r))
+            .collect();
+        let free = |r: u32| {
+            let bottom = a.bottom - r as f32 * row_height;
+            near.iter().all(|&(b, _)| (bottom - b).abs() >= row_height)
+        };
+        rows.push((0..MAX_LABEL_ROWS).find(|&r| free(r)).unwrap_or(0));
+    }
+    rows
 }
 
 #[cfg(test)]
@@ -741,50 +762,56 @@ mod tests {
     #[test]
     fn a_stack_of_eight_fans_out() {
         let at = Vec2::new(300.0, 100.0);
-        let players: Vec<(PlayerId, Vec2)> = (1..=8)
-            .map(|i| (PlayerId(i), at + Vec2::new(i as f32 * 0.3, 0.0)))
-            .collect();
-        let spots = spread(&players, None);
-        for (i, a) in spots.iter().enumerate() {
-            assert_eq!(a.pos.y, players[i].1.y, "sideways only");
-            for b in &spots[i + 1..] {
-                assert!(
-                    (a.pos.x - b.pos.x).abs() >= SPREAD_GAP - 0.01,
-                    "{a:?} {b:?}"
-                );
-                assert_ne!(a.label_row, b.label_row, "labels overprint");
+        // On one pixel (but not quite the same point), given in no order.
+        let players: Vec<(PlayerId, Vec2)> = [5, 1, 8, 3, 2, 7, 4, 6]
+            .map(|i| (PlayerId(i), at + Vec2::new(i as f32 * 0.05, 0.0)))
+            .to_vec();
+        let drawn = spread(&players, None);
+        for (i, a) in drawn.iter().enumerate() {
+            assert_eq!(a.y, players[i].1.y, "sideways only");
+            for b in &drawn[i + 1..] {
+                assert!((a.x - b.x).abs() >= SPREAD_GAP - 0.01, "{a:?} {b:?}");
             }
         }
         // Centred where they were, in id order left to right.
-        let mean = spots.iter().map(|s| s.pos.x).sum::<f32>() / 8.0;
-        assert!(close(mean, at.x + 4.5 * 0.3, 0.01), "{mean}");
-        assert!(spots.windows(2).all(|w| w[0].pos.x < w[1].pos.x));
+        let mean = |v: &[Vec2]| v.iter().map(|p| p.x).sum::<f32>() / v.len() as f32;
+        let given: Vec<Vec2> = players.iter().map(|p| p.1).collect();
+        assert!(close(mean(&drawn), mean(&given), 0.01));
+        let mut by_id: Vec<(PlayerId, f32)> = players
+            .iter()
+            .zip(&drawn)
+            .map(|(p, d)| (p.0, d.x))
+            .collect();
+        by_id.sort_by_key(|p| p.0);
+        assert!(by_id.windows(2).all(|w| w[0].1 < w[1].1), "{by_id:?}");
         // Deterministic whatever the order given.
         let mut reversed = players.clone();
         reversed.reverse();
         let mut again = spread(&reversed, None);
         again.reverse();
-        assert_eq!(spots, again);
+        assert_eq!(drawn, again);
     }
 
     #[test]
     fn ours_stays_and_the_others_go_around_it() {
         let at = Vec2::new(50.0, 80.0);
         let players: Vec<(PlayerId, Vec2)> = [5, 2, 9, 3].map(|i| (PlayerId(i), at)).to_vec();
-        let spots = spread(&players, Some(PlayerId(9)));
-        assert_eq!(
-            spots[2],
-            Spot {
-                pos: at,
-                label_row: 0
-            }
-        );
-        // Id order: 2 right, 3 left, 5 farther right.
-        assert_eq!(spots[1].pos.x, at.x + SPREAD_GAP);
-        assert_eq!(spots[3].pos.x, at.x - SPREAD_GAP);
-        assert_eq!(spots[0].pos.x, at.x + 2.0 * SPREAD_GAP);
-        let rows: Vec<u32> = spots.iter().map(|s| s.label_row).collect();
-        assert_eq!(rows, [3, 1, 0, 2]);
+        let drawn = spread(&players, Some(PlayerId(9)));
+        assert_eq!(drawn[2], at, "ours never moves");
+        // Id order on one pixel: 2, 3, 5, ours (9) last: all to its left.
+        assert_eq!(drawn[1].x, at.x - 3.0 * SPREAD_GAP);
+        assert_eq!(drawn[3].x, at.x - 2.0 * SPREAD_GAP);
+        assert_eq!(drawn[0].x, at.x - SPREAD_GAP);
+        // Standing a little to one side of ours: fanned out on that side.
+        let players = [
+            (PlayerId(1), at + Vec2::new(2.0, 0.0)),
+            (PlayerId(9), at),
+            (PlayerId(4), at + Vec2::new(-3.0, 1.0)),
+        ];
+        let drawn = spread(&players, Some(PlayerId(9)));
+        assert_eq!(drawn[1], at);
+        assert_eq!(drawn[0], Vec2::new(at.x + SPREAD_GAP, at.y));
+        assert_eq!(drawn[2], Vec2::new(at.x - SPREAD_GAP, at.y + 1.0));
     }
 
     #[test]
@@ -795,16 +822,92 @@ mod tests {
             (PlayerId(3), Vec2::new(0.0, 20.0)),
             (PlayerId(4), Vec2::new(100.0, 0.0)),
         ];
-        let spots = spread(&players, Some(PlayerId(4)));
-        for (s, (_, p)) in spots.iter().zip(&players) {
-            assert_eq!(
-                *s,
-                Spot {
-                    pos: *p,
-                    label_row: 0
-                }
-            );
+        let drawn = spread(&players, Some(PlayerId(4)));
+        for (d, (_, p)) in drawn.iter().zip(&players) {
+            assert_eq!(d, p);
         }
         assert!(spread(&[], None).is_empty());
+    }
+
+    /// Whether two placed labels overlap.
+    fn overprint(a: &Label, ra: u32, b: &Label, rb: u32, h: f32) -> bool {
+        let (ya, yb) = (a.bottom - ra as f32 * h, b.bottom - rb as f32 * h);
+        (a.x - b.x).abs() < (a.width + b.width) / 2.0 && (ya - yb).abs() < h
+    }
+
+    #[test]
+    fn labels_of_a_stack_do_not_overprint() {
+        // Eight players on one spot, fanned out, each with a 50 px label
+        // (2 screen px per world px): each label in a row of its own.
+        let players: Vec<(PlayerId, Vec2)> = (1..=8)
+            .map(|i| (PlayerId(i), Vec2::new(300.0, 100.0)))
+            .collect();
+        let drawn = spread(&players, Some(PlayerId(3)));
+        let labels: Vec<Label> = drawn
+            .iter()
+            .map(|p| Label {
+                x: p.x * 2.0,
+                bottom: (p.y - 8.0) * 2.0 - 8.0,
+                width: 50.0,
+            })
+            .collect();
+        // Ours first.
+        let mut order: Vec<usize> = (0..8).collect();
+        order.sort_by_key(|&i| (players[i].0 != PlayerId(3), players[i].0));
+        let ordered: Vec<Label> = order.iter().map(|&i| labels[i]).collect();
+        let h = 20.0;
+        let rows = label_rows(&ordered, h);
+        assert_eq!(rows[0], 0, "ours keeps its place");
+        for i in 0..8 {
+            for j in i + 1..8 {
+                assert!(!overprint(&ordered[i], rows[i], &ordered[j], rows[j], h));
+            }
+        }
+        // Stepped up, but labels far enough apart share a row.
+        let top = *rows.iter().max().unwrap();
+        assert!((2..8).contains(&top), "{rows:?}");
+    }
+
+    #[test]
+    fn labels_apart_stay_low_and_crowds_are_bounded() {
+        let h = 20.0;
+        let far: Vec<Label> = (0..5)
+            .map(|i| Label {
+                x: i as f32 * 100.0,
+                bottom: 50.0,
+                width: 60.0,
+            })
+            .collect();
+        assert_eq!(label_rows(&far, h), [0; 5]);
+        // One above the other already (a player on another's head): no
+        // need to move either.
+        let stacked = [
+            Label {
+                x: 0.0,
+                bottom: 100.0,
+                width: 60.0,
+            },
+            Label {
+                x: 10.0,
+                bottom: 100.0 - h,
+                width: 60.0,
+            },
+        ];
+        assert_eq!(label_rows(&stacked, h), [0, 0]);
+        // A crowd never climbs past the limit.
+        let crowd = vec![
+            Label {
+                x: 0.0,
+                bottom: 0.0,
+                width: 60.0,
+            };
+            40
+        ];
+        let rows = label_rows(&crowd, h);
+        assert!(rows.iter().all(|&r| r < MAX_LABEL_ROWS));
+        assert_eq!(
+            rows[..MAX_LABEL_ROWS as usize],
+            (0..MAX_LABEL_ROWS).collect::<Vec<_>>()
+        );
     }
 }
