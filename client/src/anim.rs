@@ -126,8 +126,8 @@ pub struct Pose {
     /// shifted sideways per pixel of height (+x to the right; within
     /// `[-RUN_LEAN, RUN_LEAN]`).
     pub lean: f32,
-    /// How far into the landing squash, `[0, 1]` (1: just landed, 0: none
-    /// or over), for bending the legs with it.
+    /// What is left of the landing squash, `[0, 1]` (1: just landed, 0:
+    /// none, or over), for bending the legs with it.
     pub landing: f32,
 }
 
