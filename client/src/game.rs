@@ -26,6 +26,7 @@ use ledge_shared::game::{Game, GameConfig};
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
 use ledge_shared::protocol::{decode_sim_config, EntityState, PlayerId, Welcome, MAX_ROSTER};
+use ledge_shared::world::Sides;
 
 use crate::clock::SyncClock;
 use crate::error::ClientError;
@@ -336,6 +337,8 @@ impl ClientGame {
                 facing: Facing::from_left(p.facing_left),
                 grounded: p.grounded,
                 won: p.won,
+                dead: p.dead.is_some(),
+                wall: wall_side(p.sides, p.grounded),
             }
         });
         let remotes = self
@@ -352,6 +355,9 @@ impl ClientGame {
                 facing: Facing::from_left(s.state.flags & player_flags::FACING_LEFT != 0),
                 grounded: s.state.flags & player_flags::GROUNDED != 0,
                 won: s.state.flags & player_flags::WON != 0,
+                dead: s.state.flags & player_flags::DEAD != 0,
+                // Snapshots carry no touched sides.
+                wall: None,
             })
             .collect();
         let entities = game
@@ -415,9 +421,45 @@ impl ClientGame {
     }
 }
 
+/// The side a wall touches an airborne player on (for
+/// [`PlayerDraw::wall`]): `None` on the ground, or touching both sides or
+/// neither.
+fn wall_side(sides: Sides, grounded: bool) -> Option<Facing> {
+    if grounded {
+        return None;
+    }
+    match (sides.contains(Sides::LEFT), sides.contains(Sides::RIGHT)) {
+        (true, false) => Some(Facing::Left),
+        (false, true) => Some(Facing::Right),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn wall_side_only_in_the_air_and_only_one_side() {
+        let both = Sides(Sides::LEFT.0 | Sides::RIGHT.0);
+        let left_and_top = Sides(Sides::LEFT.0 | Sides::TOP.0);
+        assert_eq!(wall_side(Sides::LEFT, false), Some(Facing::Left));
+        assert_eq!(wall_side(left_and_top, false), Some(Facing::Left));
+        assert_eq!(wall_side(Sides::RIGHT, false), Some(Facing::Right));
+        assert_eq!(wall_side(Sides::RIGHT, true), None);
+        assert_eq!(wall_side(both, false), None);
+        assert_eq!(wall_side(Sides::BOTTOM, false), None);
+        assert_eq!(wall_side(Sides::NONE, false), None);
+    }
+
+    #[test]
+    fn our_player_is_alive_and_off_walls_at_the_start() {
+        let level = ledge_levels::default_level();
+        let game = ClientGame::offline(level, Instant::now()).unwrap();
+        let me = game.view().local.expect("our player");
+        assert!(!me.dead);
+        assert_eq!(me.wall, None);
+    }
 
     #[test]
     fn names_follow_the_roster_and_stay_bounded() {

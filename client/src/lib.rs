@@ -30,11 +30,15 @@
 //!   loaded at run time (off, never failing, without it);
 //! * [`cues`]: which sound effects to play, from frame-to-frame changes of
 //!   our player (so rollbacks never replay one);
+//! * [`anim`]: how players look from frame to frame ([`anim::Animator`]:
+//!   run, jump, fall, landing squash, wall slide), and stacked players
+//!   fanned out ([`anim::spread`]);
 //! * [`error`]: what can fail ([`ClientError`]).
 //!
 //! `docs/CLIENT.md` describes the design and the figures.
 #![deny(missing_docs)]
 
+pub mod anim;
 pub mod audio;
 pub mod background;
 pub mod bot;

@@ -74,6 +74,15 @@ pub struct PlayerDraw {
     pub grounded: bool,
     /// Reached the goal.
     pub won: bool,
+    /// Dead, waiting to respawn (ours: the predicted game's
+    /// `PlayerView::dead`; remote players: the `DEAD` flag of their
+    /// interpolated state). Front ends draw no body then.
+    pub dead: bool,
+    /// Which side of its box touches a wall while airborne, for a
+    /// wall-slide look: `Some(Left)` for a wall on its left. Only our
+    /// player has it (from the predicted game's touched sides); remote
+    /// players are always `None` because snapshots do not carry the sides.
+    pub wall: Option<Facing>,
 }
 
 impl PlayerDraw {

@@ -56,7 +56,7 @@ use macroquad::prelude::*;
 
 use camera::Camera;
 use keys::{Bindings, Gamepads};
-use render::{EntitySprite, PlayerSprite};
+use render::EntitySprite;
 use script::Script;
 
 /// How long "sound off: why" stays on screen, seconds from the start.
@@ -499,6 +499,8 @@ fn list_rooms(request: &OnlineRequest) -> anyhow::Result<()> {
 async fn game(mut setup: Setup) {
     let started = Instant::now();
     let mut camera = Camera::new();
+    // How players look from frame to frame (run, jump, landing squash).
+    let mut animator = ledge_client::anim::Animator::new();
     let mut pads = Gamepads::new();
     let mut graph = hud::NetGraph::default();
     let mut show_debug = setup.debug;
@@ -621,9 +623,7 @@ async fn game(mut setup: Setup) {
             }
         };
         let frame_view = setup.play.view().unwrap_or_default();
-        let local: Option<PlayerSprite> = frame_view.local.as_ref().map(PlayerSprite::from);
-        let remotes: Vec<PlayerSprite> =
-            frame_view.remotes.iter().map(PlayerSprite::from).collect();
+        let (local, remotes) = play::sprites(&frame_view, &mut animator, frame.as_secs_f32());
         let entities: Vec<EntitySprite> =
             frame_view.entities.iter().map(EntitySprite::from).collect();
         let me = setup.play.me();
@@ -695,13 +695,14 @@ async fn game(mut setup: Setup) {
                     .unwrap_or_else(|| format!("player #{}", p.id))
             })
             .collect();
-        for (p, label) in remotes.iter().zip(&labels) {
-            render::draw_player(p, &view, render::player_color(p.id, false), label);
-        }
-        if let Some(p) = &local {
-            let label = p.name.as_deref().unwrap_or(&setup.name);
-            render::draw_player(p, &view, render::player_color(p.id, true), label);
-        }
+        let local_label = local
+            .as_ref()
+            .map(|p| p.name.as_deref().unwrap_or(&setup.name));
+        render::draw_players(
+            &view,
+            local.as_ref().zip(local_label),
+            remotes.iter().zip(labels.iter().map(String::as_str)),
+        );
         effects.draw(&view);
         effects.draw_flash();
         if show_debug {

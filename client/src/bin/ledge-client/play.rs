@@ -6,6 +6,7 @@
 use std::time::{Duration, Instant};
 
 use glam::IVec2;
+use ledge_client::anim::{spread, Animator, Pose};
 use ledge_client::background::NetStatus;
 use ledge_client::game::ClientGame;
 use ledge_client::view::{EntityDraw, FrameView, NetStats, PlayerDraw};
@@ -25,8 +26,40 @@ impl From<&PlayerDraw> for PlayerSprite {
             size: p.size,
             facing: p.facing,
             won: p.won,
+            dead: p.dead,
+            pose: Pose::still(p),
         }
     }
+}
+
+/// The players of `view` to draw this frame (ours, then the others):
+/// posed by `animator` (advanced by `dt` seconds, the frame's duration)
+/// and, where several stand on one spot, fanned out sideways
+/// (`ledge_client::anim::spread`: ours never moves). Dead players keep
+/// their place and take no part in the fanning.
+pub fn sprites(
+    view: &FrameView,
+    animator: &mut Animator,
+    dt: f32,
+) -> (Option<PlayerSprite>, Vec<PlayerSprite>) {
+    let all: Vec<&PlayerDraw> = view.local.iter().chain(&view.remotes).collect();
+    let poses = animator.update(dt, all.iter().copied());
+    let mut sprites: Vec<PlayerSprite> = all
+        .iter()
+        .zip(poses)
+        .map(|(p, pose)| PlayerSprite {
+            pose,
+            ..PlayerSprite::from(*p)
+        })
+        .collect();
+    let alive: Vec<usize> = (0..all.len()).filter(|&i| !all[i].dead).collect();
+    let placed: Vec<_> = alive.iter().map(|&i| (all[i].id, all[i].pos)).collect();
+    let ours = view.local.as_ref().map(|p| p.id);
+    for (&i, pos) in alive.iter().zip(spread(&placed, ours)) {
+        sprites[i].pos = pos;
+    }
+    let remotes = sprites.split_off(view.local.is_some() as usize);
+    (sprites.pop(), remotes)
 }
 
 impl From<&EntityDraw> for EntitySprite {

@@ -4,6 +4,7 @@
 //! layers and tileset images) is drawn by `art.rs`; the tilemap's flat
 //! colours only fill the cells the art does not draw.
 
+use ledge_client::anim::{label_rows, Action, Label, Pose};
 use ledge_client::view::{EntityType, Facing};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::level::{EntityKind, Level};
@@ -94,12 +95,18 @@ pub mod palette {
     pub const EYE: Color = rgb(255, 255, 255);
     /// The local player.
     pub const LOCAL_PLAYER: Color = rgb(255, 132, 24);
-    /// Other players, by id.
-    pub const REMOTE_PLAYERS: [Color; 4] = [
-        rgb(64, 210, 255),
+    /// Other players, by id: each far from the others, from
+    /// [`LOCAL_PLAYER`] and from the sky, ground and grass (a test checks
+    /// the distances).
+    pub const REMOTE_PLAYERS: [Color; 8] = [
+        rgb(0, 220, 230),
         rgb(190, 120, 255),
-        rgb(130, 236, 110),
+        rgb(160, 245, 90),
         rgb(255, 110, 186),
+        rgb(40, 80, 220),
+        rgb(250, 240, 90),
+        rgb(0, 150, 136),
+        rgb(232, 40, 56),
     ];
 
     /// A colour as `[r, g, b]` bytes (for the screenshot JSON).
@@ -124,6 +131,11 @@ pub struct PlayerSprite {
     pub facing: Facing,
     /// Reached the goal (wears a crown).
     pub won: bool,
+    /// Dead: nothing is drawn (the effects draw its death).
+    pub dead: bool,
+    /// How it is drawn this frame (the pose's facing wins over
+    /// [`PlayerSprite::facing`]).
+    pub pose: Pose,
 }
 
 /// A level entity to draw (world pixels: centre and full size).
@@ -679,42 +691,214 @@ pub fn player_color(id: u32, local: bool) -> Color {
     }
 }
 
-/// Draws a player, with `label` above its head.
-pub fn draw_player(p: &PlayerSprite, view: &View, color: Color, label: &str) {
-    let tl = p.top_left();
-    let a = Rect::new(tl.x, tl.y, p.size.x, p.size.y);
-    rect(view, a.x, a.y, a.w, a.h, palette::INK);
-    rect(view, a.x + 1.0, a.y + 1.0, a.w - 2.0, a.h - 2.0, color);
-    // A belt, then the eyes.
-    let belt = Color::new(color.r * 0.6, color.g * 0.6, color.b * 0.6, 1.0);
-    rect(view, a.x + 1.0, a.y + a.h * 0.72, a.w - 2.0, 1.5, belt);
-    eyes(view, Rect::new(a.x, a.y, a.w, a.h * 0.8), p.facing);
-    if p.won {
-        let c = a.center().x;
-        for dx in [-4.0, 0.0, 4.0] {
-            tri(
-                view,
-                vec2(c + dx - 2.0, a.y - 1.0),
-                vec2(c + dx, a.y - 5.0),
-                vec2(c + dx + 2.0, a.y - 1.0),
-                palette::GOAL,
-            );
-        }
+/// Height of a player's legs at rest, world px (the body is the rest of
+/// its box).
+const LEG: f32 = 3.0;
+
+/// `c` darker (`f` < 1) or lighter, opaque.
+fn shade(c: Color, f: f32) -> Color {
+    Color::new(
+        (c.r * f).min(1.0),
+        (c.g * f).min(1.0),
+        (c.b * f).min(1.0),
+        1.0,
+    )
+}
+
+/// Size of name labels' text, screen px.
+const LABEL_SIZE: f32 = 16.0;
+/// Height of one row of name labels, screen px (the text and its box,
+/// and a little space).
+const LABEL_ROW: f32 = 22.0;
+
+/// Draws the players (ours over the others; `remotes` ascending by id),
+/// then their name labels over all of them, each label stepped up where
+/// it would overprint one before it (ours first, then by id). Dead players
+/// are not drawn, nor their labels.
+pub fn draw_players<'a>(
+    view: &View,
+    local: Option<(&'a PlayerSprite, &'a str)>,
+    remotes: impl IntoIterator<Item = (&'a PlayerSprite, &'a str)>,
+) {
+    let remotes: Vec<_> = remotes.into_iter().filter(|(p, _)| !hidden(p)).collect();
+    let local = local.filter(|(p, _)| !hidden(p));
+    for (p, _) in &remotes {
+        draw_body(p, view, player_color(p.id, false));
     }
-    if !label.is_empty() {
-        let size = 16.0;
-        let dims = measure_text(label, None, size as u16, 1.0);
-        let head = view.to_screen(vec2(a.center().x, a.y));
-        let x = (head.x - dims.width / 2.0).round();
-        let y = (head.y - 8.0 - if p.won { 4.0 * view.zoom } else { 0.0 }).round();
+    if let Some((p, _)) = local {
+        draw_body(p, view, player_color(p.id, true));
+    }
+    let labelled: Vec<(&PlayerSprite, &str, Vec2, TextDimensions)> = local
+        .into_iter()
+        .chain(remotes)
+        .filter(|(_, label)| !label.is_empty())
+        .map(|(p, label)| {
+            let dims = measure_text(label, None, LABEL_SIZE as u16, 1.0);
+            (p, label, label_place(p, view, &dims), dims)
+        })
+        .collect();
+    let boxes: Vec<Label> = labelled
+        .iter()
+        .map(|(_, _, at, dims)| Label {
+            x: at.x + dims.width / 2.0,
+            bottom: at.y - dims.offset_y + dims.height + 2.0,
+            width: dims.width + 8.0,
+        })
+        .collect();
+    let rows = label_rows(&boxes, LABEL_ROW);
+    for ((_, label, at, dims), row) in labelled.iter().zip(rows) {
+        let y = at.y - row as f32 * LABEL_ROW;
         draw_rectangle(
-            x - 3.0,
+            at.x - 3.0,
             y - dims.offset_y - 2.0,
             dims.width + 6.0,
             dims.height + 4.0,
             Color::new(0.0, 0.0, 0.0, 0.45),
         );
-        draw_text(label, x, y, size, WHITE);
+        draw_text(label, at.x, y, LABEL_SIZE, WHITE);
+    }
+}
+
+/// Whether `p` is not drawn at all (dead: the effects draw its death).
+fn hidden(p: &PlayerSprite) -> bool {
+    p.dead || p.pose.action == Action::Dead
+}
+
+/// Where `p`'s label text starts (left end of its baseline), screen px, in
+/// the lowest row: steady above its box (not bouncing with the pose),
+/// above its crown if it won.
+fn label_place(p: &PlayerSprite, view: &View, dims: &TextDimensions) -> Vec2 {
+    let top = view.to_screen(vec2(p.pos.x, p.pos.y - p.size.y / 2.0));
+    let crown = if p.won { 4.0 * view.zoom } else { 0.0 };
+    vec2(
+        (top.x - dims.width / 2.0).round(),
+        (top.y - 8.0 - crown).round(),
+    )
+}
+
+/// Draws a player's body in its pose (nothing while it is dead). The
+/// drawing stands on the bottom centre of its box: the body is scaled by
+/// the pose from there and sheared by its lean, the legs follow the action
+/// (a run cycle, tucked when rising, spread when falling, bent on landing,
+/// one against the wall when sliding down it).
+fn draw_body(p: &PlayerSprite, view: &View, color: Color) {
+    if hidden(p) {
+        return;
+    }
+    let pose = &p.pose;
+    let tl = p.top_left();
+    let a = Rect::new(tl.x, tl.y, p.size.x, p.size.y);
+    let foot = vec2(a.center().x, a.bottom());
+    let dir = pose.facing.sign();
+    let (sx, sy) = (pose.scale.x, pose.scale.y);
+    let leg = LEG * sy;
+    let bw = a.w * sx;
+    let bh = (a.h - LEG).max(1.0) * sy;
+    let swing = (pose.phase * std::f32::consts::TAU).sin();
+    let lift = (pose.phase * std::f32::consts::TAU).cos();
+    // Where the wall is while sliding down it (-1 left, 1 right): the
+    // player looks away from it.
+    let wall = -dir;
+    // Each leg: (x of its centre from the middle, how high its foot is
+    // off the ground); then how far the body is raised and pushed sideways.
+    let (legs, bob, push): ([(f32, f32); 2], f32, f32) = match pose.action {
+        Action::Idle | Action::Dead => ([(-2.5, 0.0), (2.5, 0.0)], 0.0, 0.0),
+        // Legs swing forward and back, the one swinging forward raised;
+        // the body is highest when they pass each other.
+        Action::Run => (
+            [
+                (3.0 * swing * dir, 1.5 * lift.max(0.0)),
+                (-3.0 * swing * dir, 1.5 * (-lift).max(0.0)),
+            ],
+            0.75 * (1.0 - swing.abs()),
+            0.0,
+        ),
+        // Tucked, one knee forward.
+        Action::Jump => ([(1.5 * dir, 2.0), (-1.5 * dir, 1.0)], 0.0, 0.0),
+        // Spread.
+        Action::Fall => ([(-3.5, 0.0), (3.5, 0.0)], 0.0, 0.0),
+        // Bent wide.
+        Action::Land => (
+            [(-3.5 * sx, 0.0), (3.5 * sx, 0.0)],
+            -pose.landing * 0.4 * leg,
+            0.0,
+        ),
+        // One foot up against the wall, the body pressed to it.
+        Action::WallSlide => (
+            [(wall * (bw / 2.0 - 2.0), 1.0), (-wall * 2.0, 0.0)],
+            0.0,
+            wall,
+        ),
+    };
+    let cx = foot.x + push;
+    let yb = foot.y - leg - bob;
+    // A point of the body `u` px right of its middle and `z` px above its
+    // bottom, leaning.
+    let at = |u: f32, z: f32| vec2(cx + u + pose.lean * z, yb - z);
+    // Legs (behind the body), with dark shoes pointing forward.
+    for (dx, up) in legs {
+        let x = foot.x + dx - 1.5;
+        let top = yb - 0.5;
+        let bottom = (foot.y - up).max(top + 1.0);
+        rect(view, x, top, 3.0, bottom - 1.0 - top, color);
+        let toe = if dir > 0.0 { 0.0 } else { -1.0 };
+        rect(view, x + toe, bottom - 1.0, 4.0, 1.0, palette::INK);
+    }
+    // The body: an outline, then the colour inside it.
+    quad(
+        view,
+        [
+            at(-bw / 2.0, 0.0),
+            at(bw / 2.0, 0.0),
+            at(bw / 2.0, bh),
+            at(-bw / 2.0, bh),
+        ],
+        palette::INK,
+    );
+    let (iw, ih) = (bw / 2.0 - 1.0, bh - 1.0);
+    quad(
+        view,
+        [at(-iw, 1.0), at(iw, 1.0), at(iw, ih), at(-iw, ih)],
+        color,
+    );
+    let head = at(0.0, bh);
+    eyes(
+        view,
+        Rect::new(head.x - bw / 2.0 - pose.lean * 0.3 * bh, head.y, bw, bh),
+        pose.facing,
+    );
+    // Arms: thrown up when jumping, flailing when falling, swinging
+    // against the legs when running, one on the wall when sliding.
+    let arm = shade(color, 0.6);
+    let shoulder = |k: f32| at(k * (bw / 2.0 - 0.5), bh * 0.45);
+    let arms: Vec<(f32, Vec2)> = match pose.action {
+        Action::Run => vec![
+            (-1.0, vec2(-2.0, 1.5 * swing * dir)),
+            (1.0, vec2(2.0, -1.5 * swing * dir)),
+        ],
+        Action::Jump => vec![(-1.0, vec2(-1.5, -4.0)), (1.0, vec2(1.5, -4.0))],
+        Action::Fall => vec![(-1.0, vec2(-3.0, -2.5)), (1.0, vec2(3.0, -2.5))],
+        Action::WallSlide => vec![
+            (wall, vec2(wall * 0.5, -5.0)),
+            (-wall, vec2(-wall * 2.5, 1.0)),
+        ],
+        Action::Idle | Action::Land | Action::Dead => Vec::new(),
+    };
+    for (k, reach) in arms {
+        let from = shoulder(k);
+        line(view, from, from + reach, 1.5, arm);
+    }
+    if p.won {
+        let c = head.x;
+        for dx in [-4.0, 0.0, 4.0] {
+            tri(
+                view,
+                vec2(c + dx - 2.0, head.y - 1.0),
+                vec2(c + dx, head.y - 5.0),
+                vec2(c + dx + 2.0, head.y - 1.0),
+                palette::GOAL,
+            );
+        }
     }
 }
 
@@ -734,6 +918,15 @@ mod tests {
         }
     }
 
+    /// Euclidean distance of two colours in RGB bytes (0 to 441).
+    fn distance(a: Color, b: Color) -> f32 {
+        let (a, b) = (palette::bytes(a), palette::bytes(b));
+        (0..3)
+            .map(|i| (a[i] as f32 - b[i] as f32).powi(2))
+            .sum::<f32>()
+            .sqrt()
+    }
+
     #[test]
     fn colours_are_distinct_where_tests_look() {
         let all = [
@@ -746,6 +939,53 @@ mod tests {
             for b in &all[i + 1..] {
                 assert_ne!(palette::bytes(*a), palette::bytes(*b));
             }
+        }
+    }
+
+    #[test]
+    fn players_are_told_apart_by_colour() {
+        let remotes = palette::REMOTE_PLAYERS;
+        assert!(remotes.len() >= 8, "at least 8 remote colours");
+        // Far from each other, from us, and from what they stand in front
+        // of (sky, clouds, ground, grass) and their own outline.
+        let near = 80.0;
+        for (i, a) in remotes.iter().enumerate() {
+            for b in &remotes[i + 1..] {
+                let d = distance(*a, *b);
+                assert!(
+                    d > near,
+                    "{:?} {:?}: {d}",
+                    palette::bytes(*a),
+                    palette::bytes(*b)
+                );
+            }
+            for b in [
+                palette::LOCAL_PLAYER,
+                palette::SKY,
+                palette::CLOUD,
+                palette::SOLID,
+                palette::GRASS,
+                palette::INK,
+            ] {
+                let d = distance(*a, b);
+                assert!(
+                    d > near,
+                    "{:?} {:?}: {d}",
+                    palette::bytes(*a),
+                    palette::bytes(b)
+                );
+            }
+        }
+        // By id: consecutive ids differ; ours is ours whatever its id.
+        for id in 0..16 {
+            assert_ne!(
+                palette::bytes(player_color(id, false)),
+                palette::bytes(player_color(id + 1, false))
+            );
+            assert_eq!(
+                palette::bytes(player_color(id, true)),
+                palette::bytes(palette::LOCAL_PLAYER)
+            );
         }
     }
 }
