@@ -654,7 +654,7 @@ async fn game(mut setup: Setup) {
                         size: p.size,
                         tint: render::player_color(p.id, false),
                     },
-                    dead: false,
+                    dead: p.dead,
                     won: p.won,
                 })
                 .collect::<Vec<_>>(),
