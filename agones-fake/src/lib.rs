@@ -538,3 +538,89 @@ impl Drop for FakeSidecar {
         }
     }
 }
+
+/// What a `GameServerAllocation` asks for (deploy/agones/allocation-*.yaml).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Want<'a> {
+    /// A server with a free room: an Allocated one with `rooms` count
+    /// below capacity first, the fullest of them (Packed scheduling,
+    /// priority on the `rooms` counter, ascending available), else a Ready
+    /// one likewise.
+    AnyRoom,
+    /// The server whose `rooms` list holds this room name (an Allocated
+    /// one first).
+    Room(&'a str),
+}
+
+/// Allocates a GameServer of `fleet` as Agones' allocator would for
+/// `want`, with ledge's allocation manifests: marks it `Allocated` and
+/// returns its index, or `None` when no server qualifies (the fleet is
+/// full: its autoscaler would add one). Ties go to the earlier server.
+pub fn allocate(fleet: &[&FakeSidecar], want: Want<'_>) -> Option<usize> {
+    const ROOMS: &str = "rooms";
+    let pick = |state: &str| -> Option<usize> {
+        let candidates = fleet.iter().enumerate().filter(|(_, s)| s.state() == state);
+        match want {
+            Want::AnyRoom => candidates
+                .filter_map(|(i, s)| {
+                    let (count, capacity) = s.counter(ROOMS)?;
+                    (count < capacity).then_some((capacity - count, i))
+                })
+                .min()
+                .map(|(_, i)| i),
+            Want::Room(name) => candidates
+                .filter(|(_, s)| s.list(ROOMS).is_some_and(|l| l.iter().any(|v| v == name)))
+                .map(|(i, _)| i)
+                .next(),
+        }
+    };
+    let chosen = pick("Allocated").or_else(|| pick("Ready"))?;
+    fleet[chosen].allocate();
+    Some(chosen)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fleet(n: usize) -> Vec<FakeSidecar> {
+        (0..n)
+            .map(|i| {
+                FakeSidecar::start(&format!("gs-{i}"), &[("rooms", 2)], &[("rooms", 2)])
+                    .expect("starts")
+            })
+            .collect()
+    }
+
+    #[test]
+    fn allocation_packs_rooms_onto_allocated_servers_then_takes_a_ready_one() {
+        let servers = fleet(3);
+        let all: Vec<&FakeSidecar> = servers.iter().collect();
+        // Nobody Ready yet: nothing to allocate.
+        assert_eq!(allocate(&all, Want::AnyRoom), None);
+        for s in &servers[1..] {
+            s.state.set_state("Ready");
+        }
+        // The first Ready one (gs-1), then it again while it has room.
+        assert_eq!(allocate(&all, Want::AnyRoom), Some(1));
+        assert_eq!(servers[1].state(), "Allocated");
+        let set_rooms = |s: &FakeSidecar, count: i64| {
+            s.state.change(|st, _| {
+                st.counters.get_mut("rooms").unwrap().count = count;
+            })
+        };
+        set_rooms(&servers[1], 1);
+        assert_eq!(allocate(&all, Want::AnyRoom), Some(1));
+        set_rooms(&servers[1], 2);
+        // Full: the next Ready one.
+        assert_eq!(allocate(&all, Want::AnyRoom), Some(2));
+        set_rooms(&servers[2], 2);
+        assert_eq!(allocate(&all, Want::AnyRoom), None);
+        // By room name.
+        servers[2].state.change(|st, _| {
+            st.lists.get_mut("rooms").unwrap().values = vec!["friends".into()];
+        });
+        assert_eq!(allocate(&all, Want::Room("friends")), Some(2));
+        assert_eq!(allocate(&all, Want::Room("nobody")), None);
+    }
+}
