@@ -6,14 +6,16 @@
 //! Following Agones' "high density game servers" pattern, one process
 //! hosts many rooms:
 //!
-//! * Counter [`ROOMS`]: count = rooms in use (with players, or opened by
-//!   name and not yet closed), capacity = the room cap; an allocation asks
-//!   for a server with a free room;
+//! * Counter [`ROOMS`]: count = open rooms (those open from the start, and
+//!   those opened by name until they close), capacity = the room cap: the
+//!   same numbers the server refuses a new room by, so an allocation that
+//!   finds a free room here can open one there;
 //! * Counter [`PLAYERS`]: count = players in the rooms, capacity = room
 //!   cap × places per room;
 //! * List [`ROOMS`]: the names of the open rooms, so an allocation can find
 //!   the server holding a named room;
-//! * label [`FULL_LABEL`]: `"true"` while every room is in use;
+//! * label [`FULL_LABEL`]: `"true"` while no room can open (the count is
+//!   at the cap);
 //! * annotation [`CERT_ANNOTATION`]: the certificate's SHA-256 fingerprint,
 //!   which clients pin (`--cert-hash`);
 //! * health pings every [`FleetConfig::health_every`] while **every** room's
@@ -86,15 +88,6 @@ pub struct RoomLoad {
     pub players: u32,
     /// Ticks it has simulated (its tick loop advances it).
     pub tick: u64,
-    /// Open from the start (`room-1`...): in use only with players.
-    pub permanent: bool,
-}
-
-impl RoomLoad {
-    /// Counts in [`ROOMS`]: it has players, or a player opened it by name.
-    pub fn in_use(&self) -> bool {
-        self.players > 0 || !self.permanent
-    }
 }
 
 /// The server's load: its open rooms and its caps.
@@ -109,8 +102,8 @@ pub struct Load {
 }
 
 impl Load {
-    fn in_use(&self) -> u32 {
-        self.rooms.iter().filter(|r| r.in_use()).count() as u32
+    fn open(&self) -> u32 {
+        u32::try_from(self.rooms.len()).unwrap_or(u32::MAX)
     }
 
     fn players(&self) -> u32 {
@@ -222,7 +215,7 @@ impl Fleet {
             calls.push(Call::ListCapacity(list_capacity));
         }
         let players = load.players();
-        self.counter(&mut calls, ROOMS, load.in_use(), load.room_cap);
+        self.counter(&mut calls, ROOMS, load.open(), load.room_cap);
         self.counter(
             &mut calls,
             PLAYERS,
@@ -237,7 +230,7 @@ impl Fleet {
             calls.push(Call::ListAdd(new.clone()));
         }
         self.listed = open;
-        let full = load.in_use() >= load.room_cap;
+        let full = load.open() >= load.room_cap;
         if self.full != Some(full) {
             self.full = Some(full);
             calls.push(Call::Label {
@@ -360,12 +353,11 @@ impl Fleet {
 mod tests {
     use super::*;
 
-    fn room(name: &str, players: u32, tick: u64, permanent: bool) -> RoomLoad {
+    fn room(name: &str, players: u32, tick: u64) -> RoomLoad {
         RoomLoad {
             name: name.to_owned(),
             players,
             tick,
-            permanent,
         }
     }
 
@@ -394,7 +386,7 @@ mod tests {
     fn the_first_poll_publishes_everything_then_says_ready() {
         let t0 = Instant::now();
         let mut fleet = Fleet::new(config(), "ab12");
-        let calls = fleet.poll(&load(vec![room("room-1", 0, 5, true)]), t0);
+        let calls = fleet.poll(&load(vec![room("room-1", 0, 5)]), t0);
         assert_eq!(
             calls,
             [
@@ -403,9 +395,10 @@ mod tests {
                     value: "ab12".into()
                 },
                 Call::ListCapacity(3),
+                // room-1, open from the start, takes a place of the cap.
                 Call::Counter {
                     name: ROOMS,
-                    count: 0,
+                    count: 1,
                     capacity: 3
                 },
                 Call::Counter {
@@ -423,22 +416,17 @@ mod tests {
             ]
         );
         // Nothing changed, no time passed: nothing to say.
-        assert!(fleet
-            .poll(&load(vec![room("room-1", 0, 6, true)]), t0)
-            .is_empty());
+        assert!(fleet.poll(&load(vec![room("room-1", 0, 6)]), t0).is_empty());
     }
 
     #[test]
     fn counters_list_and_label_follow_the_rooms() {
         let t0 = Instant::now();
         let mut fleet = Fleet::new(config(), "ab12");
-        fleet.poll(&load(vec![room("room-1", 0, 1, true)]), t0);
+        fleet.poll(&load(vec![room("room-1", 0, 1)]), t0);
         // A player joins room-1; another opens "friends" by name.
         let calls = fleet.poll(
-            &load(vec![
-                room("friends", 1, 1, false),
-                room("room-1", 1, 2, true),
-            ]),
+            &load(vec![room("friends", 1, 1), room("room-1", 1, 2)]),
             secs(t0, 0.5),
         );
         assert_eq!(
@@ -457,12 +445,12 @@ mod tests {
                 Call::ListAdd("friends".into()),
             ]
         );
-        // A third room: every room in use, the server is full.
+        // A third room: the cap is reached, the server is full.
         let calls = fleet.poll(
             &load(vec![
-                room("duel", 2, 1, false),
-                room("friends", 1, 2, false),
-                room("room-1", 1, 3, true),
+                room("duel", 2, 1),
+                room("friends", 1, 2),
+                room("room-1", 1, 3),
             ]),
             secs(t0, 1.0),
         );
@@ -471,9 +459,9 @@ mod tests {
             value: "true".into()
         }));
         assert!(calls.contains(&Call::ListAdd("duel".into())));
-        // "friends" closes, room-1 empties: 1 in use, not full.
+        // "friends" closes, room-1 empties: 2 open, not full.
         let calls = fleet.poll(
-            &load(vec![room("duel", 2, 5, false), room("room-1", 0, 6, true)]),
+            &load(vec![room("duel", 2, 5), room("room-1", 0, 6)]),
             secs(t0, 1.5),
         );
         assert_eq!(
@@ -481,7 +469,7 @@ mod tests {
             [
                 Call::Counter {
                     name: ROOMS,
-                    count: 1,
+                    count: 2,
                     capacity: 3
                 },
                 Call::Counter {
@@ -503,7 +491,7 @@ mod tests {
         let t0 = Instant::now();
         let mut fleet = Fleet::new(config(), "ab12");
         let pinged = |calls: Vec<Call>| calls.contains(&Call::Health);
-        let two = |a: u64, b: u64| load(vec![room("a", 1, a, false), room("b", 1, b, false)]);
+        let two = |a: u64, b: u64| load(vec![room("a", 1, a), room("b", 1, b)]);
         assert!(pinged(fleet.poll(&two(1, 1), t0)));
         // Within the period: no ping even though ticks advance.
         assert!(!pinged(fleet.poll(&two(60, 60), secs(t0, 1.0))));
@@ -519,7 +507,7 @@ mod tests {
         // A stuck room that closes no longer holds pings back.
         assert!(!pinged(fleet.poll(&two(400, 121), secs(t0, 8.0))));
         assert!(pinged(
-            fleet.poll(&load(vec![room("a", 1, 401, false)]), secs(t0, 8.1))
+            fleet.poll(&load(vec![room("a", 1, 401)]), secs(t0, 8.1))
         ));
     }
 
@@ -527,7 +515,7 @@ mod tests {
     fn an_allocated_server_shuts_down_once_empty_long_enough() {
         let t0 = Instant::now();
         let mut fleet = Fleet::new(config(), "ab12");
-        let with = |players: u32, tick: u64| load(vec![room("room-1", players, tick, true)]);
+        let with = |players: u32, tick: u64| load(vec![room("room-1", players, tick)]);
         let shuts = |calls: &[Call]| calls.contains(&Call::Shutdown);
         // Not allocated: empty forever, never shut down.
         fleet.poll(&with(0, 1), t0);
@@ -548,7 +536,7 @@ mod tests {
     fn a_failed_call_is_made_again() {
         let t0 = Instant::now();
         let mut fleet = Fleet::new(config(), "ab12");
-        let one = load(vec![room("room-1", 1, 1, true)]);
+        let one = load(vec![room("room-1", 1, 1)]);
         let calls = fleet.poll(&one, t0);
         for call in &calls {
             fleet.failed(call);

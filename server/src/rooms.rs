@@ -128,7 +128,6 @@ impl Rooms {
                 name: e.handle.name().to_owned(),
                 players: u32::try_from(e.handle.players()).unwrap_or(u32::MAX),
                 tick: e.handle.status().tick,
-                permanent: e.permanent,
             })
             .collect();
         Load {

@@ -16,8 +16,9 @@ use ledge_server::fleet::{FleetConfig, CERT_ANNOTATION, FULL_LABEL, PLAYERS, ROO
 use ledge_server::{Server, ServerConfig, ServerError};
 use ledge_tests::TestServer;
 
-/// Room places: `--max-rooms` 2 with 4 players each.
-const MAX_ROOMS: i64 = 2;
+/// Room places: `--max-rooms` 3 (room-1, open from the start, and two
+/// more by name) with 4 players each.
+const MAX_ROOMS: i64 = 3;
 const MAX_PLAYERS: i64 = 4;
 /// Time between health pings in these tests.
 const HEALTH: Duration = Duration::from_millis(200);
@@ -92,38 +93,55 @@ async fn ready_after_listening_then_counters_list_and_label_follow_two_rooms() {
         sidecar.annotation(CERT_ANNOTATION),
         Some(server.fingerprint.to_string())
     );
-    assert_eq!(sidecar.counter(ROOMS), Some((0, MAX_ROOMS)));
+    assert_eq!(sidecar.counter(ROOMS), Some((1, MAX_ROOMS)));
     assert_eq!(sidecar.counter(PLAYERS), Some((0, MAX_ROOMS * MAX_PLAYERS)));
     assert_eq!(sidecar.list(ROOMS), Some(vec!["room-1".to_owned()]));
     // Ready means listening: a player joins at once.
     let ada = join(&server, "ada", None).await;
-    until("1 player, 1 room in use", || {
-        sidecar.counter(PLAYERS) == Some((1, 8)) && sidecar.counter(ROOMS) == Some((1, 2))
+    until("1 player in room-1", || {
+        sidecar.counter(PLAYERS) == Some((1, 12)) && sidecar.counter(ROOMS) == Some((1, 3))
     })
     .await;
-    // A second room, opened by name: both rooms in use, the server full.
+    // A second room, opened by name.
     let bob = join(&server, "bob", Some("friends")).await;
-    until("2 rooms in use and full", || {
-        sidecar.counter(ROOMS) == Some((2, 2))
+    until("2 rooms open", || {
+        sidecar.counter(ROOMS) == Some((2, 3)) && sidecar.counter(PLAYERS) == Some((2, 12))
+    })
+    .await;
+    assert_eq!(sidecar.label(FULL_LABEL).as_deref(), Some("false"));
+    // A third: the room cap is reached, the server is full.
+    let carol = join(&server, "carol", Some("duel")).await;
+    until("3 rooms open and full", || {
+        sidecar.counter(ROOMS) == Some((3, 3))
             && sidecar.label(FULL_LABEL).as_deref() == Some("true")
     })
     .await;
-    assert_eq!(sidecar.counter(PLAYERS), Some((2, 8)));
+    assert_eq!(sidecar.counter(PLAYERS), Some((3, 12)));
     assert_eq!(
         sidecar.list(ROOMS),
-        Some(vec!["room-1".to_owned(), "friends".to_owned()])
+        Some(vec!["room-1".into(), "friends".into(), "duel".into()])
     );
-    // Both leave: room-1 (open from the start) is no longer in use;
-    // "friends" stays open (and listed) until it has been empty a minute.
-    ada.close().await;
-    bob.close().await;
-    until("no players, 1 room in use, not full", || {
-        sidecar.counter(PLAYERS) == Some((0, 8))
-            && sidecar.counter(ROOMS) == Some((1, 2))
-            && sidecar.label(FULL_LABEL).as_deref() == Some("false")
-    })
+    // A fourth room is refused by the server, as its counter said.
+    let refused = connect_with(
+        server.addr,
+        "localhost",
+        server.fingerprint,
+        &JoinOptions {
+            player_name: "dave".into(),
+            room: Some("more".into()),
+            resume: None,
+        },
+    )
     .await;
-    assert_eq!(sidecar.list(ROOMS).unwrap().len(), 2);
+    assert!(refused.is_err(), "a fourth room opened");
+    // All leave: no players; the rooms opened by name stay open (and
+    // counted) until they have been empty a minute.
+    for p in [ada, bob, carol] {
+        p.close().await;
+    }
+    until("no players", || sidecar.counter(PLAYERS) == Some((0, 12))).await;
+    assert_eq!(sidecar.counter(ROOMS), Some((3, 3)));
+    assert_eq!(sidecar.list(ROOMS).unwrap().len(), 3);
     // Nothing was sent twice for nothing: each counter value once.
     let players_updates = sidecar
         .calls()
@@ -132,7 +150,7 @@ async fn ready_after_listening_then_counters_list_and_label_follow_two_rooms() {
             |c| matches!(c, Call::UpdateCounter { name, count: Some(_), .. } if name == PLAYERS),
         )
         .count();
-    assert_eq!(players_updates, 4, "0, 1, 2, 0: {:?}", sidecar.calls());
+    assert_eq!(players_updates, 5, "0, 1, 2, 3, 0: {:?}", sidecar.calls());
     server.stop().await.expect("clean stop");
 }
 
@@ -266,12 +284,101 @@ async fn a_failing_sidecar_is_retried_and_play_goes_on() {
     .await;
     assert_eq!(
         sidecar.counter(PLAYERS),
-        Some((0, 8)),
+        Some((0, 12)),
         "nothing got through"
     );
     // The sidecar recovers: the count catches up.
     sidecar.set_failing(false);
-    until("caught up", || sidecar.counter(PLAYERS) == Some((1, 8))).await;
+    until("caught up", || sidecar.counter(PLAYERS) == Some((1, 12))).await;
     ada.close().await;
     server.stop().await.expect("clean stop");
+}
+
+/// A local fleet of three servers, each under its own fake sidecar: rooms
+/// are allocated one by one with Agones' rule for ledge's manifests (a free
+/// room on the fullest Allocated server, else a Ready one), two players
+/// join each; every room's players see each other and nobody else, every
+/// sidecar lists exactly its rooms, and the fleet is full after 3 × 2.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_fleet_of_three_packs_rooms_by_the_counter_rule_without_cross_talk() {
+    use ledge_agones_fake::{allocate, Want};
+    use ledge_shared::game::kind;
+
+    const PER_ROOM: usize = 2;
+    let sidecars: Vec<FakeSidecar> = (0..3).map(|_| sidecar()).collect();
+    let mut servers = Vec::new();
+    for s in &sidecars {
+        servers.push(server_under(fleet(s, Duration::from_secs(60))).await);
+    }
+    for s in &sidecars {
+        until("Ready", || s.state() == "Ready").await;
+    }
+    let all: Vec<&FakeSidecar> = sidecars.iter().collect();
+    // Room k goes where the rule says; its players join there.
+    let mut rooms: Vec<(String, usize, Vec<Session>)> = Vec::new();
+    // Each server has room-1 open from the start: two more rooms each.
+    let per_server = MAX_ROOMS as usize - 1;
+    for k in 0..3 * per_server {
+        let name = format!("match-{k}");
+        let at = allocate(&all, Want::AnyRoom).expect("a server with a free room");
+        // Packed: the first server's rooms fill up before the next is used.
+        assert_eq!(at, k / per_server, "room {name}");
+        let mut players = Vec::new();
+        for p in 0..PER_ROOM {
+            players.push(join(&servers[at], &format!("p{k}-{p}"), Some(&name)).await);
+        }
+        let listed = |s: &FakeSidecar| s.list(ROOMS).is_some_and(|l| l.contains(&name));
+        until("the room listed", || listed(&sidecars[at])).await;
+        rooms.push((name, at, players));
+    }
+    assert_eq!(allocate(&all, Want::AnyRoom), None, "the fleet is full");
+    for (i, s) in sidecars.iter().enumerate() {
+        until("counters", || {
+            s.counter(ROOMS) == Some((3, 3))
+                && s.counter(PLAYERS) == Some((2 * PER_ROOM as i64, 12))
+                && s.label(FULL_LABEL).as_deref() == Some("true")
+        })
+        .await;
+        let mut mine: Vec<String> = rooms
+            .iter()
+            .filter(|r| r.1 == i)
+            .map(|r| r.0.clone())
+            .collect();
+        mine.push("room-1".into());
+        let mut listed = s.list(ROOMS).unwrap();
+        mine.sort();
+        listed.sort();
+        assert_eq!(listed, mine, "server {i} lists its rooms");
+    }
+    // A named room is found on its server.
+    for (name, at, _) in &rooms {
+        assert_eq!(allocate(&all, Want::Room(name)), Some(*at));
+    }
+    // No cross-talk: each player sees exactly its room's players.
+    for (name, _, players) in &mut rooms {
+        let ids: std::collections::BTreeSet<u32> =
+            players.iter().map(|p| p.welcome().player_id.0).collect();
+        for p in players.iter_mut() {
+            let snapshot = ledge_tests::snapshot_where(p, Duration::from_secs(3), |s| {
+                s.entities.iter().filter(|e| e.kind == kind::PLAYER).count() == PER_ROOM
+            })
+            .await;
+            let seen: std::collections::BTreeSet<u32> = snapshot
+                .entities
+                .iter()
+                .filter(|e| e.kind == kind::PLAYER)
+                .map(|e| e.id)
+                .collect();
+            assert_eq!(seen, ids, "in {name}");
+            assert_eq!(&p.welcome().room, name);
+        }
+    }
+    for (_, _, players) in rooms {
+        for p in players {
+            p.close().await;
+        }
+    }
+    for server in servers {
+        server.stop().await.expect("clean stop");
+    }
 }
