@@ -1,22 +1,25 @@
 //! Builds the server side of the Agones SDK's gRPC services from the
-//! vendored definitions (`proto/`, see its README). Needs `protoc`
-//! (Debian: protobuf-compiler), as the `agones` crate itself does.
+//! definitions the SDK itself is built from (`vendor/agones/proto`, see
+//! `vendor/agones/VENDORED.md`), parsed by protox: no `protoc` needed.
 
 fn main() {
+    let root = "../vendor/agones/proto";
+    let protos = [
+        format!("{root}/sdk/sdk.proto"),
+        format!("{root}/sdk/beta/beta.proto"),
+    ];
+    let includes = [
+        format!("{root}/googleapis"),
+        format!("{root}/grpc-gateway"),
+        format!("{root}/sdk/beta"),
+        format!("{root}/sdk"),
+    ];
+    println!("cargo:rerun-if-changed={root}");
+    let descriptors = protox::compile(&protos, &includes)
+        .expect("parsing the Agones SDK protocol (vendor/agones/proto)");
     tonic_build::configure()
         .build_client(false)
         .build_server(true)
-        .compile_protos(
-            &["proto/sdk/sdk.proto", "proto/sdk/beta/beta.proto"],
-            &[
-                "proto/googleapis",
-                "proto/grpc-gateway",
-                "proto/sdk/beta",
-                "proto/sdk",
-            ],
-        )
-        .expect(
-            "compiling the Agones SDK protocol (proto/): is protoc installed? \
-             (apt-get install protobuf-compiler)",
-        );
+        .compile_fds(descriptors)
+        .expect("generating the fake sidecar's gRPC services");
 }

@@ -1,6 +1,6 @@
 //! A fake Agones SDK sidecar for tests: the SDK's own gRPC services
 //! (`agones.dev.sdk.SDK` and `agones.dev.sdk.beta.SDK`, built from the
-//! vendored definitions in `proto/`) served with tonic on
+//! definitions the SDK is built from, `vendor/agones/proto`) served with tonic on
 //! `127.0.0.1:PORT`, keeping a GameServer as the real sidecar does (state,
 //! labels and annotations prefixed `agones.dev/sdk-`, counters and lists
 //! declared up front with their capacities) and recording every call with
