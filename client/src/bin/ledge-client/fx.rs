@@ -528,7 +528,9 @@ impl Fx {
 
     /// Advances everything by `dt` seconds (clamped to a tenth of a
     /// second: a stalled frame does not throw particles across the level).
-    pub fn update(&mut self, dt: f32) {
+    /// Falling pieces stop where `solid(world px)` says the ground is, and
+    /// lie there while they fade.
+    pub fn update(&mut self, dt: f32, solid: impl Fn(Vec2) -> bool) {
         let dt = dt.clamp(0.0, 0.1);
         self.time += dt;
         self.trauma = (self.trauma - TRAUMA_DECAY * dt).max(0.0);
@@ -537,7 +539,13 @@ impl Fx {
             p.age += dt;
             p.vel.y += p.gravity * dt;
             p.vel *= p.drag.powf(dt);
-            p.pos += p.vel * dt;
+            let next = p.pos + p.vel * dt;
+            if p.gravity > 0.0 && solid(next) {
+                p.vel = Vec2::ZERO;
+                p.gravity = 0.0;
+            } else {
+                p.pos = next;
+            }
         }
         self.particles.retain(|p| p.age < p.life);
     }
@@ -630,11 +638,11 @@ mod tests {
             .filter(|p| p.color == palette::LOCAL_PLAYER)
             .count();
         assert!(ours >= 10, "{ours}");
-        fx.update(1.0 / 60.0);
+        fx.update(1.0 / 60.0, |_| false);
         assert!(fx.shake().length() > 0.0);
         assert!(fx.flash().a > 0.2);
         // They fly apart.
-        fx.update(0.1);
+        fx.update(0.1, |_| false);
         let far = fx
             .particles()
             .iter()
@@ -642,7 +650,7 @@ mod tests {
             .count();
         assert!(far > n / 2, "{far} of {n}");
         for _ in 0..20 {
-            fx.update(0.1);
+            fx.update(0.1, |_| false);
         }
         assert!(fx.particles().is_empty());
         assert_eq!(fx.shake(), Vec2::ZERO);
@@ -651,18 +659,38 @@ mod tests {
     }
 
     #[test]
+    fn falling_pieces_lie_on_the_ground() {
+        let mut fx = Fx::default();
+        fx.start(Effect::Hurt, at(100.0, 50.0), true);
+        // Ground from y = 60 down.
+        let ground = |p: Vec2| p.y >= 60.0;
+        for _ in 0..30 {
+            fx.update(1.0 / 60.0, ground);
+        }
+        let pieces: Vec<&Particle> = fx
+            .particles()
+            .iter()
+            .filter(|p| p.shape == Shape::Square)
+            .collect();
+        assert!(!pieces.is_empty());
+        assert!(pieces.iter().all(|p| p.pos.y < 60.0), "{pieces:?}");
+        let resting = pieces.iter().filter(|p| p.vel == Vec2::ZERO).count();
+        assert!(resting > pieces.len() / 2, "{resting} of {}", pieces.len());
+    }
+
+    #[test]
     fn each_effect_leaves_something_on_screen_and_only_ours_shake() {
         for effect in Effect::ALL {
             let mut fx = Fx::new(7);
             fx.start(effect, at(0.0, 0.0), false);
             assert!(!fx.particles().is_empty(), "{effect:?}");
-            fx.update(0.01);
+            fx.update(0.01, |_| false);
             assert_eq!(fx.shake(), Vec2::ZERO, "{effect:?} is not ours");
             assert_eq!(fx.flash().a, 0.0, "{effect:?}");
         }
         let mut fx = Fx::new(7);
         fx.start(Effect::Goal, at(0.0, 0.0), true);
-        fx.update(0.01);
+        fx.update(0.01, |_| false);
         assert!(fx.shake().length() > 0.0 && fx.flash().a > 0.0);
     }
 
@@ -692,7 +720,7 @@ mod tests {
             fx.recent(),
             [Effect::Hurt, Effect::Respawn, Effect::Respawn, Effect::Goal]
         );
-        fx.update(0.01);
+        fx.update(0.01, |_| false);
         assert_eq!(fx.shake(), Vec2::ZERO);
         // Gone, then back: seen for the first time again.
         fx.watch(&[]);
@@ -707,7 +735,7 @@ mod tests {
         for i in 0..200 {
             for fx in [&mut a, &mut b] {
                 fx.start(Effect::Goal, at(i as f32, 0.0), true);
-                fx.update(0.004);
+                fx.update(0.004, |_| false);
             }
         }
         assert_eq!(a.particles().len(), MAX_PARTICLES);
@@ -716,7 +744,7 @@ mod tests {
         // A stalled frame moves particles at most a tenth of a second's
         // worth.
         let before: Vec<Vec2> = a.particles().iter().map(|p| p.pos).collect();
-        a.update(5.0);
+        a.update(5.0, |_| false);
         for (p, q) in a.particles().iter().zip(&before) {
             assert!(p.pos.distance(*q) < 40.0, "{p:?} from {q}");
         }

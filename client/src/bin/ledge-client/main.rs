@@ -659,7 +659,11 @@ async fn game(mut setup: Setup) {
                 })
                 .collect::<Vec<_>>(),
         );
-        effects.update(frame.as_secs_f32());
+        let map = &level.tilemap;
+        effects.update(frame.as_secs_f32(), |p| {
+            let units = (p * UNITS_PER_PX as f32).clamp(Vec2::splat(-1e9), Vec2::splat(1e9));
+            map.is_solid_at(IVec2::new(units.x as i32, units.y as i32))
+        });
         // The shake moves the world, not the HUD.
         let view = camera::View {
             offset: view.offset + effects.shake(),
