@@ -7,8 +7,9 @@
 //!   [`FleetConfig::connect_timeout`]); a sidecar that never answers stops
 //!   the server with an error saying so.
 //! * Every [`POLL`], the rooms' load goes to [`Fleet::poll`] and its calls
-//!   are made in order. A call that fails is logged (a warning at most
-//!   every [`WARN_EVERY`]) and made again at the next poll; play goes on.
+//!   are made in order. A call that fails, or gets no answer within
+//!   [`CALL_TIMEOUT`], is logged (a warning at most every [`WARN_EVERY`])
+//!   and made again at the next poll; play goes on.
 //! * The GameServer is watched (re-watched after a lost stream) for its
 //!   state: `Allocated` starts the empty-server clock.
 //! * Health pings go through the SDK's health stream, reopened when the
@@ -32,6 +33,10 @@ pub const POLL: Duration = Duration::from_millis(250);
 
 /// Shortest time between two warnings about failed SDK calls.
 pub const WARN_EVERY: Duration = Duration::from_secs(10);
+
+/// Longest an SDK call may take before it counts as failed (a sidecar that
+/// accepts and never answers must not hold up the health pings for long).
+pub const CALL_TIMEOUT: Duration = Duration::from_secs(2);
 
 /// The sidecar's port: `config.sdk_port`, else `AGONES_SDK_GRPC_PORT`,
 /// else 9357 (as the SDK reads it).
@@ -269,7 +274,10 @@ async fn drive(
                 }
                 continue;
             }
-            match make(&mut sdk, &call).await {
+            let made = tokio::time::timeout(CALL_TIMEOUT, make(&mut sdk, &call))
+                .await
+                .unwrap_or_else(|_| Err(format!("no answer within {CALL_TIMEOUT:?}")));
+            match made {
                 Ok(()) => {
                     debug!(?call, "Agones SDK call made");
                     if call == Call::Shutdown {
