@@ -82,7 +82,7 @@ struct FleetArgs {
     /// reach the goal.
     #[arg(long, default_value = "runner")]
     brain: String,
-    /// Measured window, seconds, once every room is allocated.
+    /// Measured window, seconds, once every bot is in (after --warmup).
     #[arg(long, default_value_t = 30.0)]
     duration: f64,
     /// Time between the last bot joining and the window, seconds (the
