@@ -441,6 +441,8 @@ pub struct FleetReport {
     pub rooms_per_server: usize,
     /// Bots per room (K).
     pub bots_per_room: usize,
+    /// The bots' brain (thin bots do not predict: no mispredictions).
+    pub brain: String,
     /// The window, seconds (measured).
     pub window_s: f64,
     /// The allocations, in order.
@@ -539,7 +541,11 @@ impl FleetReport {
                 b.bots,
                 b.joined,
                 b.goals,
-                b.mispredictions,
+                if self.brain == "thin" {
+                    "-".to_owned()
+                } else {
+                    b.mispredictions.to_string()
+                },
                 b.cpu_pct
             );
         }
@@ -1313,6 +1319,7 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
         servers: s,
         rooms_per_server: r,
         bots_per_room: k,
+        brain: config.brain.clone(),
         window_s,
         allocations,
         one_more,
@@ -1542,6 +1549,7 @@ mod tests {
             servers: 1,
             rooms_per_server: 1,
             bots_per_room: 2,
+            brain: "runner".into(),
             window_s: 30.0,
             allocations: vec![Allocation {
                 room: "fleet-01".into(),
@@ -1604,6 +1612,14 @@ mod tests {
             md.contains("| gs-1 | 3.10 | 3.50 | exit status: 0 |"),
             "{md}"
         );
+        // Thin bots do not predict.
+        let thin = FleetReport {
+            brain: "thin".into(),
+            ..report
+        };
+        assert!(thin
+            .markdown()
+            .contains("| fleet-01 | gs-1 | 2 | 2 | 2 | - | 20 |"));
     }
 
     #[test]
