@@ -8,10 +8,15 @@
 //! The bots are `ledge-bot`'s, predicting with a brain or thin
 //! (`--brain thin`: inputs and snapshots, no prediction), which cost far
 //! less.
+//!
+//! [`fleet`] is `ledge-load fleet`: a local Agones fleet of servers with
+//! fake SDK sidecars, rooms allocated across them by Agones' rule, and
+//! checks that no room's players end up anywhere else.
 
 #![deny(missing_docs)]
 
 pub mod children;
+pub mod fleet;
 pub mod procstat;
 pub mod prom;
 pub mod quantile;
