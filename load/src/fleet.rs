@@ -90,7 +90,9 @@ pub const SHUTDOWN_EARLY_TOLERANCE: Duration = Duration::from_millis(500);
 pub struct FleetConfig {
     /// Server processes (S).
     pub servers: usize,
-    /// Rooms per server (R): `--max-rooms`, and the capacities declared.
+    /// Rooms allocated per server (R). Its `--max-rooms` (and the
+    /// capacities declared) is R + 1: `room-1`, open from the start, takes
+    /// a place, and the server's `rooms` counter counts it.
     pub rooms_per_server: usize,
     /// Bots per room (K): `--max-players`, one `ledge-bot` process each
     /// room.
@@ -108,9 +110,6 @@ pub struct FleetConfig {
     pub shutdown_after: Duration,
     /// `--agones-health-every` of the servers (`None`: their default).
     pub health_every: Option<Duration>,
-    /// The first room allocated on each server is its start-up room
-    /// (`room-1`) rather than a fresh name.
-    pub use_start_room: bool,
     /// Server tick rate, Hz.
     pub tick_hz: u32,
     /// Server snapshot rate, Hz.
@@ -620,12 +619,13 @@ fn server_failure(log: &Path) -> String {
 
 fn start_member(config: &FleetConfig, index: usize, stop: &Stop) -> anyhow::Result<Member> {
     let name = format!("gs-{}", index + 1);
-    let r = config.rooms_per_server as i64;
+    // room-1, open from the start, takes one of the --max-rooms places.
+    let places = config.rooms_per_server as i64 + 1;
     let k = config.bots_per_room as i64;
     let sidecar = FakeSidecar::start(
         &format!("ledge-fleet-{}", index + 1),
-        &[(ROOMS, r), (PLAYERS, r * k)],
-        &[(ROOMS, r)],
+        &[(ROOMS, places), (PLAYERS, places * k)],
+        &[(ROOMS, places)],
     )
     .with_context(|| format!("starting the fake Agones sidecar of {name}"))?;
     let cert_dir = tempfile::tempdir().context("creating a certificate directory")?;
@@ -644,7 +644,7 @@ fn start_member(config: &FleetConfig, index: usize, stop: &Stop) -> anyhow::Resu
         .arg(cert_dir.path())
         .args(["--tick-rate", &config.tick_hz.to_string()])
         .args(["--snapshot-rate", &config.snapshot_hz.to_string()])
-        .args(["--max-rooms", &config.rooms_per_server.to_string()])
+        .args(["--max-rooms", &places.to_string()])
         .args(["--max-players", &config.bots_per_room.to_string()])
         .args(["--max-connections", &clients])
         // Every bot connects from this machine's one address.
@@ -889,12 +889,6 @@ fn wait_for_room(
                 .into_iter()
                 .find_map(|b| b.ended.filter(|why| why.contains("no room named")));
             let hint = match refused {
-                Some(why) if !is_start_room(room) => format!(
-                    "\nthe server refused the room: {why}\n(its start-up room {START_ROOM} takes \
-                     one of its --max-rooms places but not a place in its `rooms` counter, so \
-                     the allocation rule sends it one room too many; --use-start-room fills \
-                     {START_ROOM} first)"
-                ),
                 Some(why) => format!("\nthe server refused the room: {why}"),
                 None => String::new(),
             };
@@ -965,11 +959,7 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
                     .collect::<Vec<_>>()
             );
         };
-        let room = if config.use_start_room && rooms_of[server].is_empty() {
-            START_ROOM.to_owned()
-        } else {
-            room_name(i)
-        };
+        let room = room_name(i);
         let before = members[server].sidecar.counter(ROOMS).map_or(0, |(n, _)| n);
         let seconds = end.saturating_duration_since(Instant::now()).as_secs_f64();
         let mut process = start_bot_process(config, &members[server], server, &room, i, seconds)?;
@@ -1459,7 +1449,7 @@ mod tests {
         assert!(problems[2].contains("fleet-03") && problems[2].contains("cross-talk"));
         assert!(problems[3].contains("fleet-04") && problems[3].contains("is open"));
         assert!(problems[4].contains("room-1") && problems[4].contains("1 players"));
-        // The start-up room allocated (--use-start-room) counts like any.
+        // A start-up room allocated by name counts like any.
         let expected = names(&["room-1", "fleet-02"]);
         let actual =
             players("ledge_players{room=\"room-1\"} 4\nledge_players{room=\"fleet-02\"} 4\n");
@@ -1651,7 +1641,6 @@ mod tests {
             room_timeout: Duration::from_secs(5),
             shutdown_after: Duration::from_secs(3),
             health_every: None,
-            use_start_room: false,
             tick_hz: 60,
             snapshot_hz: 30,
             bin_dir: PathBuf::new(),

@@ -101,11 +101,6 @@ struct FleetArgs {
     /// The servers' --agones-health-every, seconds [default: theirs].
     #[arg(long)]
     health_every: Option<f64>,
-    /// Allocate each server's start-up room (room-1) first, then fresh
-    /// names: works around a server counting room-1 against --max-rooms
-    /// but not in its rooms counter.
-    #[arg(long)]
-    use_start_room: bool,
     /// Server tick rate, Hz.
     #[arg(long, default_value_t = 60)]
     tick_hz: u32,
@@ -259,7 +254,6 @@ fn fleet(args: FleetArgs) -> anyhow::Result<bool> {
             .health_every
             .map(|h| seconds(h, "--health-every", false))
             .transpose()?,
-        use_start_room: args.use_start_room,
         tick_hz: args.tick_hz,
         snapshot_hz: args.snapshot_hz,
         bin_dir: bin_dir.clone(),
@@ -456,21 +450,12 @@ mod tests {
         };
         assert_eq!((f.servers, f.rooms_per_server, f.bots_per_room), (3, 2, 4));
         assert_eq!((f.duration, f.shutdown_after), (30.0, 3.0));
-        assert!(!f.use_start_room);
-        let cli = parse(&[
-            "fleet",
-            "--servers",
-            "2",
-            "--use-start-room",
-            "--brain",
-            "walker",
-        ])
+        let cli = parse(&["fleet", "--servers", "2", "--brain", "walker"])
         .unwrap();
         let Some(Mode::Fleet(f)) = cli.command else {
             panic!("not the fleet mode");
         };
         assert_eq!((f.servers, f.brain.as_str()), (2, "walker"));
-        assert!(f.use_start_room);
         // The two modes' flags do not mix.
         assert!(parse(&["--bots", "16", "fleet"]).is_err());
         assert!(parse(&["fleet", "--bots", "16"]).is_err());
