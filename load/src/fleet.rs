@@ -7,9 +7,10 @@
 //!
 //! The run:
 //!
-//! 1. starts the sidecars (declaring Counter `rooms` = R, Counter `players`
-//!    = R×K and List `rooms` = R, as the GameServer spec does) and the
-//!    servers (`--max-rooms R --max-players K`, `AGONES_SDK_GRPC_PORT` =
+//! 1. starts the sidecars (declaring Counter `rooms` = R + 1, Counter
+//!    `players` = (R + 1)×K and List `rooms` = R + 1, as the GameServer
+//!    spec does: `room-1`, open from the start, takes a place) and the
+//!    servers (`--max-rooms R+1 --max-players K`, `AGONES_SDK_GRPC_PORT` =
 //!    their sidecar's port); waits for each to say `Ready` and reads its
 //!    fingerprint from the `ledge-cert-sha256` annotation, as a matchmaker
 //!    would;
@@ -1102,7 +1103,8 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
             expected,
             &m.sidecar.list(ROOMS).unwrap_or_default(),
         ));
-        let want_rooms = Some((r as i64, r as i64));
+        // Its allocated rooms and room-1, open from the start: full.
+        let want_rooms = Some((r as i64 + 1, r as i64 + 1));
         if m.sidecar.counter(ROOMS) != want_rooms {
             problems.push(format!(
                 "{}: rooms counter {:?}, not {want_rooms:?}",

@@ -70,8 +70,9 @@ struct FleetArgs {
     /// Server processes, each with its fake sidecar.
     #[arg(long, default_value_t = 3)]
     servers: usize,
-    /// Rooms per server (its --max-rooms and the capacities its GameServer
-    /// declares); servers x rooms are allocated.
+    /// Rooms allocated per server; servers x rooms are allocated. Each
+    /// server gets --max-rooms one more (its room-1, open from the start,
+    /// takes a place), and its GameServer declares those capacities.
     #[arg(long, default_value_t = 2)]
     rooms_per_server: usize,
     /// Bots per room (the servers' --max-players), one ledge-bot process
@@ -450,8 +451,7 @@ mod tests {
         };
         assert_eq!((f.servers, f.rooms_per_server, f.bots_per_room), (3, 2, 4));
         assert_eq!((f.duration, f.shutdown_after), (30.0, 3.0));
-        let cli = parse(&["fleet", "--servers", "2", "--brain", "walker"])
-        .unwrap();
+        let cli = parse(&["fleet", "--servers", "2", "--brain", "walker"]).unwrap();
         let Some(Mode::Fleet(f)) = cli.command else {
             panic!("not the fleet mode");
         };
