@@ -95,17 +95,34 @@ impl LevelBundle {
     }
 }
 
-/// SHA-256 of `bytes`.
+/// SHA-256 of `bytes` (ring natively, already built for rustls; the
+/// pure-Rust sha2 for wasm32, where ring would need a C compiler).
 pub fn sha256(bytes: &[u8]) -> [u8; 32] {
-    let digest = ring::digest::digest(&ring::digest::SHA256, bytes);
-    let mut out = [0u8; 32];
-    out.copy_from_slice(digest.as_ref());
-    out
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        let digest = ring::digest::digest(&ring::digest::SHA256, bytes);
+        let mut out = [0u8; 32];
+        out.copy_from_slice(digest.as_ref());
+        out
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        use sha2::Digest;
+        sha2::Sha256::digest(bytes).into()
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sha256_is_sha_256() {
+        // FIPS 180-2's "abc" vector.
+        let expected = "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad";
+        let got: String = sha256(b"abc").iter().map(|b| format!("{b:02x}")).collect();
+        assert_eq!(got, expected);
+    }
 
     #[test]
     fn bundles_round_trip_and_refuse_trailing_bytes_and_bad_art() {
