@@ -14,22 +14,22 @@
 //! dropped and counted rather than piling up.
 
 use std::collections::BTreeMap;
-use std::fmt;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use ledge_levels::LevelBundle;
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::{CloseCode, Fingerprint, NoticeKind, PlayerId, Welcome};
+use ledge_shared::protocol::{CloseCode, Fingerprint, PlayerId};
 use tokio::sync::oneshot;
 
-use crate::bundle::{fetch_level, FetchOptions, Fetched, LevelCache};
+use crate::bundle::{fetch_level, FetchOptions, LevelCache};
 use crate::error::ClientError;
+use crate::net::Network;
+pub use crate::net::{NetEvent, NetStatus};
 use crate::netstats::TransportSample;
-use crate::session::{JoinOptions, Session, SessionEvent, SnapshotUpdate};
+use crate::session::{JoinOptions, Session, SessionEvent};
 use crate::trust::{connect_trusted, Trust};
 
 /// How often the background thread pings the server.
@@ -92,64 +92,6 @@ pub enum NetCommand {
     },
     /// Say something in the room.
     Chat(String),
-}
-
-/// What the background thread reports.
-#[derive(Debug, Clone, PartialEq)]
-pub enum NetEvent {
-    /// Downloading the server's level: `got` of `total` bytes.
-    LevelProgress {
-        /// Bytes so far (a resumed download starts above 0).
-        got: u64,
-        /// The level's size.
-        total: u64,
-    },
-    /// The server's level (with [`NetOptions::download_level`]), just
-    /// before [`NetEvent::Connected`].
-    Level(Box<LevelBundle>, Fetched),
-    /// The server welcomed us.
-    Connected(Welcome),
-    /// A fresh round-trip measurement.
-    Rtt(Duration),
-    /// A new authoritative snapshot, decoded.
-    Snapshot(SnapshotUpdate),
-    /// A chat line from a player in our room.
-    Chat {
-        /// Who said it.
-        from: PlayerId,
-        /// The line.
-        text: String,
-    },
-    /// A server announcement (shutdown, kick, information).
-    Notice(NoticeKind),
-    /// A player is in our room (from the roster after the welcome, us
-    /// included, or joining later).
-    PlayerJoined {
-        /// Its id.
-        id: PlayerId,
-        /// Its name.
-        name: String,
-    },
-    /// A player left our room.
-    PlayerLeft {
-        /// Its id.
-        id: PlayerId,
-    },
-    /// Connecting failed; the thread has ended.
-    Failed(String),
-    /// Connecting failed because the server's certificate is not the one
-    /// trusted (a wrong pin, or a known host whose certificate changed);
-    /// the message says what to do. The thread has ended.
-    Untrusted(String),
-    /// The connection was lost; reconnecting (attempt 0: just lost). Then
-    /// [`NetEvent::Connected`] (the same player, if the server still kept
-    /// it) or [`NetEvent::Disconnected`].
-    Reconnecting {
-        /// Failed attempts so far.
-        attempt: u32,
-    },
-    /// An established session ended; the thread has ended.
-    Disconnected(String),
 }
 
 /// A running network thread. Dropping it leaves the server and joins the
@@ -251,6 +193,28 @@ impl NetThread {
     /// Waits up to `timeout` for the next event (for headless callers).
     pub fn recv_timeout(&self, timeout: Duration) -> Option<NetEvent> {
         self.events.recv_timeout(timeout).ok()
+    }
+}
+
+impl Network for NetThread {
+    fn try_recv(&mut self) -> Option<NetEvent> {
+        NetThread::try_recv(self)
+    }
+
+    fn send_input(&mut self, tick: u64, buttons: Buttons) -> bool {
+        NetThread::send_input(self, tick, buttons)
+    }
+
+    fn chat(&mut self, text: &str) -> bool {
+        NetThread::chat(self, text)
+    }
+
+    fn transport(&self) -> Option<TransportSample> {
+        NetThread::transport(self)
+    }
+
+    fn players(&self) -> BTreeMap<PlayerId, String> {
+        NetThread::players(self)
     }
 }
 
@@ -480,20 +444,14 @@ async fn serve(
                 None => return Served::Quit,
             },
             _ = ticker.tick() => session.send_ping().await.map(|_| true),
-            event = session.recv() => event.map(|event| match event {
-                SessionEvent::Snapshot(update) => events.send(NetEvent::Snapshot(update)),
-                SessionEvent::Chat { from, text } => events.send(NetEvent::Chat { from, text }),
-                SessionEvent::Notice(kind) => events.send(NetEvent::Notice(kind)),
-                SessionEvent::Pong { rtt: Some(rtt), .. } => events.send(NetEvent::Rtt(rtt)),
-                SessionEvent::Pong { rtt: None, .. } => true,
-                SessionEvent::PlayerJoined { id, name } => {
+            event = session.recv() => event.map(|event| {
+                if matches!(
+                    event,
+                    SessionEvent::PlayerJoined { .. } | SessionEvent::PlayerLeft { .. }
+                ) {
                     roster(session);
-                    events.send(NetEvent::PlayerJoined { id, name })
                 }
-                SessionEvent::PlayerLeft { id, .. } => {
-                    roster(session);
-                    events.send(NetEvent::PlayerLeft { id })
-                }
+                NetEvent::from_session(event).is_none_or(|event| events.send(event))
             }),
         };
         match result {
@@ -504,164 +462,9 @@ async fn serve(
     }
 }
 
-/// What a front end shows about the network.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub enum NetStatus {
-    /// Playing locally, no server.
-    #[default]
-    Offline,
-    /// Connecting to the named server.
-    Connecting(String),
-    /// The connection was lost; reconnecting.
-    Reconnecting {
-        /// Failed attempts so far.
-        attempt: u32,
-    },
-    /// Joined; downloading the server's level.
-    Downloading {
-        /// Bytes so far.
-        got: u64,
-        /// The level's size.
-        total: u64,
-    },
-    /// Joined.
-    Connected {
-        /// The server's welcome.
-        welcome: Welcome,
-        /// The latest round-trip time, once measured.
-        rtt: Option<Duration>,
-    },
-    /// Connecting failed, with the reason.
-    Failed(String),
-    /// The session ended, with the reason.
-    Disconnected(String),
-}
-
-impl NetStatus {
-    /// Folds one event into the status.
-    pub fn apply(&mut self, event: NetEvent) {
-        *self = match (std::mem::take(self), event) {
-            (_, NetEvent::Connected(welcome)) => NetStatus::Connected { welcome, rtt: None },
-            (NetStatus::Connected { welcome, .. }, NetEvent::Rtt(rtt)) => NetStatus::Connected {
-                welcome,
-                rtt: Some(rtt),
-            },
-            (_, NetEvent::LevelProgress { got, total }) => NetStatus::Downloading { got, total },
-            (_, NetEvent::Reconnecting { attempt }) => NetStatus::Reconnecting { attempt },
-            (
-                status,
-                NetEvent::Rtt(_)
-                | NetEvent::Level(..)
-                | NetEvent::Snapshot(_)
-                | NetEvent::Chat { .. }
-                | NetEvent::Notice(_)
-                | NetEvent::PlayerJoined { .. }
-                | NetEvent::PlayerLeft { .. },
-            ) => status,
-            (_, NetEvent::Failed(reason) | NetEvent::Untrusted(reason)) => {
-                NetStatus::Failed(reason)
-            }
-            (_, NetEvent::Disconnected(reason)) => NetStatus::Disconnected(reason),
-        };
-    }
-}
-
-impl fmt::Display for NetStatus {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            NetStatus::Offline => write!(f, "offline (local simulation)"),
-            NetStatus::Connecting(server) => write!(f, "connecting to {server}..."),
-            NetStatus::Reconnecting { attempt: 0 } => write!(f, "connection lost: reconnecting..."),
-            NetStatus::Reconnecting { attempt } => {
-                write!(
-                    f,
-                    "connection lost: reconnecting... (attempt {})",
-                    attempt + 1
-                )
-            }
-            NetStatus::Downloading { got, total } => write!(
-                f,
-                "downloading the level: {} of {} KiB",
-                got / 1024,
-                total.div_ceil(1024)
-            ),
-            NetStatus::Connected { welcome, rtt } => {
-                write!(
-                    f,
-                    "welcome, player {} in {} on {} (joined at tick {}, {} Hz)",
-                    welcome.player_id,
-                    welcome.room,
-                    welcome.level_id,
-                    welcome.server_tick,
-                    welcome.timing.tick_rate
-                )?;
-                if let Some(rtt) = rtt {
-                    write!(f, ", rtt {:.1} ms", rtt.as_secs_f64() * 1000.0)?;
-                }
-                Ok(())
-            }
-            NetStatus::Failed(reason) => write!(f, "connection failed: {reason}"),
-            NetStatus::Disconnected(reason) => write!(f, "disconnected: {reason}"),
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ledge_shared::protocol::NetTiming;
-
-    fn welcome() -> Welcome {
-        Welcome {
-            player_id: PlayerId(3),
-            room: "room-1".into(),
-            level_id: "level".into(),
-            level_hash: 0xabc,
-            level: Default::default(),
-            session_token: Default::default(),
-            server_tick: 10,
-            timing: NetTiming {
-                tick_rate: 60,
-                snapshot_interval: 2,
-                input_redundancy: 16,
-            },
-            sim_config: vec![],
-        }
-    }
-
-    #[test]
-    fn status_follows_events() {
-        let mut status = NetStatus::Connecting("x:1".into());
-        status.apply(NetEvent::Rtt(Duration::from_millis(5)));
-        assert_eq!(status, NetStatus::Connecting("x:1".into()));
-        status.apply(NetEvent::Connected(welcome()));
-        status.apply(NetEvent::Rtt(Duration::from_millis(5)));
-        status.apply(NetEvent::Chat {
-            from: PlayerId(1),
-            text: "hi".into(),
-        });
-        status.apply(NetEvent::PlayerJoined {
-            id: PlayerId(1),
-            name: "bo".into(),
-        });
-        status.apply(NetEvent::PlayerLeft { id: PlayerId(1) });
-        assert_eq!(
-            status,
-            NetStatus::Connected {
-                welcome: welcome(),
-                rtt: Some(Duration::from_millis(5))
-            }
-        );
-        let text = status.to_string();
-        assert!(
-            text.contains("player #3") && text.contains("rtt 5.0 ms"),
-            "{text}"
-        );
-        status.apply(NetEvent::Disconnected("gone".into()));
-        assert_eq!(status, NetStatus::Disconnected("gone".into()));
-        status.apply(NetEvent::Untrusted("changed".into()));
-        assert_eq!(status, NetStatus::Failed("changed".into()));
-    }
 
     #[test]
     fn a_bad_address_fails_without_blocking() {

@@ -10,19 +10,20 @@
 //! * A download writes `HASH.part`; a cut one is resumed from its length
 //!   the next time (`GetLevel{offset}`), and the whole is hashed before it
 //!   becomes `HASH.bundle`: a mismatch deletes it and fails, saying so.
-//! * Nothing bigger than [`MAX_LEVEL_BUNDLE`] is read, whatever the server
+//! * Nothing bigger than [`ledge_shared::protocol::MAX_LEVEL_BUNDLE`] is read, whatever the server
 //!   offers or sends; the cache keeps its newest bundles within
 //!   [`CACHE_BYTES`].
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 use std::time::Duration;
 
 use ledge_levels::bundle::sha256;
 use ledge_levels::LevelBundle;
-use ledge_shared::protocol::{ClientControl, LevelOffer, MAX_LEVEL_BUNDLE};
+use ledge_shared::protocol::{ClientControl, LevelOffer};
 
+pub use crate::download::Fetched;
+use crate::download::{decode, embedded, Download};
 use crate::error::ClientError;
 use crate::session::Session;
 
@@ -135,37 +136,6 @@ impl LevelCache {
     }
 }
 
-/// How the level was had.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Fetched {
-    /// Bytes downloaded now (0: from the cache or embedded).
-    pub downloaded: u64,
-    /// Where the download started (non-zero: a cut one was resumed).
-    pub resumed_from: u64,
-    /// Found in the cache.
-    pub cached: bool,
-    /// The embedded default level.
-    pub embedded: bool,
-}
-
-impl Fetched {
-    /// In words, for logs: where the level of `size` bytes came from.
-    pub fn describe(&self, size: u64) -> String {
-        if self.embedded {
-            "the server plays the embedded default level".to_owned()
-        } else if self.cached {
-            format!("the server's level ({size} bytes) was in the level cache")
-        } else if self.resumed_from > 0 {
-            format!(
-                "downloaded the rest of the server's level: {} of {size} bytes (resumed)",
-                self.downloaded
-            )
-        } else {
-            format!("downloaded the server's level: {size} bytes")
-        }
-    }
-}
-
 /// Options of [`fetch_level`].
 #[derive(Debug, Clone, Default)]
 pub struct FetchOptions {
@@ -174,16 +144,6 @@ pub struct FetchOptions {
     /// For tests of resuming: stop the download (as if cut) after this
     /// many bytes, keeping the part.
     pub cut_after: Option<u64>,
-}
-
-/// The embedded default level's bundle bytes and offer (built once).
-fn embedded() -> &'static (LevelBundle, LevelOffer) {
-    static EMBEDDED: OnceLock<(LevelBundle, LevelOffer)> = OnceLock::new();
-    EMBEDDED.get_or_init(|| {
-        let bundle = LevelBundle::default_level();
-        let offer = LevelBundle::offer(&bundle.encode());
-        (bundle, offer)
-    })
 }
 
 /// The level the session's server offers: the embedded default, the
@@ -203,12 +163,6 @@ pub async fn fetch_level(
         };
         return Ok((embedded().0.clone(), fetched));
     }
-    if offer.size > MAX_LEVEL_BUNDLE {
-        return Err(ClientError::LevelTooLarge {
-            size: offer.size,
-            max: MAX_LEVEL_BUNDLE,
-        });
-    }
     let cache = options.cache.as_ref();
     if let Some(bytes) = cache.and_then(|c| c.get(&offer)) {
         let fetched = Fetched {
@@ -217,13 +171,13 @@ pub async fn fetch_level(
         };
         return Ok((decode(&bytes)?, fetched));
     }
-    let mut bytes = cache.map(|c| c.partial(&offer)).unwrap_or_default();
-    let resumed_from = bytes.len() as u64;
+    let mut download = Download::new(offer, cache.map(|c| c.partial(&offer)).unwrap_or_default())?;
+    let resumed_from = download.resumed_from();
     let mut part = match cache {
         Some(c) => Some(open_part(c, &offer, resumed_from)?),
         None => None,
     };
-    if resumed_from < offer.size {
+    if !download.is_complete() {
         session
             .send_control(&ClientControl::GetLevel {
                 offset: resumed_from,
@@ -239,9 +193,9 @@ pub async fn fetch_level(
         let mut buf = vec![0u8; 64 * 1024];
         progress(resumed_from, offer.size);
         loop {
-            let got = bytes.len() as u64;
+            let (got, size) = download.progress();
             // One byte more than is left, to notice a server sending more.
-            let mut want = (offer.size - got + 1).min(buf.len() as u64);
+            let mut want = (size - got + 1).min(buf.len() as u64);
             if let Some(cut) = options.cut_after {
                 want = want.min((resumed_from + cut).saturating_sub(got).max(1));
             }
@@ -251,61 +205,36 @@ pub async fn fetch_level(
                 .map_err(|_| ClientError::LevelDownload("the level download stalled".into()))?
                 .map_err(|e| ClientError::LevelDownload(e.to_string()))?;
             let Some(n) = read else { break };
-            if bytes.len() as u64 + n as u64 > offer.size {
-                return Err(ClientError::LevelDownload(format!(
-                    "the server sent more than the {} bytes it offered",
-                    offer.size
-                )));
-            }
-            bytes.extend_from_slice(&buf[..n]);
+            download.push(&buf[..n])?;
             if let Some(f) = &mut part {
                 f.write_all(&buf[..n])
                     .map_err(|e| ClientError::LevelDownload(format!("writing the cache: {e}")))?;
             }
-            progress(bytes.len() as u64, offer.size);
+            let (got, size) = download.progress();
+            progress(got, size);
             if options
                 .cut_after
-                .is_some_and(|cut| bytes.len() as u64 - resumed_from >= cut)
+                .is_some_and(|cut| got - resumed_from >= cut)
             {
                 return Err(ClientError::LevelDownload(
                     "cut short (a test's cut_after)".into(),
                 ));
             }
         }
-        if (bytes.len() as u64) < offer.size {
-            return Err(ClientError::LevelDownload(format!(
-                "the level stream ended after {} of {} bytes",
-                bytes.len(),
-                offer.size
-            )));
-        }
     }
     drop(part);
-    if sha256(&bytes) != offer.sha256 {
-        if let Some(c) = cache {
-            let _ = std::fs::remove_file(c.part_path(&offer));
-        }
-        return Err(ClientError::LevelHashMismatch {
-            expected: offer.hex(),
-        });
+    let finished = download.finish();
+    if let (Err(ClientError::LevelHashMismatch { .. }), Some(c)) = (&finished, cache) {
+        let _ = std::fs::remove_file(c.part_path(&offer));
     }
-    let level = decode(&bytes)?;
+    let (level, fetched) = finished?;
     if let Some(c) = cache {
         let done = c.bundle_path(&offer);
         if std::fs::rename(c.part_path(&offer), &done).is_ok() {
             c.trim(&done);
         }
     }
-    let fetched = Fetched {
-        downloaded: offer.size - resumed_from,
-        resumed_from,
-        ..Fetched::default()
-    };
     Ok((level, fetched))
-}
-
-fn decode(bytes: &[u8]) -> Result<LevelBundle, ClientError> {
-    LevelBundle::decode(bytes).map_err(|e| ClientError::Level(e.to_string()))
 }
 
 /// Opens (creating the folder) the part file for appending at `len`.

@@ -13,7 +13,9 @@
 //!   and never skips ticks, except forward when it is hopelessly late (the
 //!   server is already past the ticks we would send).
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use crate::time::Instant;
 
 use ledge_shared::protocol::Welcome;
 

@@ -18,6 +18,7 @@ pub enum ClientError {
     #[error("client TLS configuration: {0}")]
     Config(String),
     /// quinn refused to start the connection (e.g. an invalid server name).
+    #[cfg(not(target_arch = "wasm32"))]
     #[error("cannot connect: {0}")]
     Connect(#[from] quinn::ConnectError),
     /// The server's certificate is not the pinned one.
@@ -44,6 +45,7 @@ pub enum ClientError {
         reason: String,
     },
     /// The connection failed (handshake, timeout, reset, ...).
+    #[cfg(not(target_arch = "wasm32"))]
     #[error("{}", connection_text(.0))]
     Connection(quinn::ConnectionError),
     /// The server refused the hello.
@@ -57,6 +59,7 @@ pub enum ClientError {
     #[error("the connection to the server broke: {0}")]
     Stream(String),
     /// A datagram could not be sent.
+    #[cfg(not(target_arch = "wasm32"))]
     #[error("cannot send a datagram: {0}")]
     Datagram(#[from] quinn::SendDatagramError),
     /// The server sent a valid message at the wrong time.
@@ -118,10 +121,12 @@ pub enum ClientError {
     Game(#[from] ledge_shared::game::GameError),
     /// The server's certificate is not the one this client trusted for
     /// this address before (trust on first use).
+    #[cfg(not(target_arch = "wasm32"))]
     #[error("{0}")]
     Trust(#[from] crate::trust::TrustError),
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 impl ClientError {
     /// Classifies a quinn connection error, decoding application closes.
     pub fn from_connection_error(error: quinn::ConnectionError) -> ClientError {
@@ -138,6 +143,7 @@ impl ClientError {
 }
 
 /// A failed connection in words, with what to check.
+#[cfg(not(target_arch = "wasm32"))]
 fn connection_text(error: &quinn::ConnectionError) -> String {
     use quinn::ConnectionError as E;
     match error {

@@ -18,7 +18,9 @@
 //! ```
 
 use std::collections::BTreeMap;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use crate::time::Instant;
 
 use glam::IVec2;
 use ledge_shared::game::state::{kind, player_flags};

@@ -20,8 +20,8 @@
 //! and remote players do not interact with ours (no player collisions), so
 //! showing them 50 ms late costs nothing in play. See `docs/CLIENT.md`.
 
+use crate::time::Instant;
 use std::collections::VecDeque;
-use std::time::Instant;
 
 use glam::Vec2;
 use ledge_shared::fixed::UNITS_PER_PX;

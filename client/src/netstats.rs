@@ -7,7 +7,9 @@
 //! last second or two ([`crate::game::ClientGame::net_stats`] gathers them).
 
 use std::collections::VecDeque;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use crate::time::Instant;
 
 /// Window of the rate figures.
 const RATE_WINDOW: Duration = Duration::from_secs(1);
@@ -26,6 +28,7 @@ pub struct TransportSample {
 }
 
 impl TransportSample {
+    #[cfg(not(target_arch = "wasm32"))]
     /// Reads a quinn connection's totals.
     pub fn of(connection: &quinn::Connection) -> TransportSample {
         let s = connection.stats();

@@ -25,19 +25,28 @@
 //! `try_recv`, inputs queued with `try_send`.
 
 use std::collections::VecDeque;
+#[cfg(not(target_arch = "wasm32"))]
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use ledge_levels::art::LevelArt;
 use ledge_levels::LevelBundle;
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
-use ledge_shared::protocol::{Fingerprint, NoticeKind, PlayerId, StateSnapshot};
+#[cfg(not(target_arch = "wasm32"))]
+use ledge_shared::protocol::Fingerprint;
+use ledge_shared::protocol::{NoticeKind, PlayerId, StateSnapshot};
 
-use crate::background::{ConnectRequest, NetEvent, NetOptions, NetStatus, NetThread};
-use crate::bundle::{Fetched, LevelCache};
+#[cfg(not(target_arch = "wasm32"))]
+use crate::background::{ConnectRequest, NetOptions, NetThread};
+#[cfg(not(target_arch = "wasm32"))]
+use crate::bundle::LevelCache;
+use crate::download::Fetched;
 use crate::game::ClientGame;
 use crate::levels::{check_level, level_for};
+use crate::net::{NetEvent, NetStatus, Network};
+use crate::time::Instant;
+#[cfg(not(target_arch = "wasm32"))]
 use crate::trust::Trust;
 use crate::view::{FrameView, NetStats};
 
@@ -50,6 +59,7 @@ pub const CHAT_LINES: usize = 32;
 pub const STALL_AFTER: Duration = Duration::from_secs(1);
 
 /// Where, as whom, and how to trust.
+#[cfg(not(target_arch = "wasm32"))]
 #[derive(Debug, Clone)]
 pub struct OnlineRequest {
     /// `HOST:PORT`.
@@ -68,6 +78,7 @@ pub struct OnlineRequest {
     pub level_cache: Option<PathBuf>,
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 impl OnlineRequest {
     /// Joins any room of `server` as `player_name` on the default level.
     pub fn new(server: &str, trust: Trust, player_name: &str) -> OnlineRequest {
@@ -82,13 +93,17 @@ impl OnlineRequest {
     }
 }
 
-/// A networked game for a GUI: the network thread plus the predicted game.
+/// A networked game for a GUI: a network driver (natively the network
+/// thread) plus the predicted game.
 #[derive(Debug)]
-pub struct OnlineGame {
-    net: NetThread,
+pub struct OnlineGame<
+    #[cfg(not(target_arch = "wasm32"))] N: Network = NetThread,
+    #[cfg(target_arch = "wasm32")] N: Network,
+> {
+    net: N,
     status: NetStatus,
     game: Option<ClientGame>,
-    level_file: Option<PathBuf>,
+    level_file: Option<std::path::PathBuf>,
     name: String,
     chat: VecDeque<(PlayerId, String)>,
     notices: VecDeque<NoticeKind>,
@@ -108,11 +123,12 @@ pub struct OnlineGame {
     /// When the last snapshot (or the welcome) arrived.
     last_news: Option<Instant>,
     /// The game was just created: the ticks due at its first update are
-    /// nobody's play (e.g. a window was opening after [`OnlineGame::wait`]).
+    /// nobody's play (e.g. a window was opening after a wait).
     fresh: bool,
 }
 
-impl OnlineGame {
+#[cfg(not(target_arch = "wasm32"))]
+impl OnlineGame<NetThread> {
     /// Starts connecting in the background.
     pub fn connect(request: OnlineRequest) -> std::io::Result<OnlineGame> {
         let pin = match &request.trust {
@@ -132,12 +148,45 @@ impl OnlineGame {
                 level_cache: request.level_cache.clone(),
             },
         )?;
-        Ok(OnlineGame {
+        let mut game = OnlineGame::with_network(net, &request.server, &request.player_name);
+        game.level_file = request.level;
+        Ok(game)
+    }
+
+    /// Waits up to `timeout` for the network thread's first word (joined,
+    /// refused, failed) and takes it, so that a refused certificate is
+    /// known before, say, a window opens.
+    pub fn wait(&mut self, timeout: Duration) {
+        let deadline = Instant::now() + timeout;
+        while let Some(event) = self
+            .net
+            .recv_timeout(deadline.saturating_duration_since(Instant::now()))
+        {
+            // The level (and its download's progress) comes before the
+            // first word.
+            let first_word = !matches!(event, NetEvent::Level(..) | NetEvent::LevelProgress { .. });
+            self.take(event, Instant::now());
+            if first_word {
+                break;
+            }
+        }
+    }
+
+    /// The network thread (queues, counters).
+    pub fn net(&self) -> &NetThread {
+        &self.net
+    }
+}
+
+impl<N: Network> OnlineGame<N> {
+    /// A game fed by `net`, connecting to `server` as `name`.
+    pub fn with_network(net: N, server: &str, name: &str) -> OnlineGame<N> {
+        OnlineGame {
             net,
-            status: NetStatus::Connecting(request.server),
+            status: NetStatus::Connecting(server.to_owned()),
             game: None,
-            level_file: request.level,
-            name: request.player_name,
+            level_file: None,
+            name: name.to_owned(),
             chat: VecDeque::new(),
             notices: VecDeque::new(),
             error: None,
@@ -148,7 +197,7 @@ impl OnlineGame {
             arrivals: 0,
             last_news: None,
             fresh: false,
-        })
+        }
     }
 
     /// Call once per frame: takes the network's events, runs the due ticks
@@ -182,29 +231,10 @@ impl OnlineGame {
                 game.step(Buttons::NONE);
             }
         }
-        let net = &self.net;
+        let net = &mut self.net;
         game.update(now, max_ticks, buttons, |tick, b| {
             net.send_input(tick, b);
         })
-    }
-
-    /// Waits up to `timeout` for the network thread's first word (joined,
-    /// refused, failed) and takes it, so that a refused certificate is
-    /// known before, say, a window opens.
-    pub fn wait(&mut self, timeout: Duration) {
-        let deadline = Instant::now() + timeout;
-        while let Some(event) = self
-            .net
-            .recv_timeout(deadline.saturating_duration_since(Instant::now()))
-        {
-            // The level (and its download's progress) comes before the
-            // first word.
-            let first_word = !matches!(event, NetEvent::Level(..) | NetEvent::LevelProgress { .. });
-            self.take(event, Instant::now());
-            if first_word {
-                break;
-            }
-        }
     }
 
     /// Takes one event from the network thread.
@@ -375,12 +405,12 @@ impl OnlineGame {
     }
 
     /// Says `text` in the room; `false` if it could not be queued.
-    pub fn say(&self, text: &str) -> bool {
+    pub fn say(&mut self, text: &str) -> bool {
         self.net.chat(text)
     }
 
-    /// The network thread (queues, counters).
-    pub fn net(&self) -> &NetThread {
+    /// The network driver.
+    pub fn network(&self) -> &N {
         &self.net
     }
 }

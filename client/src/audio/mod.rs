@@ -17,12 +17,15 @@
 //! The window maps game events to effects and owns the mute key and the
 //! volume setting; this module only offers the calls.
 
+#[cfg(not(target_arch = "wasm32"))]
 pub mod alsa;
 pub mod synth;
 
 use std::fmt;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
-use std::sync::mpsc::{self, Receiver, RecvTimeoutError, SyncSender, TrySendError};
+#[cfg(not(target_arch = "wasm32"))]
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::sync::mpsc::{SyncSender, TrySendError};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -149,6 +152,7 @@ pub const OPEN_TIMEOUT: Duration = Duration::from_secs(1);
 pub const STOP_TIMEOUT: Duration = Duration::from_millis(500);
 
 /// Play requests queued for the mixer thread; more are dropped.
+#[cfg(not(target_arch = "wasm32"))]
 const QUEUE: usize = 32;
 
 #[derive(Debug, Clone, Copy)]
@@ -295,6 +299,7 @@ impl Shared {
         }
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     fn set_status(&self, status: AudioStatus) {
         *self.status.lock().unwrap_or_else(PoisonError::into_inner) = status;
     }
@@ -328,12 +333,20 @@ impl Audio {
     /// Starts sound on ALSA's default device. Never fails: without ALSA or
     /// a device the result is [`Audio::disabled`] with the reason (logged
     /// once at info level). Waits at most [`OPEN_TIMEOUT`] for the device.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn start() -> Audio {
         Audio::start_with(alsa::LIBRARY, alsa::DEFAULT_DEVICE)
     }
 
+    /// In a browser: sound is off (the page's Web Audio is not wired up).
+    #[cfg(target_arch = "wasm32")]
+    pub fn start() -> Audio {
+        Audio::disabled("the browser client has no sound yet")
+    }
+
     /// [`Audio::start`] with another ALSA library file name or PCM device
     /// (tests; a device chosen by the user).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn start_with(library: &str, device: &str) -> Audio {
         let shared = Arc::new(Shared::new(AudioStatus::Off {
             reason: "starting".to_owned(),
@@ -471,6 +484,7 @@ impl Drop for Audio {
 
 /// The mixer thread: loads ALSA, opens the device, reports the outcome on
 /// `opened`, then mixes and writes until told to stop.
+#[cfg(not(target_arch = "wasm32"))]
 fn mixer_thread(
     library: &str,
     device: &str,

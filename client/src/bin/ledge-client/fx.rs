@@ -18,7 +18,7 @@
 use std::collections::BTreeMap;
 
 use ledge_client::audio::Effect;
-use ledge_client::bot::SplitMix64;
+use ledge_client::rng::SplitMix64;
 use macroquad::prelude::*;
 
 use crate::camera::View;

@@ -289,8 +289,14 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
         results_card(&run, info.restart_key);
     }
     if info.hint_alpha > 0.0 {
+        // A page has no quit key: its tab is closed.
+        let quit = if cfg!(target_arch = "wasm32") {
+            ""
+        } else {
+            "   Esc quit"
+        };
         let help = format!(
-            "arrows/WASD move   space/Z jump   down+jump drop   {} restart   M sound   F3 net   F2 HUD   Esc quit",
+            "arrows/WASD move   space/Z jump   down+jump drop   {} restart   M sound   F3 net   F2 HUD{quit}",
             info.restart_key
         );
         let dims = measure_text(&help, None, 16, 1.0);
@@ -490,7 +496,12 @@ pub fn banner(text: &str) {
 pub fn failure(message: &str) -> BannerLayout {
     let screen = vec2(screen_width(), screen_height());
     draw_rectangle(0.0, 0.0, screen.x, screen.y, FAILURE_SHADE);
-    let layout = BannerLayout::new(&[message, "Esc quits"], screen, measure);
+    let quit = if cfg!(target_arch = "wasm32") {
+        "reload the page to try again"
+    } else {
+        "Esc quits"
+    };
+    let layout = BannerLayout::new(&[message, quit], screen, measure);
     draw_banner(&layout, FAILURE_PANEL);
     layout
 }

@@ -277,12 +277,12 @@ pub fn key_by_name(name: &str) -> Option<KeyCode> {
 
 /// Gamepads through gilrs: d-pad or left stick to move, south (A/cross)
 /// or east to jump, down + jump to drop through, select to restart.
-#[cfg(feature = "gamepad")]
+#[cfg(all(feature = "gamepad", not(target_arch = "wasm32")))]
 pub struct Gamepads {
     gilrs: Option<gilrs::Gilrs>,
 }
 
-#[cfg(feature = "gamepad")]
+#[cfg(all(feature = "gamepad", not(target_arch = "wasm32")))]
 impl Gamepads {
     /// Opens the gamepad subsystem (none if it cannot start: keyboard only).
     pub fn new() -> Gamepads {
@@ -331,10 +331,10 @@ impl Gamepads {
 }
 
 /// Without the `gamepad` feature: no gamepads.
-#[cfg(not(feature = "gamepad"))]
+#[cfg(not(all(feature = "gamepad", not(target_arch = "wasm32"))))]
 pub struct Gamepads;
 
-#[cfg(not(feature = "gamepad"))]
+#[cfg(not(all(feature = "gamepad", not(target_arch = "wasm32"))))]
 impl Gamepads {
     /// No gamepad support in this build.
     pub fn new() -> Gamepads {

@@ -3,13 +3,16 @@
 //! [`ledge_client::OnlineGame`] (the network thread feeding the predicted
 //! game).
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use glam::IVec2;
 use ledge_client::anim::{spread, Animator, Pose};
+#[cfg(not(target_arch = "wasm32"))]
 use ledge_client::background::NetStatus;
 use ledge_client::game::ClientGame;
+use ledge_client::time::Instant;
 use ledge_client::view::{EntityDraw, FrameView, NetStats, PlayerDraw};
+#[cfg(not(target_arch = "wasm32"))]
 use ledge_client::{OnlineGame, OnlineRequest};
 use ledge_shared::game::PlayerView;
 use ledge_shared::input::Buttons;
@@ -81,6 +84,7 @@ enum Mode {
     /// A local game, no server.
     Offline(Box<ClientGame>),
     /// A server's game (once welcomed).
+    #[cfg(not(target_arch = "wasm32"))]
     Online(Box<OnlineGame>),
 }
 
@@ -107,6 +111,7 @@ impl Play {
         })
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     /// Connects on a background thread as `request` says; the game starts
     /// when welcomed. `level` is drawn until then.
     pub fn online(request: OnlineRequest, level: Level) -> anyhow::Result<Play> {
@@ -127,6 +132,7 @@ impl Play {
     pub fn update(&mut self, remaining: u64, buttons: impl FnMut(u64) -> Buttons) -> u64 {
         let now = Instant::now();
         match &mut self.mode {
+            #[cfg(not(target_arch = "wasm32"))]
             Mode::Online(online) => online.update_ticks(now, remaining, buttons),
             Mode::Offline(game) => game.update(now, remaining, buttons, |_, _| {}),
         }
@@ -135,6 +141,7 @@ impl Play {
     /// Waits up to `timeout` for the network thread's first word (joined,
     /// refused, failed) and takes it, so a refused certificate is known
     /// before any window opens. Returns at once offline.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn wait_for_network(&mut self, timeout: Duration) {
         if let Mode::Online(online) = &mut self.mode {
             online.wait(timeout);
@@ -147,11 +154,18 @@ impl Play {
     }
 
     /// The online game, if online.
+    #[cfg(not(target_arch = "wasm32"))]
     fn connection(&self) -> Option<&OnlineGame> {
         match &self.mode {
             Mode::Online(online) => Some(online),
             Mode::Offline(_) => None,
         }
+    }
+
+    /// The browser build plays offline only, for now.
+    #[cfg(target_arch = "wasm32")]
+    fn connection(&self) -> Option<&Offline> {
+        None
     }
 
     /// Why the server's certificate was refused (the message says what to
@@ -180,15 +194,20 @@ impl Play {
     /// naming the server and saying what to do (the window shows it, and
     /// stderr).
     pub fn failure(&self) -> Option<String> {
-        let online = self.connection()?;
-        let server = &self.server;
-        if let Some(e) = online.error() {
-            return Some(format!("cannot play on {server}: {e}"));
-        }
-        match online.status() {
-            NetStatus::Failed(r) => Some(format!("cannot join {server}: {r}")),
-            NetStatus::Disconnected(r) => Some(format!("disconnected from {server}: {r}")),
-            _ => None,
+        #[cfg(target_arch = "wasm32")]
+        return None;
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let online = self.connection()?;
+            let server = &self.server;
+            if let Some(e) = online.error() {
+                return Some(format!("cannot play on {server}: {e}"));
+            }
+            match online.status() {
+                NetStatus::Failed(r) => Some(format!("cannot join {server}: {r}")),
+                NetStatus::Disconnected(r) => Some(format!("disconnected from {server}: {r}")),
+                _ => None,
+            }
         }
     }
 
@@ -201,6 +220,7 @@ impl Play {
     pub fn game(&self) -> Option<&ClientGame> {
         match &self.mode {
             Mode::Offline(game) => Some(game),
+            #[cfg(not(target_arch = "wasm32"))]
             Mode::Online(online) => online.game(),
         }
     }
@@ -239,6 +259,7 @@ impl Play {
     /// Snapshots arrived since the last call.
     pub fn take_arrivals(&mut self) -> u32 {
         match &mut self.mode {
+            #[cfg(not(target_arch = "wasm32"))]
             Mode::Online(online) => online.take_arrivals(),
             Mode::Offline(_) => 0,
         }
@@ -257,6 +278,9 @@ impl Play {
     /// One short line about the game (a failure's reason is the
     /// banner's, not this line's: it would not fit).
     pub fn status_line(&self) -> String {
+        #[cfg(target_arch = "wasm32")]
+        return format!("offline: {}", self.level.name);
+        #[cfg(not(target_arch = "wasm32"))]
         match self.connection().map(OnlineGame::status) {
             None => format!("offline: {}", self.level.name),
             Some(NetStatus::Connected { welcome, .. }) => match self.stalled() {
@@ -279,6 +303,9 @@ impl Play {
     /// A message for the middle of the screen while connecting or waiting,
     /// if any (failures: [`Play::failure`]).
     pub fn banner(&self) -> Option<String> {
+        #[cfg(target_arch = "wasm32")]
+        return None;
+        #[cfg(not(target_arch = "wasm32"))]
         match self.connection()?.status() {
             NetStatus::Connecting(server) => Some(format!(
                 "connecting to {server}... ({:.0} s)",
@@ -302,5 +329,30 @@ impl Play {
             )),
             _ => None,
         }
+    }
+}
+
+/// No network in the browser build yet: a type without values, so every
+/// question about a connection answers "none" (see `Play::connection`).
+#[cfg(target_arch = "wasm32")]
+#[derive(Debug)]
+enum Offline {}
+
+#[cfg(target_arch = "wasm32")]
+impl Offline {
+    fn untrusted(&self) -> Option<&str> {
+        match *self {}
+    }
+    fn level_art(&self) -> Option<&ledge_levels::art::LevelArt> {
+        match *self {}
+    }
+    fn game(&self) -> Option<&ClientGame> {
+        match *self {}
+    }
+    fn server_state(&self) -> Option<&ledge_shared::protocol::StateSnapshot> {
+        match *self {}
+    }
+    fn stalled(&self, _now: Instant) -> Option<Duration> {
+        match *self {}
     }
 }

@@ -1,0 +1,339 @@
+//! The native entry: the command line, the level file, the network
+//! request (or an in-process server with `--local`), then the window.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+use std::time::Duration;
+
+use clap::Parser;
+use ledge_client::{Fingerprint, OnlineRequest, Trust};
+use macroquad::prelude::vec2;
+
+use crate::keys::{self, Bindings};
+use crate::script::Script;
+use crate::{game, local, play, tell, Setup, EXIT_CODE, EXIT_FAILED, EXIT_UNTRUSTED};
+
+/// How long the window waits for the server's first answer before it
+/// opens (showing "connecting..."): enough for the TLS handshake, so a
+/// refused certificate is reported on the terminal without a window.
+const CONNECT_WAIT: Duration = Duration::from_secs(3);
+
+/// The exit codes, for `--help`.
+const EXIT_CODES: &str = "Exit codes:
+  0  the game ended normally (Esc, window closed, --exit-after-ticks reached)
+  1  the session failed (server unreachable, refused us or dropped us), or the
+     game could not start (level or keys file, screenshot); the reason is
+     printed on stderr, prefixed \"ledge-client: \"
+  2  a command-line error, or not joined within --join-timeout
+  3  the server's certificate was refused (wrong --cert-hash, or not the one
+     remembered in the known-hosts file)";
+
+/// ledge: a networked 2D platformer.
+///
+/// Keys (rebind with --keys FILE; --print-keys shows the defaults): arrows
+/// or WASD move, space, Z or K jump, down + jump drops through one-way
+/// ledges, R restarts the run, M mutes, F1 debug overlay, F2 HUD on/off,
+/// F3 network panel, Esc quits. Gamepads need the `gamepad` build feature.
+#[derive(Debug, Parser)]
+#[command(version, after_help = EXIT_CODES)]
+struct Cli {
+    /// Server to join, as HOST:PORT (without it or --local: play offline).
+    #[arg(long, value_name = "HOST:PORT")]
+    connect: Option<String>,
+    /// SHA-256 fingerprint of the server certificate (the server prints
+    /// it): trust only that certificate. Without it, the certificate is
+    /// trusted on first use and remembered in the known-hosts file.
+    #[arg(long, value_name = "HEX", requires = "connect")]
+    cert_hash: Option<Fingerprint>,
+    /// Known-hosts file for trust on first use (one `HOST:PORT SHA256` line
+    /// per server; created with its folder if missing) [default:
+    /// $XDG_CONFIG_HOME/ledge/known_hosts or ~/.config/ledge/known_hosts].
+    #[arg(
+        long,
+        value_name = "PATH",
+        requires = "connect",
+        conflicts_with = "cert_hash"
+    )]
+    known_hosts: Option<PathBuf>,
+    /// Start a server in this process (127.0.0.1, any free port, the
+    /// default level) and join it.
+    #[arg(long, conflicts_with = "connect")]
+    local: bool,
+    /// Level file (OGMO `.json` or Tiled `.tmx`) to play offline; default:
+    /// the embedded level. Online the server's level is downloaded (or
+    /// found in the level cache); a file given here must be the server's.
+    /// `--local` always plays the embedded level.
+    #[arg(long, value_name = "FILE")]
+    level: Option<PathBuf>,
+    /// Where downloaded levels are kept [default:
+    /// $XDG_CACHE_HOME/ledge/levels or ~/.cache/ledge/levels].
+    #[arg(long, value_name = "DIR")]
+    level_cache: Option<PathBuf>,
+    /// The room to join (opened if the server has no room of that name
+    /// and its room cap allows); default: the server picks.
+    #[arg(long, value_name = "NAME", requires = "connect")]
+    room: Option<String>,
+    /// Print the server's rooms (name, level, players, capacity) and exit.
+    #[arg(long, requires = "connect")]
+    list_rooms: bool,
+    /// The level's settings file for offline play [default: LEVEL.ledge.toml
+    /// beside the level, when there is one; online, always that one, as the
+    /// server's default].
+    #[arg(long, value_name = "FILE")]
+    level_settings: Option<PathBuf>,
+    /// Player name: 1 to 32 bytes (UTF-8), no control characters.
+    #[arg(long, default_value = "player", value_parser = parse_name)]
+    name: String,
+    /// Key bindings file (TOML; actions left out keep their defaults).
+    #[arg(long, value_name = "FILE")]
+    keys: Option<PathBuf>,
+    /// Print the default key bindings file and exit.
+    #[arg(long)]
+    print_keys: bool,
+    /// Scripted input instead of the keyboard: a file, or the script
+    /// itself, e.g. "0-59 -> right; 60 -> right+jump" (ticks from the
+    /// start of play -> buttons).
+    #[arg(long, value_name = "FILE|SCRIPT")]
+    script: Option<String>,
+    /// Quit after this many ticks of play (from joining, or from the start
+    /// offline).
+    #[arg(long, value_name = "N")]
+    exit_after_ticks: Option<u64>,
+    /// Save a PNG of the frame at --exit-after-ticks, and PATH.json beside
+    /// it (camera transform, our player's server position on screen).
+    #[arg(long, value_name = "PATH", requires = "exit_after_ticks")]
+    screenshot: Option<PathBuf>,
+    /// Give up (exit code 2) when not joined within this many seconds (only
+    /// with --exit-after-ticks; interactive sessions keep waiting).
+    #[arg(long, value_name = "SECONDS", default_value_t = 20)]
+    join_timeout: u64,
+    /// Point the camera at world pixel X,Y instead of our player (for
+    /// screenshots of any part of the level).
+    #[arg(long, value_name = "X,Y", value_parser = parse_point)]
+    look_at: Option<(f32, f32)>,
+    /// Start with the debug overlay (F1) on.
+    #[arg(long)]
+    debug: bool,
+    /// Start with the network panel and graph (F3) on.
+    #[arg(long)]
+    net: bool,
+    /// Start with the whole HUD (F2) off: clean screenshots of the level.
+    #[arg(long)]
+    no_hud: bool,
+    /// Sound volume, 0 to 100.
+    #[arg(long, value_name = "0..=100", default_value_t = 80,
+          value_parser = clap::value_parser!(u8).range(0..=100))]
+    volume: u8,
+    /// Start with sound muted (M toggles it).
+    #[arg(long)]
+    mute: bool,
+    /// Window size, WIDTHxHEIGHT.
+    #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = parse_size)]
+    window: (i32, i32),
+}
+
+fn parse_size(s: &str) -> Result<(i32, i32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| "expected WIDTHxHEIGHT, e.g. 960x540".to_owned())?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<i32>()
+            .ok()
+            .filter(|&v| (64..=16384).contains(&v))
+            .ok_or_else(|| format!("'{v}': expected a size in pixels (64 to 16384)"))
+    };
+    Ok((n(w)?, n(h)?))
+}
+
+/// A player name the server accepts (checked here, so a bad one is a
+/// command-line error naming the limit, not a refusal after connecting).
+fn parse_name(s: &str) -> Result<String, String> {
+    use ledge_shared::protocol::{check_name, MAX_NAME_LEN};
+    if check_name(s).is_ok() {
+        return Ok(s.to_owned());
+    }
+    Err(if s.is_empty() {
+        "a player name cannot be empty".to_owned()
+    } else if s.len() > MAX_NAME_LEN {
+        format!(
+            "the name is {} bytes long; a player name is at most {MAX_NAME_LEN} bytes",
+            s.len()
+        )
+    } else {
+        match check_name(s) {
+            Err(ledge_shared::protocol::ProtocolError::InvalidString { problem, .. }) => {
+                format!("the player name {problem}: use visible letters, digits and punctuation")
+            }
+            _ => "this player name is not allowed".to_owned(),
+        }
+    })
+}
+
+fn parse_point(s: &str) -> Result<(f32, f32), String> {
+    let (x, y) = s
+        .split_once(',')
+        .ok_or_else(|| "expected X,Y, e.g. 400,240".to_owned())?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("'{v}': expected a number of pixels"))
+    };
+    Ok((n(x)?, n(y)?))
+}
+
+/// Runs the game from the command line; exits with the game's code.
+pub fn main() {
+    if let Err(e) = run() {
+        tell(&format!("{e:#}"));
+        std::process::exit(EXIT_FAILED);
+    }
+}
+
+fn run() -> anyhow::Result<()> {
+    // Parse before opening the window, so `--help` and errors need no display.
+    let cli = Cli::parse();
+    if cli.print_keys {
+        print!("{}", keys::DEFAULT_KEYS);
+        return Ok(());
+    }
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
+        )
+        .with_writer(std::io::stderr)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        // A closed stderr drops log lines instead of panicking.
+        .log_internal_errors(false)
+        .init();
+
+    let bindings = match &cli.keys {
+        Some(path) => Bindings::load(path).map_err(anyhow::Error::msg)?,
+        None => Bindings::default(),
+    };
+    let script = cli
+        .script
+        .as_deref()
+        .map(Script::load)
+        .transpose()
+        .map_err(anyhow::Error::msg)?;
+    // A level file's own art is drawn; the embedded level keeps ledge's
+    // flat colours.
+    let (level, level_art) = match &cli.level {
+        Some(path) if !cli.local => {
+            let loaded = ledge_levels::load_level(path, cli.level_settings.as_deref())
+                .map_err(|e| anyhow::anyhow!("loading the level: {e}"))?;
+            // What the importer ignored, guessed or placed: the player
+            // (and the level's author) should see it.
+            let mut err = std::io::stderr().lock();
+            for w in &loaded.warnings {
+                let _ = writeln!(err, "warning: {w}");
+            }
+            for w in &loaded.art.warnings {
+                let _ = writeln!(err, "warning: level art: {w}");
+            }
+            (loaded.level, loaded.art)
+        }
+        _ => (ledge_levels::default_level(), Default::default()),
+    };
+    let mut server = None;
+    let request = if cli.local {
+        let s = local::LocalServer::start()?;
+        let trust = Trust::Pinned(s.fingerprint);
+        let request = OnlineRequest::new(&s.addr.to_string(), trust, &cli.name);
+        server = Some(s);
+        Some(request)
+    } else {
+        cli.connect.clone().map(|server| {
+            let trust = Trust::from_args(cli.cert_hash, cli.known_hosts.clone());
+            let default = OnlineRequest::new(&server, trust, &cli.name);
+            OnlineRequest {
+                level: cli.level.clone(),
+                room: cli.room.clone(),
+                level_cache: cli.level_cache.clone().or(default.level_cache.clone()),
+                ..default
+            }
+        })
+    };
+    if cli.list_rooms {
+        if let Some(request) = &request {
+            return list_rooms(request);
+        }
+    }
+    let mut play = match request {
+        Some(request) => {
+            tracing::info!("connecting to {} ({})", request.server, request.trust);
+            play::Play::online(request, level)?
+        }
+        None => play::Play::offline(level, &cli.name)?,
+    };
+    // A refused certificate ends here, on the terminal, before any window.
+    play.wait_for_network(CONNECT_WAIT);
+    if let Some(message) = play.untrusted() {
+        tell(message);
+        std::process::exit(EXIT_UNTRUSTED);
+    }
+    let setup = Setup {
+        play,
+        bindings,
+        script,
+        exit_after: cli.exit_after_ticks,
+        screenshot: cli.screenshot,
+        join_timeout: Duration::from_secs(cli.join_timeout),
+        name: cli.name,
+        debug: cli.debug,
+        net: cli.net,
+        hud: !cli.no_hud,
+        volume: f32::from(cli.volume) / 100.0,
+        mute: cli.mute,
+        look_at: cli.look_at.map(|(x, y)| vec2(x, y)),
+        level_art,
+        server,
+    };
+
+    let conf = macroquad::window::Conf {
+        window_title: "ledge".to_owned(),
+        window_width: cli.window.0,
+        window_height: cli.window.1,
+        window_resizable: true,
+        ..Default::default()
+    };
+    // What `#[macroquad::main]` expands to, called directly so the command
+    // line is parsed before a window exists.
+    macroquad::Window::from_config(conf, game(setup));
+    match EXIT_CODE.load(Ordering::Relaxed) {
+        0 => Ok(()),
+        code => std::process::exit(code),
+    }
+}
+
+/// `--list-rooms`: prints the server's rooms, one line each.
+fn list_rooms(request: &OnlineRequest) -> anyhow::Result<()> {
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
+    let (rooms, _) = runtime
+        .block_on(ledge_client::list_rooms_trusted(
+            &request.server,
+            &request.trust,
+        ))
+        .map_err(|e| anyhow::anyhow!("cannot list the rooms of {}: {e}", request.server))?;
+    let mut out = std::io::stdout().lock();
+    let plural = if rooms.len() == 1 { "" } else { "s" };
+    let _ = writeln!(out, "{} room{plural} on {}:", rooms.len(), request.server);
+    for r in &rooms {
+        let _ = writeln!(
+            out,
+            "  {}  level {}  {}/{} players",
+            r.name, r.level_id, r.players, r.capacity
+        );
+    }
+    let _ = writeln!(
+        out,
+        "join one with --room NAME (a new name opens a room while the server has places)"
+    );
+    Ok(())
+}

@@ -1,0 +1,649 @@
+//! A session over a transport driven from outside, sans IO: the browser's
+//! WebTransport or WebSocket (through the page's glue), or anything else
+//! that carries the control stream's bytes, datagrams and the level
+//! stream as messages.
+//!
+//! [`Link`] is the [`Network`] of a browser's
+//! [`crate::online::OnlineGame`]: the driver calls [`Link::on_open`] when
+//! the transport is up, feeds what arrives ([`Link::on_message`],
+//! [`Link::on_closed`]), calls [`Link::poll`] once per frame (pings) and
+//! sends what [`Link::poll_transmit`] gives. Behind it are the same
+//! [`Handshake`], [`SessionState`] and [`Download`] as the native client's,
+//! so both speak one protocol. It reports as the background thread does:
+//! the level ([`NetEvent::Level`], after its download if the server plays
+//! another than the embedded one), then [`NetEvent::Connected`], then the
+//! session's events.
+//!
+//! Everything queued here is bounded: at most [`MAX_EVENTS`] events and
+//! [`MAX_TRANSMITS`] messages waiting (beyond, the oldest input datagrams,
+//! then the oldest events, are dropped and counted).
+
+use std::collections::{BTreeMap, VecDeque};
+use std::time::Duration;
+
+use ledge_shared::input::Buttons;
+use ledge_shared::protocol::{write_frame, ClientControl, CloseCode, Message, PlayerId, Welcome};
+
+use crate::download::{embedded, Download, Fetched};
+use crate::error::ClientError;
+use crate::net::{NetEvent, Network};
+use crate::netstats::TransportSample;
+use crate::session::{Handshake, JoinOptions, SessionState};
+use crate::time::Instant;
+
+/// Events waiting for the front end; beyond, the oldest are dropped.
+pub const MAX_EVENTS: usize = 512;
+/// Messages waiting for the transport; beyond, the oldest datagrams are
+/// dropped (inputs repeat the last ticks: an old one is worthless).
+pub const MAX_TRANSMITS: usize = 256;
+/// How often the server is pinged (round-trip time).
+pub const PING_EVERY: Duration = Duration::from_secs(1);
+/// How long the server has to answer the hello.
+pub const HELLO_TIMEOUT: Duration = crate::session::REPLY_TIMEOUT;
+
+/// Something that arrived on the transport.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Incoming<'a> {
+    /// Bytes of the control stream, in order (any slice of it).
+    Stream(&'a [u8]),
+    /// One datagram (a snapshot).
+    Datagram(&'a [u8]),
+    /// The next bytes of the level stream (after `GetLevel`).
+    Level(&'a [u8]),
+    /// The level stream ended.
+    LevelEnd,
+}
+
+/// Something to send.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Transmit {
+    /// Bytes to write on the control stream, in order.
+    Stream(Vec<u8>),
+    /// One datagram (an input packet).
+    Datagram(Vec<u8>),
+}
+
+/// Where the session is.
+#[derive(Debug)]
+enum Phase {
+    /// The transport is not up yet.
+    Opening,
+    /// Hello sent, waiting for the answer (since `.1`).
+    Hello(Handshake, Instant),
+    /// Welcomed; downloading the server's level first, if needed.
+    Joined {
+        state: Box<SessionState>,
+        download: Option<Download>,
+        /// `Connected` was reported (the level is there).
+        connected: bool,
+    },
+    /// Over (the reason was reported).
+    Ended,
+}
+
+/// The session's protocol over a driven transport (see the module).
+#[derive(Debug)]
+pub struct Link {
+    options: JoinOptions,
+    phase: Phase,
+    events: VecDeque<NetEvent>,
+    out: VecDeque<Transmit>,
+    sample: TransportSample,
+    last_ping: Option<Instant>,
+    /// Messages or events dropped because a queue was full.
+    dropped: u64,
+}
+
+impl Link {
+    /// A link that will join as `options` say once its transport opens.
+    pub fn new(options: JoinOptions) -> Link {
+        Link {
+            options,
+            phase: Phase::Opening,
+            events: VecDeque::new(),
+            out: VecDeque::new(),
+            sample: TransportSample::default(),
+            last_ping: None,
+            dropped: 0,
+        }
+    }
+
+    /// The transport is up: sends the hello (a name the server would
+    /// refuse fails here, with the reason).
+    pub fn on_open(&mut self, now: Instant) {
+        if !matches!(self.phase, Phase::Opening) {
+            return;
+        }
+        match Handshake::hello_frame(&self.options) {
+            Ok(frame) => {
+                self.transmit(Transmit::Stream(frame));
+                self.phase = Phase::Hello(Handshake::new(), now);
+            }
+            Err(e) => self.fail(&e),
+        }
+    }
+
+    /// Takes what arrived at `now`. A broken control stream or level
+    /// download ends the session with the reason.
+    pub fn on_message(&mut self, message: Incoming<'_>, now: Instant) {
+        let len = match message {
+            Incoming::Stream(b) | Incoming::Datagram(b) | Incoming::Level(b) => b.len(),
+            Incoming::LevelEnd => 0,
+        };
+        self.sample.bytes_in += len as u64;
+        if let Err(e) = self.handle(message, now) {
+            self.fail(&e);
+        }
+    }
+
+    fn handle(&mut self, message: Incoming<'_>, now: Instant) -> Result<(), ClientError> {
+        match (&mut self.phase, message) {
+            (Phase::Hello(handshake, _), Incoming::Stream(bytes)) => {
+                if let Some(state) = handshake.on_stream(bytes)? {
+                    self.joined(state);
+                }
+            }
+            (Phase::Joined { state, .. }, Incoming::Stream(bytes)) => {
+                state.on_stream(bytes, now)?;
+            }
+            (Phase::Joined { state, .. }, Incoming::Datagram(bytes)) => {
+                state.on_datagram(bytes, now);
+            }
+            (
+                Phase::Joined {
+                    download: Some(download),
+                    ..
+                },
+                Incoming::Level(bytes),
+            ) => {
+                download.push(bytes)?;
+                let (got, total) = download.progress();
+                self.event(NetEvent::LevelProgress { got, total });
+            }
+            (Phase::Joined { download, .. }, Incoming::LevelEnd) if download.is_some() => {
+                let (bundle, fetched) = download.take().expect("checked").finish()?;
+                self.level_ready(bundle, fetched);
+            }
+            (_, Incoming::Level(_) | Incoming::LevelEnd) => {
+                return Err(ClientError::Unexpected(
+                    "a level stream nobody asked for".into(),
+                ))
+            }
+            // Datagrams before the welcome (or after the end) mean nothing.
+            (_, Incoming::Datagram(_)) | (Phase::Opening | Phase::Ended, Incoming::Stream(_)) => {}
+        }
+        self.drain_session();
+        Ok(())
+    }
+
+    /// Welcomed: the level is the embedded one, or download it.
+    fn joined(&mut self, state: SessionState) {
+        let offer = state.welcome().level;
+        let (download, ready) = if offer == embedded().1 {
+            let fetched = Fetched {
+                embedded: true,
+                ..Fetched::default()
+            };
+            (None, Some((embedded().0.clone(), fetched)))
+        } else {
+            match Download::new(offer, Vec::new()) {
+                Ok(download) => (Some(download), None),
+                Err(e) => return self.fail(&e),
+            }
+        };
+        if download.is_some() {
+            let mut frame = Vec::new();
+            match write_frame(&ClientControl::GetLevel { offset: 0 }, &mut frame) {
+                Ok(()) => self.transmit(Transmit::Stream(frame)),
+                Err(e) => return self.fail(&e.into()),
+            }
+        }
+        self.phase = Phase::Joined {
+            state: Box::new(state),
+            download,
+            connected: false,
+        };
+        if let Some((bundle, fetched)) = ready {
+            self.level_ready(bundle, fetched);
+        }
+    }
+
+    /// The level is here: report it, then the welcome.
+    fn level_ready(&mut self, bundle: ledge_levels::LevelBundle, fetched: Fetched) {
+        let Phase::Joined {
+            state, connected, ..
+        } = &mut self.phase
+        else {
+            return;
+        };
+        *connected = true;
+        let welcome = state.welcome().clone();
+        self.event(NetEvent::Level(Box::new(bundle), fetched));
+        self.event(NetEvent::Connected(welcome));
+    }
+
+    /// Moves the session's events (once connected) to ours.
+    fn drain_session(&mut self) {
+        let Phase::Joined {
+            state,
+            connected: true,
+            ..
+        } = &mut self.phase
+        else {
+            return;
+        };
+        let mut moved = Vec::new();
+        while let Some(event) = state.poll_event() {
+            if let crate::session::SessionEvent::Pong { rtt: Some(rtt), .. } = &event {
+                self.sample.rtt = *rtt;
+            }
+            moved.extend(NetEvent::from_session(event));
+        }
+        for event in moved {
+            self.event(event);
+        }
+    }
+
+    /// The transport closed with `code` (the server's [`CloseCode`] when it
+    /// sent one) and `reason`.
+    pub fn on_closed(&mut self, code: Option<u32>, reason: &str) {
+        let error = match code.and_then(CloseCode::from_u32) {
+            Some(code) => ClientError::ClosedByServer {
+                code: Some(code),
+                reason: reason.to_owned(),
+            },
+            None if reason.is_empty() => ClientError::StreamEnded,
+            None => ClientError::Stream(reason.to_owned()),
+        };
+        self.fail(&error);
+    }
+
+    /// The transport failed (could not connect, or broke) with `reason`,
+    /// in words.
+    pub fn on_failed(&mut self, reason: &str) {
+        self.fail(&ClientError::Stream(reason.to_owned()));
+    }
+
+    /// Ends the session with `error`: [`NetEvent::Disconnected`] once
+    /// joined, [`NetEvent::Failed`] before. Only the first reason counts.
+    fn fail(&mut self, error: &ClientError) {
+        let was = std::mem::replace(&mut self.phase, Phase::Ended);
+        let event = match was {
+            Phase::Ended => {
+                self.phase = Phase::Ended;
+                return;
+            }
+            Phase::Joined {
+                connected: true, ..
+            } => NetEvent::Disconnected(error.to_string()),
+            _ => NetEvent::Failed(error.to_string()),
+        };
+        self.event(event);
+    }
+
+    /// Once per frame: pings the server every [`PING_EVERY`], and gives up
+    /// on a server that has not answered the hello in [`HELLO_TIMEOUT`].
+    pub fn poll(&mut self, now: Instant) {
+        match &mut self.phase {
+            Phase::Hello(_, since) if now.saturating_duration_since(*since) > HELLO_TIMEOUT => {
+                self.fail(&ClientError::Timeout);
+            }
+            Phase::Joined { state, .. } => {
+                let due = self
+                    .last_ping
+                    .is_none_or(|at| now.saturating_duration_since(at) >= PING_EVERY);
+                if due {
+                    self.last_ping = Some(now);
+                    match state.ping_frame(now) {
+                        Ok((_, frame)) => self.transmit(Transmit::Stream(frame)),
+                        Err(e) => self.fail(&e),
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// The next message to send, oldest first.
+    pub fn poll_transmit(&mut self) -> Option<Transmit> {
+        self.out.pop_front()
+    }
+
+    /// Whether the session ended.
+    pub fn is_ended(&self) -> bool {
+        matches!(self.phase, Phase::Ended)
+    }
+
+    /// The welcome, once joined.
+    pub fn welcome(&self) -> Option<&Welcome> {
+        match &self.phase {
+            Phase::Joined { state, .. } => Some(state.welcome()),
+            _ => None,
+        }
+    }
+
+    /// Messages and events dropped so far because a queue was full.
+    pub fn dropped(&self) -> u64 {
+        self.dropped
+    }
+
+    /// Queues a message; beyond [`MAX_TRANSMITS`] the oldest datagram (or
+    /// else this one, if it is a datagram) is dropped. Control frames are
+    /// never dropped: the stream would be out of step.
+    fn transmit(&mut self, t: Transmit) {
+        if self.out.len() >= MAX_TRANSMITS {
+            match self
+                .out
+                .iter()
+                .position(|t| matches!(t, Transmit::Datagram(_)))
+            {
+                Some(at) => {
+                    self.out.remove(at);
+                }
+                None if matches!(t, Transmit::Datagram(_)) => {
+                    self.dropped += 1;
+                    return;
+                }
+                None => {}
+            }
+            self.dropped += 1;
+        }
+        let len = match &t {
+            Transmit::Stream(b) | Transmit::Datagram(b) => b.len(),
+        };
+        self.sample.bytes_out += len as u64;
+        self.out.push_back(t);
+    }
+
+    /// Queues an event; beyond [`MAX_EVENTS`] the oldest is dropped.
+    fn event(&mut self, event: NetEvent) {
+        if self.events.len() >= MAX_EVENTS {
+            self.events.pop_front();
+            self.dropped += 1;
+        }
+        self.events.push_back(event);
+    }
+}
+
+impl Network for Link {
+    fn try_recv(&mut self) -> Option<NetEvent> {
+        self.events.pop_front()
+    }
+
+    fn send_input(&mut self, tick: u64, buttons: Buttons) -> bool {
+        let Phase::Joined { state, .. } = &mut self.phase else {
+            return false;
+        };
+        match state.input_datagram(tick, buttons) {
+            Ok(datagram) => {
+                self.transmit(Transmit::Datagram(datagram));
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    fn chat(&mut self, text: &str) -> bool {
+        if !matches!(self.phase, Phase::Joined { .. }) {
+            return false;
+        }
+        let message = ClientControl::Chat {
+            text: text.to_owned(),
+        };
+        if message.validate().is_err() {
+            return false;
+        }
+        let mut frame = Vec::new();
+        if write_frame(&message, &mut frame).is_err() {
+            return false;
+        }
+        self.transmit(Transmit::Stream(frame));
+        true
+    }
+
+    fn transport(&self) -> Option<TransportSample> {
+        matches!(self.phase, Phase::Joined { .. }).then_some(self.sample)
+    }
+
+    fn players(&self) -> BTreeMap<PlayerId, String> {
+        match &self.phase {
+            Phase::Joined { state, .. } => state.players().clone(),
+            _ => BTreeMap::new(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ledge_levels::LevelBundle;
+    use ledge_shared::protocol::{
+        FrameDecoder, InputPacket, NetTiming, RejectReason, RosterEntry, ServerControl, MAX_FRAME,
+    };
+
+    fn welcome(level: ledge_shared::protocol::LevelOffer) -> Welcome {
+        Welcome {
+            player_id: PlayerId(3),
+            room: "friends".into(),
+            level_id: "level".into(),
+            level_hash: 0xabc,
+            level,
+            session_token: Default::default(),
+            server_tick: 10,
+            timing: NetTiming {
+                tick_rate: 60,
+                snapshot_interval: 2,
+                input_redundancy: 4,
+            },
+            sim_config: vec![],
+        }
+    }
+
+    fn frame(message: &ServerControl) -> Vec<u8> {
+        let mut f = Vec::new();
+        write_frame(message, &mut f).unwrap();
+        f
+    }
+
+    /// The control messages among `out` (decoded), and the datagrams.
+    fn sent(link: &mut Link) -> (Vec<ClientControl>, Vec<Vec<u8>>) {
+        let mut decoder = FrameDecoder::new(MAX_FRAME);
+        let mut datagrams = Vec::new();
+        while let Some(t) = link.poll_transmit() {
+            match t {
+                Transmit::Stream(b) => decoder.push(&b).unwrap(),
+                Transmit::Datagram(d) => datagrams.push(d),
+            }
+        }
+        let mut controls = Vec::new();
+        while let Some(m) = decoder.pop_message::<ClientControl>() {
+            controls.push(m.unwrap());
+        }
+        (controls, datagrams)
+    }
+
+    fn events(link: &mut Link) -> Vec<NetEvent> {
+        std::iter::from_fn(|| link.try_recv()).collect()
+    }
+
+    fn joining(room: &str) -> Link {
+        Link::new(JoinOptions {
+            room: Some(room.into()),
+            ..JoinOptions::new("ada")
+        })
+    }
+
+    #[test]
+    fn joins_on_the_embedded_level_and_plays() {
+        let now = Instant::now();
+        let mut link = joining("friends");
+        assert!(link.poll_transmit().is_none(), "nothing before the open");
+        link.on_open(now);
+        let (controls, _) = sent(&mut link);
+        assert_eq!(
+            controls[0].as_hello(),
+            Some((
+                ledge_shared::protocol::PROTOCOL_VERSION,
+                "ada",
+                Some("friends")
+            ))
+        );
+        // The welcome and the roster in one read, split anywhere.
+        let mut bytes = frame(&ServerControl::Welcome(welcome(embedded().1)));
+        bytes.extend(frame(&ServerControl::Roster {
+            players: vec![RosterEntry {
+                id: PlayerId(3),
+                name: "ada".into(),
+            }],
+        }));
+        let (a, b) = bytes.split_at(7);
+        link.on_message(Incoming::Stream(a), now);
+        assert!(events(&mut link).is_empty());
+        link.on_message(Incoming::Stream(b), now);
+        let got = events(&mut link);
+        assert!(
+            matches!(&got[0], NetEvent::Level(_, f) if f.embedded),
+            "{got:?}"
+        );
+        assert!(matches!(&got[1], NetEvent::Connected(w) if w.room == "friends"));
+        assert!(
+            matches!(&got[2], NetEvent::PlayerJoined { id: PlayerId(3), name } if name == "ada")
+        );
+        assert_eq!(link.players().len(), 1);
+
+        assert!(link.send_input(11, Buttons(Buttons::RIGHT)));
+        assert!(link.send_input(12, Buttons(Buttons::RIGHT)));
+        link.poll(now);
+        let (controls, datagrams) = sent(&mut link);
+        assert!(
+            matches!(controls[..], [ClientControl::Ping { .. }]),
+            "{controls:?}"
+        );
+        let packet = InputPacket::decode(&datagrams[1]).unwrap();
+        assert_eq!(packet.newest_tick, 12);
+        assert_eq!(packet.get(11), Some(Buttons(Buttons::RIGHT)));
+        assert!(link.transport().unwrap().bytes_out > 0);
+    }
+
+    #[test]
+    fn downloads_another_level_before_reporting_the_welcome() {
+        let now = Instant::now();
+        let mut link = joining("friends");
+        link.on_open(now);
+        sent(&mut link);
+        let mut bundle = LevelBundle::default_level();
+        bundle.level.name = "another".into();
+        let bytes = bundle.encode();
+        let offer = LevelBundle::offer(&bytes);
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(offer)))),
+            now,
+        );
+        let (controls, _) = sent(&mut link);
+        assert!(
+            matches!(controls[..], [ClientControl::GetLevel { offset: 0 }]),
+            "{controls:?}"
+        );
+        // A roster while downloading waits for the welcome's report.
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::PlayerLeft { id: PlayerId(9) })),
+            now,
+        );
+        for chunk in bytes.chunks(4096) {
+            link.on_message(Incoming::Level(chunk), now);
+        }
+        let progress = events(&mut link);
+        assert!(progress
+            .iter()
+            .all(|e| matches!(e, NetEvent::LevelProgress { .. })));
+        assert!(matches!(
+            progress.last(),
+            Some(NetEvent::LevelProgress { got, total }) if got == total
+        ));
+        link.on_message(Incoming::LevelEnd, now);
+        let got = events(&mut link);
+        assert!(
+            matches!(&got[0], NetEvent::Level(b, f) if b.level.name == "another" && f.downloaded == bytes.len() as u64)
+        );
+        assert!(matches!(&got[1], NetEvent::Connected(_)));
+        assert!(matches!(&got[2], NetEvent::PlayerLeft { id: PlayerId(9) }));
+    }
+
+    #[test]
+    fn refusals_closes_and_silence_end_the_session_with_the_reason() {
+        let now = Instant::now();
+        let mut link = joining("friends");
+        link.on_open(now);
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Reject {
+                reason: RejectReason::RoomFull,
+            })),
+            now,
+        );
+        let got = events(&mut link);
+        assert!(
+            matches!(&got[..], [NetEvent::Failed(r)] if r.contains("room is full")),
+            "{got:?}"
+        );
+        assert!(link.is_ended());
+        link.on_closed(Some(CloseCode::Rejected.to_u32()), "full");
+        assert!(events(&mut link).is_empty(), "only the first reason counts");
+
+        let mut link = joining("friends");
+        link.on_open(now);
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
+            now,
+        );
+        events(&mut link);
+        link.on_closed(Some(CloseCode::Kicked.to_u32()), "flooding");
+        let got = events(&mut link);
+        assert!(
+            matches!(&got[..], [NetEvent::Disconnected(r)] if r.contains("flooding")),
+            "{got:?}"
+        );
+
+        let mut link = joining("friends");
+        link.on_open(now);
+        link.poll(now + HELLO_TIMEOUT + Duration::from_millis(1));
+        let got = events(&mut link);
+        assert!(
+            matches!(&got[..], [NetEvent::Failed(r)] if r.contains("did not answer")),
+            "{got:?}"
+        );
+    }
+
+    #[test]
+    fn a_level_stream_nobody_asked_for_or_too_long_is_an_error() {
+        let now = Instant::now();
+        let mut link = joining("friends");
+        link.on_open(now);
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
+            now,
+        );
+        events(&mut link);
+        link.on_message(Incoming::Level(&[1, 2, 3]), now);
+        assert!(matches!(
+            &events(&mut link)[..],
+            [NetEvent::Disconnected(_)]
+        ));
+    }
+
+    #[test]
+    fn queues_stay_bounded() {
+        let now = Instant::now();
+        let mut link = joining("friends");
+        link.on_open(now);
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
+            now,
+        );
+        for tick in 0..(MAX_TRANSMITS as u64 * 3) {
+            link.send_input(tick, Buttons::NONE);
+        }
+        let (_, datagrams) = sent(&mut link);
+        assert!(datagrams.len() <= MAX_TRANSMITS);
+        assert!(link.dropped() > 0);
+    }
+}

@@ -1,0 +1,416 @@
+//! The session's protocol, sans IO: what to send and what the server's
+//! bytes mean, without sockets or a clock of its own (the caller passes
+//! `now`). [`super::Session`] drives it over QUIC; the browser front end
+//! over WebTransport or WebSocket.
+
+use std::collections::{BTreeMap, VecDeque};
+
+use ledge_shared::input::Buttons;
+use ledge_shared::protocol::{
+    write_frame, ClientControl, FrameDecoder, InputPacket, Message, PlayerId, RosterEntry,
+    ServerControl, Snapshot, SnapshotHistory, StateSnapshot, Welcome, MAX_FRAME, MAX_INPUT_HISTORY,
+    MAX_ROSTER,
+};
+
+use super::{JoinOptions, SessionEvent, SessionStats, SnapshotUpdate, SNAPSHOT_HISTORY};
+use crate::error::ClientError;
+use crate::time::Instant;
+
+/// Pings remembered for round-trip times.
+const PINGS_REMEMBERED: usize = 8;
+
+/// Events queued and not yet taken; beyond this the oldest snapshot events
+/// are dropped (a caller that stopped polling must not grow memory).
+pub const MAX_PENDING_EVENTS: usize = 1024;
+
+/// The last ticks of our inputs, contiguous, newest last.
+#[derive(Debug, Clone, Default)]
+struct InputHistory {
+    ticks: VecDeque<(u64, Buttons)>,
+}
+
+impl InputHistory {
+    /// Records `buttons` for `tick`. Ticks skipped since the newest repeat
+    /// its buttons; a tick at or before the newest (the clock moved back)
+    /// replaces it and forgets the ticks after.
+    fn record(&mut self, tick: u64, buttons: Buttons) {
+        match self.ticks.back().copied() {
+            Some((newest, last)) if tick > newest && tick - newest <= MAX_INPUT_HISTORY as u64 => {
+                for t in newest + 1..tick {
+                    self.ticks.push_back((t, last));
+                }
+            }
+            Some((newest, _)) if tick <= newest => {
+                while self.ticks.back().is_some_and(|&(t, _)| t >= tick) {
+                    self.ticks.pop_back();
+                }
+                if self.ticks.back().is_some_and(|&(t, _)| t + 1 != tick) {
+                    self.ticks.clear();
+                }
+            }
+            _ => self.ticks.clear(),
+        }
+        self.ticks.push_back((tick, buttons));
+        while self.ticks.len() > MAX_INPUT_HISTORY {
+            self.ticks.pop_front();
+        }
+    }
+
+    /// A packet of the newest `n` ticks.
+    fn packet(&self, n: usize, ack: Option<u64>) -> Option<InputPacket> {
+        let &(newest, _) = self.ticks.back()?;
+        let buttons: Vec<Buttons> = self.ticks.iter().rev().take(n).map(|&(_, b)| b).collect();
+        Some(InputPacket::new(newest, &buttons, ack))
+    }
+}
+
+/// The start of a session: our hello sent, waiting for the server's first
+/// answer on the control stream.
+#[derive(Debug)]
+pub struct Handshake {
+    decoder: FrameDecoder,
+}
+
+impl Default for Handshake {
+    fn default() -> Self {
+        Handshake::new()
+    }
+}
+
+impl Handshake {
+    /// Ready to read the answer.
+    pub fn new() -> Handshake {
+        Handshake {
+            decoder: FrameDecoder::new(MAX_FRAME),
+        }
+    }
+
+    /// The bytes that open the control stream for `options` (the name is
+    /// checked first: a bad one is refused here, with the reason).
+    pub fn hello_frame(options: &JoinOptions) -> Result<Vec<u8>, ClientError> {
+        let hello = options.hello();
+        hello.validate()?;
+        let mut frame = Vec::new();
+        write_frame(&hello, &mut frame)?;
+        Ok(frame)
+    }
+
+    /// Feeds bytes of the control stream. `Ok(None)`: no answer yet;
+    /// `Ok(Some(state))`: welcomed (bytes after the welcome are kept for
+    /// the session); a `Reject` or another message is an error.
+    pub fn on_stream(&mut self, bytes: &[u8]) -> Result<Option<SessionState>, ClientError> {
+        self.decoder.push(bytes)?;
+        match self.decoder.pop_message::<ServerControl>() {
+            None => Ok(None),
+            Some(message) => match message? {
+                ServerControl::Welcome(welcome) => {
+                    let decoder = std::mem::replace(&mut self.decoder, FrameDecoder::new(0));
+                    let mut state = SessionState::new(welcome, decoder);
+                    state.drain_stream()?;
+                    Ok(Some(state))
+                }
+                ServerControl::Reject { reason } => Err(ClientError::Rejected(reason)),
+                other => Err(ClientError::Unexpected(format!(
+                    "{} before the welcome",
+                    other.kind()
+                ))),
+            },
+        }
+    }
+}
+
+/// A welcomed session's protocol state: the roster, the snapshot history,
+/// our recent inputs, pings in flight, and the events not yet taken.
+#[derive(Debug)]
+pub struct SessionState {
+    decoder: FrameDecoder,
+    welcome: Welcome,
+    inputs: InputHistory,
+    redundancy: usize,
+    history: SnapshotHistory,
+    pending: VecDeque<SessionEvent>,
+    pings: VecDeque<(u64, Instant)>,
+    players: BTreeMap<PlayerId, String>,
+    next_nonce: u64,
+    stats: SessionStats,
+}
+
+impl SessionState {
+    /// The state after `welcome`; `decoder` holds the control stream's
+    /// bytes that followed it.
+    pub fn new(welcome: Welcome, decoder: FrameDecoder) -> SessionState {
+        SessionState {
+            decoder,
+            inputs: InputHistory::default(),
+            redundancy: usize::from(welcome.timing.input_redundancy).clamp(1, MAX_INPUT_HISTORY),
+            welcome,
+            history: SnapshotHistory::new(SNAPSHOT_HISTORY),
+            pending: VecDeque::new(),
+            pings: VecDeque::new(),
+            players: BTreeMap::new(),
+            next_nonce: 0,
+            stats: SessionStats::default(),
+        }
+    }
+
+    /// What the server said when we joined.
+    pub fn welcome(&self) -> &Welcome {
+        &self.welcome
+    }
+
+    /// Who is in our room, by id (us included, once the roster arrived).
+    pub fn players(&self) -> &BTreeMap<PlayerId, String> {
+        &self.players
+    }
+
+    /// The name of player `id`, if known.
+    pub fn player_name(&self, id: PlayerId) -> Option<&str> {
+        self.players.get(&id).map(String::as_str)
+    }
+
+    /// The newest decoded snapshot.
+    pub fn latest_snapshot(&self) -> Option<&StateSnapshot> {
+        self.history.latest()
+    }
+
+    /// The snapshots decoded so far (the newest [`SNAPSHOT_HISTORY`]).
+    pub fn snapshots(&self) -> &SnapshotHistory {
+        &self.history
+    }
+
+    /// The tick we acknowledge: the newest decoded snapshot's.
+    pub fn ack(&self) -> Option<u64> {
+        self.history.latest().map(|s| s.tick)
+    }
+
+    /// Counters of what was received and sent.
+    pub fn stats(&self) -> SessionStats {
+        self.stats
+    }
+
+    /// Records our buttons for `tick` and returns the input datagram to
+    /// send: it and the ticks before it (as many as the server asked for
+    /// in `Welcome`), plus the acknowledgement of the newest snapshot.
+    pub fn input_datagram(&mut self, tick: u64, buttons: Buttons) -> Result<Vec<u8>, ClientError> {
+        self.inputs.record(tick, buttons);
+        let packet = self
+            .inputs
+            .packet(self.redundancy, self.ack())
+            .expect("just recorded");
+        let bytes = packet.encode()?;
+        self.stats.inputs_sent += 1;
+        Ok(bytes)
+    }
+
+    /// A ping sent at `now`: its nonce and the control frame to write; the
+    /// [`SessionEvent::Pong`] carries the round-trip time.
+    pub fn ping_frame(&mut self, now: Instant) -> Result<(u64, Vec<u8>), ClientError> {
+        let nonce = self.next_nonce;
+        let mut frame = Vec::new();
+        write_frame(&ClientControl::Ping { nonce }, &mut frame)?;
+        self.next_nonce = self.next_nonce.wrapping_add(1);
+        if self.pings.len() == PINGS_REMEMBERED {
+            self.pings.pop_front();
+        }
+        self.pings.push_back((nonce, now));
+        Ok((nonce, frame))
+    }
+
+    /// Feeds bytes of the control stream, received at `now`; the messages
+    /// they complete become events. A broken stream is an error.
+    pub fn on_stream(&mut self, bytes: &[u8], now: Instant) -> Result<(), ClientError> {
+        self.decoder.push(bytes)?;
+        self.drain_stream_at(now)
+    }
+
+    /// Handles the messages already buffered (after the welcome).
+    fn drain_stream(&mut self) -> Result<(), ClientError> {
+        self.drain_stream_at(Instant::now())
+    }
+
+    fn drain_stream_at(&mut self, now: Instant) -> Result<(), ClientError> {
+        while let Some(message) = self.decoder.pop_message::<ServerControl>() {
+            self.control(message?, now);
+        }
+        Ok(())
+    }
+
+    /// Feeds one datagram received at `now` (a snapshot); an undecodable
+    /// one is counted and dropped.
+    pub fn on_datagram(&mut self, bytes: &[u8], now: Instant) {
+        match Snapshot::decode(bytes) {
+            Ok(snapshot) => self.snapshot(snapshot, false, bytes.len(), now),
+            Err(_) => self.stats.malformed += 1,
+        }
+    }
+
+    /// The next event, oldest first.
+    pub fn poll_event(&mut self) -> Option<SessionEvent> {
+        self.pending.pop_front()
+    }
+
+    /// Puts events back in front (in their order), e.g. those read while
+    /// waiting for one in particular.
+    pub fn unpoll(&mut self, events: Vec<SessionEvent>) {
+        for event in events.into_iter().rev() {
+            self.pending.push_front(event);
+        }
+    }
+
+    /// Queues an event, dropping the oldest snapshot (or else the oldest
+    /// event) beyond [`MAX_PENDING_EVENTS`].
+    fn push(&mut self, event: SessionEvent) {
+        if self.pending.len() >= MAX_PENDING_EVENTS {
+            let at = self
+                .pending
+                .iter()
+                .position(|e| matches!(e, SessionEvent::Snapshot(_)))
+                .unwrap_or(0);
+            self.pending.remove(at);
+        }
+        self.pending.push_back(event);
+    }
+
+    /// Handles one control message.
+    fn control(&mut self, message: ServerControl, now: Instant) {
+        match message {
+            ServerControl::FullState(snapshot) => {
+                let len = snapshot.delta.len();
+                self.stats.stream_snapshots += 1;
+                self.snapshot(snapshot, true, len, now);
+            }
+            ServerControl::Chat { from, text } => self.push(SessionEvent::Chat { from, text }),
+            ServerControl::Notice { kind } => self.push(SessionEvent::Notice(kind)),
+            ServerControl::Pong { nonce } => {
+                let rtt = self
+                    .pings
+                    .iter()
+                    .find(|(n, _)| *n == nonce)
+                    .map(|(_, at)| now.saturating_duration_since(*at));
+                self.push(SessionEvent::Pong { nonce, rtt });
+            }
+            ServerControl::Roster { players } => {
+                // The full list: forget whoever is not in it.
+                let listed: BTreeMap<PlayerId, String> =
+                    players.into_iter().map(|p| (p.id, p.name)).collect();
+                let gone: Vec<PlayerId> = self
+                    .players
+                    .keys()
+                    .filter(|id| !listed.contains_key(id))
+                    .copied()
+                    .collect();
+                for id in gone {
+                    self.player_left(id);
+                }
+                for (id, name) in listed {
+                    self.player_joined(RosterEntry { id, name });
+                }
+            }
+            ServerControl::PlayerJoined(entry) => self.player_joined(entry),
+            ServerControl::PlayerLeft { id } => self.player_left(id),
+            ServerControl::Welcome(_)
+            | ServerControl::Reject { .. }
+            | ServerControl::Rooms { .. } => {
+                tracing::warn!("ignoring a second welcome, a reject or a room list");
+            }
+        }
+    }
+
+    /// Records a player in the roster (a new name for a known id replaces
+    /// the old one) and reports it; beyond [`MAX_ROSTER`] names new ids are
+    /// ignored and counted.
+    fn player_joined(&mut self, entry: RosterEntry) {
+        let RosterEntry { id, name } = entry;
+        if self.players.get(&id) == Some(&name) {
+            return;
+        }
+        if self.players.len() >= MAX_ROSTER && !self.players.contains_key(&id) {
+            self.stats.roster_overflow += 1;
+            return;
+        }
+        self.players.insert(id, name.clone());
+        self.push(SessionEvent::PlayerJoined { id, name });
+    }
+
+    /// Removes a player from the roster and reports it.
+    fn player_left(&mut self, id: PlayerId) {
+        let name = self.players.remove(&id);
+        self.push(SessionEvent::PlayerLeft { id, name });
+    }
+
+    /// Decodes a snapshot against our history and queues it if it is new.
+    fn snapshot(&mut self, snapshot: Snapshot, via_stream: bool, wire_bytes: usize, now: Instant) {
+        let baseline = match snapshot.baseline_tick {
+            None => None,
+            Some(tick) => match self.history.get(tick) {
+                Some(b) => Some(b),
+                None => {
+                    self.stats.missing_baselines += 1;
+                    return;
+                }
+            },
+        };
+        let state = match snapshot.decode_state(baseline) {
+            Ok(state) => state,
+            Err(e) => {
+                tracing::debug!("undecodable snapshot: {e}");
+                self.stats.malformed += 1;
+                return;
+            }
+        };
+        if !self.history.insert(state.clone()) {
+            self.stats.stale_snapshots += 1;
+            return;
+        }
+        self.stats.snapshots += 1;
+        if snapshot.baseline_tick.is_none() {
+            self.stats.full_snapshots += 1;
+        }
+        self.push(SessionEvent::Snapshot(SnapshotUpdate {
+            state,
+            baseline_tick: snapshot.baseline_tick,
+            last_input_tick: snapshot.last_input_tick,
+            input_timing: snapshot.input_timing,
+            via_stream,
+            wire_bytes,
+            received: now,
+        }));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ticks(h: &InputHistory) -> Vec<(u64, u8)> {
+        h.ticks.iter().map(|&(t, b)| (t, b.0)).collect()
+    }
+
+    #[test]
+    fn input_history_fills_gaps_and_rewinds() {
+        let mut h = InputHistory::default();
+        h.record(10, Buttons(1));
+        h.record(11, Buttons(2));
+        h.record(14, Buttons(3));
+        assert_eq!(
+            ticks(&h),
+            [(10, 1), (11, 2), (12, 2), (13, 2), (14, 3)],
+            "skipped ticks repeat the last buttons"
+        );
+        h.record(12, Buttons(4));
+        assert_eq!(ticks(&h), [(10, 1), (11, 2), (12, 4)], "rewound");
+        h.record(500, Buttons(5));
+        assert_eq!(ticks(&h), [(500, 5)], "a jump restarts");
+        h.record(5, Buttons(6));
+        assert_eq!(ticks(&h), [(5, 6)], "far back restarts too");
+        for t in 6..200 {
+            h.record(t, Buttons(t as u8));
+        }
+        assert_eq!(h.ticks.len(), MAX_INPUT_HISTORY);
+        let p = h.packet(16, Some(7)).unwrap();
+        assert_eq!(p.newest_tick, 199);
+        assert_eq!(p.buttons.len(), 16);
+        assert_eq!(p.get(190), Some(Buttons(190)));
+        assert_eq!(p.ack_snapshot, Some(7));
+    }
+}
