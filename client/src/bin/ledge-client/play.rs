@@ -7,13 +7,19 @@ use std::time::Duration;
 
 use glam::IVec2;
 use ledge_client::anim::{spread, Animator, Pose};
-#[cfg(not(target_arch = "wasm32"))]
-use ledge_client::background::NetStatus;
 use ledge_client::game::ClientGame;
+use ledge_client::net::NetStatus;
 use ledge_client::time::Instant;
 use ledge_client::view::{EntityDraw, FrameView, NetStats, PlayerDraw};
 #[cfg(not(target_arch = "wasm32"))]
-use ledge_client::{OnlineGame, OnlineRequest};
+use ledge_client::OnlineRequest;
+
+/// A server's game: the network thread natively, the page's connection in
+/// a browser.
+#[cfg(not(target_arch = "wasm32"))]
+type OnlineGame = ledge_client::OnlineGame;
+#[cfg(target_arch = "wasm32")]
+type OnlineGame = ledge_client::OnlineGame<crate::web::WebNet>;
 use ledge_shared::game::PlayerView;
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
@@ -84,7 +90,6 @@ enum Mode {
     /// A local game, no server.
     Offline(Box<ClientGame>),
     /// A server's game (once welcomed).
-    #[cfg(not(target_arch = "wasm32"))]
     Online(Box<OnlineGame>),
 }
 
@@ -126,13 +131,24 @@ impl Play {
         })
     }
 
+    /// Joins the server that served the page over `net`; the game starts
+    /// when welcomed. `level` is drawn until then.
+    #[cfg(target_arch = "wasm32")]
+    pub fn web(net: crate::web::WebNet, server: &str, level: Level, name: &str) -> Play {
+        Play {
+            level,
+            mode: Mode::Online(Box::new(OnlineGame::with_network(net, server, name))),
+            server: server.to_owned(),
+            started: Instant::now(),
+        }
+    }
+
     /// Polls the network, then runs the ticks due now, at most
     /// `remaining`; `buttons(i)` gives the buttons of the i-th tick run in
     /// this call. Returns the ticks run.
     pub fn update(&mut self, remaining: u64, buttons: impl FnMut(u64) -> Buttons) -> u64 {
         let now = Instant::now();
         match &mut self.mode {
-            #[cfg(not(target_arch = "wasm32"))]
             Mode::Online(online) => online.update_ticks(now, remaining, buttons),
             Mode::Offline(game) => game.update(now, remaining, buttons, |_, _| {}),
         }
@@ -154,18 +170,11 @@ impl Play {
     }
 
     /// The online game, if online.
-    #[cfg(not(target_arch = "wasm32"))]
     fn connection(&self) -> Option<&OnlineGame> {
         match &self.mode {
             Mode::Online(online) => Some(online),
             Mode::Offline(_) => None,
         }
-    }
-
-    /// The browser build plays offline only, for now.
-    #[cfg(target_arch = "wasm32")]
-    fn connection(&self) -> Option<&Offline> {
-        None
     }
 
     /// Why the server's certificate was refused (the message says what to
@@ -194,20 +203,15 @@ impl Play {
     /// naming the server and saying what to do (the window shows it, and
     /// stderr).
     pub fn failure(&self) -> Option<String> {
-        #[cfg(target_arch = "wasm32")]
-        return None;
-        #[cfg(not(target_arch = "wasm32"))]
-        {
-            let online = self.connection()?;
-            let server = &self.server;
-            if let Some(e) = online.error() {
-                return Some(format!("cannot play on {server}: {e}"));
-            }
-            match online.status() {
-                NetStatus::Failed(r) => Some(format!("cannot join {server}: {r}")),
-                NetStatus::Disconnected(r) => Some(format!("disconnected from {server}: {r}")),
-                _ => None,
-            }
+        let online = self.connection()?;
+        let server = &self.server;
+        if let Some(e) = online.error() {
+            return Some(format!("cannot play on {server}: {e}"));
+        }
+        match online.status() {
+            NetStatus::Failed(r) => Some(format!("cannot join {server}: {r}")),
+            NetStatus::Disconnected(r) => Some(format!("disconnected from {server}: {r}")),
+            _ => None,
         }
     }
 
@@ -220,7 +224,6 @@ impl Play {
     pub fn game(&self) -> Option<&ClientGame> {
         match &self.mode {
             Mode::Offline(game) => Some(game),
-            #[cfg(not(target_arch = "wasm32"))]
             Mode::Online(online) => online.game(),
         }
     }
@@ -259,7 +262,6 @@ impl Play {
     /// Snapshots arrived since the last call.
     pub fn take_arrivals(&mut self) -> u32 {
         match &mut self.mode {
-            #[cfg(not(target_arch = "wasm32"))]
             Mode::Online(online) => online.take_arrivals(),
             Mode::Offline(_) => 0,
         }
@@ -278,9 +280,6 @@ impl Play {
     /// One short line about the game (a failure's reason is the
     /// banner's, not this line's: it would not fit).
     pub fn status_line(&self) -> String {
-        #[cfg(target_arch = "wasm32")]
-        return format!("offline: {}", self.level.name);
-        #[cfg(not(target_arch = "wasm32"))]
         match self.connection().map(OnlineGame::status) {
             None => format!("offline: {}", self.level.name),
             Some(NetStatus::Connected { welcome, .. }) => match self.stalled() {
@@ -290,8 +289,11 @@ impl Play {
                     silent.as_secs_f32()
                 ),
                 None => format!(
-                    "online: {} on {}, you are player {}",
-                    welcome.room, welcome.level_id, welcome.player_id.0
+                    "online: {} on {}, you are player {}{}",
+                    welcome.room,
+                    welcome.level_id,
+                    welcome.player_id.0,
+                    self.via()
                 ),
             },
             Some(NetStatus::Failed(_)) => format!("could not join {}", self.server),
@@ -300,12 +302,19 @@ impl Play {
         }
     }
 
+    /// How the browser reached the server (" via WebTransport"); nothing
+    /// natively (always QUIC).
+    fn via(&self) -> String {
+        #[cfg(target_arch = "wasm32")]
+        if let Some(name) = self.connection().and_then(|o| o.network().transport_name()) {
+            return format!(" via {name}");
+        }
+        String::new()
+    }
+
     /// A message for the middle of the screen while connecting or waiting,
     /// if any (failures: [`Play::failure`]).
     pub fn banner(&self) -> Option<String> {
-        #[cfg(target_arch = "wasm32")]
-        return None;
-        #[cfg(not(target_arch = "wasm32"))]
         match self.connection()?.status() {
             NetStatus::Connecting(server) => Some(format!(
                 "connecting to {server}... ({:.0} s)",
@@ -329,30 +338,5 @@ impl Play {
             )),
             _ => None,
         }
-    }
-}
-
-/// No network in the browser build yet: a type without values, so every
-/// question about a connection answers "none" (see `Play::connection`).
-#[cfg(target_arch = "wasm32")]
-#[derive(Debug)]
-enum Offline {}
-
-#[cfg(target_arch = "wasm32")]
-impl Offline {
-    fn untrusted(&self) -> Option<&str> {
-        match *self {}
-    }
-    fn level_art(&self) -> Option<&ledge_levels::art::LevelArt> {
-        match *self {}
-    }
-    fn game(&self) -> Option<&ClientGame> {
-        match *self {}
-    }
-    fn server_state(&self) -> Option<&ledge_shared::protocol::StateSnapshot> {
-        match *self {}
-    }
-    fn stalled(&self, _now: Instant) -> Option<Duration> {
-        match *self {}
     }
 }

@@ -3,12 +3,22 @@
 //! page's glue (`web/ledge.js`, a miniquad plugin) gives the clock, the
 //! address's parameters and a place to report the game's state.
 //!
-//! This build plays the embedded default level offline; joining a server
-//! from the browser (WebTransport, WebSocket) comes next (issue 18).
+//! The page joins the server that served it ([`WebNet`]: WebTransport,
+//! or a WebSocket where the browser has no WebTransport), in the room the
+//! address names (`?room=friends`); `?offline` plays the embedded level
+//! without a server.
 
+use std::collections::BTreeMap;
 use std::time::Duration;
 
+use ledge_client::link::{Incoming, Link, Transmit};
+use ledge_client::net::{NetEvent, Network};
+use ledge_client::netstats::TransportSample;
+use ledge_client::time::Instant;
+use ledge_client::JoinOptions;
 use ledge_shared::fixed::UNITS_PER_PX;
+use ledge_shared::input::Buttons;
+use ledge_shared::protocol::PlayerId;
 
 use crate::keys::Bindings;
 use crate::{game, play, tell, Setup};
@@ -27,6 +37,141 @@ extern "C" {
     /// Publishes the game's state (JSON) as `window.ledgeState`, for the
     /// page and for tests.
     fn ledge_report(json: *const u8, len: u32);
+    /// Writes the page's `HOST:PORT` into `out` (at most `cap` bytes);
+    /// returns its length.
+    fn ledge_page_host(out: *mut u8, cap: u32) -> u32;
+    /// Starts connecting to the server that served the page.
+    fn ledge_net_open();
+    /// The next message from the connection (tag byte, payload) into
+    /// `out`; its length, or -1 if none.
+    fn ledge_net_poll(out: *mut u8, cap: u32) -> i32;
+    /// Sends on the control stream (`kind` 0) or as a datagram (1);
+    /// 0 if dropped.
+    fn ledge_net_send(kind: u32, bytes: *const u8, len: u32) -> u32;
+}
+
+/// Message tags from the glue (`web/ledge.js`): the WebSocket framing's
+/// (`0x00`..`0x03`), and the connection's own news.
+mod tag {
+    pub const STREAM: u8 = 0x00;
+    pub const DATAGRAM: u8 = 0x01;
+    pub const LEVEL: u8 = 0x02;
+    pub const LEVEL_END: u8 = 0x03;
+    pub const OPENED: u8 = 0xF0;
+    pub const CLOSED: u8 = 0xF1;
+    pub const FAILED: u8 = 0xF2;
+}
+
+/// Largest message taken from the glue at once (longer stream and level
+/// chunks come split; a snapshot datagram is far smaller).
+const POLL_BUFFER: usize = 64 * 1024;
+
+/// The page's connection as a [`Network`]: the glue's messages fed to a
+/// [`Link`] (the session's protocol), its transmits handed to the glue.
+#[derive(Debug)]
+pub struct WebNet {
+    link: Link,
+    buf: Vec<u8>,
+    /// "WebTransport" or "WebSocket", once open.
+    transport: Option<String>,
+}
+
+impl WebNet {
+    /// Starts connecting, to join as `options` say.
+    pub fn open(options: JoinOptions) -> WebNet {
+        // SAFETY: an import without arguments.
+        unsafe { ledge_net_open() };
+        WebNet {
+            link: Link::new(options),
+            buf: vec![0; POLL_BUFFER],
+            transport: None,
+        }
+    }
+
+    /// The transport's name, once open.
+    pub fn transport_name(&self) -> Option<&str> {
+        self.transport.as_deref()
+    }
+
+    /// Feeds the glue's messages to the link; pings when due.
+    fn pump(&mut self) {
+        let now = Instant::now();
+        loop {
+            // SAFETY: `buf` is valid for its length; the glue writes at
+            // most that many bytes.
+            let n = unsafe { ledge_net_poll(self.buf.as_mut_ptr(), self.buf.len() as u32) };
+            let Ok(n) = usize::try_from(n) else { break };
+            let Some((&t, payload)) = self.buf[..n.min(self.buf.len())].split_first() else {
+                continue;
+            };
+            match t {
+                tag::STREAM => self.link.on_message(Incoming::Stream(payload), now),
+                tag::DATAGRAM => self.link.on_message(Incoming::Datagram(payload), now),
+                tag::LEVEL => self.link.on_message(Incoming::Level(payload), now),
+                tag::LEVEL_END => self.link.on_message(Incoming::LevelEnd, now),
+                tag::OPENED => {
+                    self.transport = Some(String::from_utf8_lossy(payload).into_owned());
+                    self.link.on_open(now);
+                }
+                tag::CLOSED => {
+                    let code = payload
+                        .get(..4)
+                        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                        .filter(|&c| c != u32::MAX);
+                    let reason = String::from_utf8_lossy(payload.get(4..).unwrap_or(&[]));
+                    self.link.on_closed(code, &reason);
+                }
+                tag::FAILED => self.link.on_failed(&String::from_utf8_lossy(payload)),
+                other => tell(&format!(
+                    "the page's glue sent an unknown message {other:#x}"
+                )),
+            }
+        }
+        self.link.poll(now);
+        self.flush();
+    }
+
+    /// Hands the link's transmits to the glue.
+    fn flush(&mut self) {
+        while let Some(t) = self.link.poll_transmit() {
+            let (kind, bytes) = match &t {
+                Transmit::Stream(b) => (u32::from(tag::STREAM), b),
+                Transmit::Datagram(b) => (u32::from(tag::DATAGRAM), b),
+            };
+            // SAFETY: a valid buffer and its length.
+            unsafe { ledge_net_send(kind, bytes.as_ptr(), bytes.len() as u32) };
+        }
+    }
+}
+
+impl Network for WebNet {
+    fn try_recv(&mut self) -> Option<NetEvent> {
+        if let Some(event) = self.link.try_recv() {
+            return Some(event);
+        }
+        self.pump();
+        self.link.try_recv()
+    }
+
+    fn send_input(&mut self, tick: u64, buttons: Buttons) -> bool {
+        let sent = self.link.send_input(tick, buttons);
+        self.flush();
+        sent
+    }
+
+    fn chat(&mut self, text: &str) -> bool {
+        let sent = self.link.chat(text);
+        self.flush();
+        sent
+    }
+
+    fn transport(&self) -> Option<TransportSample> {
+        self.link.transport()
+    }
+
+    fn players(&self) -> BTreeMap<PlayerId, String> {
+        self.link.players()
+    }
 }
 
 /// Tells the loader which glue this build expects.
@@ -48,6 +193,15 @@ fn param(name: &str) -> Option<String> {
     Some(String::from_utf8_lossy(&out).into_owned())
 }
 
+/// The page's `HOST:PORT` (the server that served it).
+fn host() -> String {
+    let mut out = vec![0u8; MAX_PARAM];
+    // SAFETY: `out` is valid for its length; the glue writes at most that.
+    let n = unsafe { ledge_page_host(out.as_mut_ptr(), MAX_PARAM as u32) } as usize;
+    out.truncate(n.min(MAX_PARAM));
+    String::from_utf8_lossy(&out).into_owned()
+}
+
 /// The player name from `?name=`, when the server would accept it.
 fn name() -> String {
     match param("name") {
@@ -67,7 +221,21 @@ fn name() -> String {
 pub fn main() {
     let name = name();
     let level = ledge_levels::default_level();
-    let play = match play::Play::offline(level, &name) {
+    let made = if param("offline").is_some() {
+        play::Play::offline(level, &name)
+    } else {
+        let options = JoinOptions {
+            room: param("room").filter(|r| !r.is_empty()),
+            ..JoinOptions::new(&name)
+        };
+        Ok(play::Play::web(
+            WebNet::open(options),
+            &host(),
+            level,
+            &name,
+        ))
+    };
+    let play = match made {
         Ok(play) => play,
         Err(e) => {
             tell(&format!("cannot start the game: {e:#}"));
