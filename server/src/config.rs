@@ -23,6 +23,9 @@ use crate::fleet::FleetConfig;
 pub const DEFAULT_BIND: &str = "0.0.0.0:4433";
 /// Default directory of the certificate and key.
 pub const DEFAULT_CERT_DIR: &str = "certs";
+/// Default directory of the web page (`--web-root`), relative to the
+/// working directory.
+pub const DEFAULT_WEB_ROOT: &str = "web/dist";
 /// Default simulation rate in Hz.
 pub const DEFAULT_TICK_RATE: u32 = 60;
 /// Default snapshot rate in Hz.
@@ -163,6 +166,33 @@ pub struct ServerConfig {
     /// settings; `None`: not under Agones. Needs the `agones` cargo
     /// feature.
     pub agones: Option<FleetConfig>,
+    /// Browsers: the web port and WebTransport (`--web-bind`); `None`
+    /// (the default): no web port.
+    pub web: Option<WebConfig>,
+}
+
+/// Where browsers connect (docs/SERVER.md, "Browsers").
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WebConfig {
+    /// TCP address of the HTTP/1.1 server: the page, `/web.json`,
+    /// `/level`, WebSocket sessions at `/ws`.
+    pub bind: SocketAddr,
+    /// The web page's directory (read once at start).
+    pub root: PathBuf,
+    /// UDP address of WebTransport sessions; `None`: WebTransport off.
+    pub webtransport: Option<SocketAddr>,
+}
+
+impl WebConfig {
+    /// The web port at `bind` with the default page directory and
+    /// WebTransport on the same port number.
+    pub fn new(bind: SocketAddr) -> WebConfig {
+        WebConfig {
+            bind,
+            root: PathBuf::from(DEFAULT_WEB_ROOT),
+            webtransport: Some(bind),
+        }
+    }
 }
 
 impl Default for ServerConfig {
@@ -189,6 +219,7 @@ impl Default for ServerConfig {
             respawn_delay: DEFAULT_RESPAWN_DELAY,
             record_ticks: None,
             agones: None,
+            web: None,
         }
     }
 }
@@ -422,6 +453,22 @@ pub struct Cli {
     /// Under Agones: seconds between health pings [default: 2].
     #[arg(long, value_name = "SECONDS", requires = "agones")]
     pub agones_health_every: Option<f64>,
+    /// TCP address of the web port for browsers: the web page, /web.json,
+    /// /level and WebSocket sessions at /ws; WebTransport listens on the
+    /// same port number over UDP unless told otherwise [default: off].
+    #[arg(long, value_name = "ADDR:PORT", value_parser = parse_bind)]
+    pub web_bind: Option<SocketAddr>,
+    /// Directory of the web page (built by scripts/build-web), read at
+    /// start [default: web/dist].
+    #[arg(long, value_name = "DIR")]
+    pub web_root: Option<PathBuf>,
+    /// UDP address of WebTransport sessions [default: the --web-bind
+    /// address].
+    #[arg(long, value_name = "ADDR:PORT", value_parser = parse_bind)]
+    pub webtransport_bind: Option<SocketAddr>,
+    /// No WebTransport: browsers use WebSocket only.
+    #[arg(long)]
+    pub no_webtransport: bool,
 }
 
 /// The TOML file: every key optional.
@@ -453,6 +500,13 @@ struct FileConfig {
     limits: Option<Limits>,
     admission: Option<FileAdmission>,
     agones: Option<FileAgones>,
+    /// As `--web-bind`.
+    web_bind: Option<String>,
+    web_root: Option<PathBuf>,
+    /// As `--webtransport-bind`.
+    webtransport_bind: Option<String>,
+    /// `false`: as `--no-webtransport`.
+    webtransport: Option<bool>,
 }
 
 /// The file's `[agones]`: present (even empty) means run under Agones.
@@ -585,6 +639,35 @@ impl Cli {
                 fleet.connect_timeout = seconds(secs, "agones connect_timeout")?;
             }
             c.agones = Some(fleet);
+        }
+        let file_bind = |key: &str, value: &Option<String>| {
+            value
+                .as_deref()
+                .map(|b| {
+                    parse_bind(b).map_err(|message| ConfigError::Parse {
+                        path: self.config.clone().unwrap_or_default(),
+                        message: format!("{key}: {message}"),
+                    })
+                })
+                .transpose()
+        };
+        let web_bind = match self.web_bind {
+            Some(bind) => Some(bind),
+            None => file_bind("web_bind", &file.web_bind)?,
+        };
+        if let Some(bind) = web_bind {
+            let mut web = WebConfig::new(bind);
+            set(&mut web.root, file.web_root.map(relative));
+            set(&mut web.root, self.web_root.clone());
+            let wt_bind = match self.webtransport_bind {
+                Some(b) => Some(b),
+                None => file_bind("webtransport_bind", &file.webtransport_bind)?,
+            };
+            web.webtransport = match (self.no_webtransport, file.webtransport) {
+                (true, _) | (false, Some(false)) => None,
+                _ => Some(wt_bind.unwrap_or(bind)),
+            };
+            c.web = Some(web);
         }
         c.validate()?;
         Ok(c)
@@ -861,6 +944,62 @@ datagrams_per_second = 500.0
             .resolve()
             .unwrap_err();
         assert!(matches!(err, ConfigError::Parse { .. }), "{err}");
+    }
+
+    #[test]
+    fn the_web_port_comes_from_the_flags_or_the_file() {
+        assert_eq!(cli(&[]).resolve().unwrap().web, None);
+        let w = cli(&["--web-bind", "8080"]).resolve().unwrap().web.unwrap();
+        let bind: SocketAddr = "0.0.0.0:8080".parse().unwrap();
+        assert_eq!(w, WebConfig::new(bind));
+        assert_eq!(w.root, PathBuf::from(DEFAULT_WEB_ROOT));
+        assert_eq!(w.webtransport, Some(bind), "the same port number");
+        let w = cli(&[
+            "--web-bind",
+            "127.0.0.1:8080",
+            "--webtransport-bind",
+            "127.0.0.1:9443",
+            "--web-root",
+            "/srv/page",
+        ])
+        .resolve()
+        .unwrap()
+        .web
+        .unwrap();
+        assert_eq!(w.webtransport, Some("127.0.0.1:9443".parse().unwrap()));
+        assert_eq!(w.root, PathBuf::from("/srv/page"));
+        let w = cli(&["--web-bind", "8080", "--no-webtransport"])
+            .resolve()
+            .unwrap()
+            .web
+            .unwrap();
+        assert_eq!(w.webtransport, None);
+        assert!(Cli::try_parse_from(["ledge-server", "--web-bind", "nowhere:x"]).is_err());
+
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("server.toml");
+        std::fs::write(
+            &path,
+            "web_bind = \"127.0.0.1:8000\"\nweb_root = \"page\"\nwebtransport = false\n",
+        )
+        .unwrap();
+        let config = path.to_str().unwrap();
+        let w = cli(&["--config", config]).resolve().unwrap().web.unwrap();
+        assert_eq!(w.bind, "127.0.0.1:8000".parse().unwrap());
+        assert_eq!(w.root, dir.path().join("page"), "relative to the file");
+        assert_eq!(w.webtransport, None);
+        let w = cli(&["--config", config, "--web-bind", "9000"])
+            .resolve()
+            .unwrap()
+            .web
+            .unwrap();
+        assert_eq!(w.bind.port(), 9000, "the flag wins");
+        std::fs::write(&path, "web_bind = \"not an address\"\n").unwrap();
+        let err = cli(&["--config", config]).resolve().unwrap_err();
+        assert!(
+            matches!(&err, ConfigError::Parse { message, .. } if message.contains("web_bind")),
+            "{err}"
+        );
     }
 
     #[test]

@@ -1,5 +1,6 @@
 //! One client connection: handshake, then the control stream and input
-//! datagrams until either side ends it.
+//! datagrams until either side ends it. The same code serves every
+//! transport ([`crate::link`]: native QUIC, WebTransport, WebSocket).
 //!
 //! The client opens one bidirectional stream and sends a `Hello` (or
 //! `HelloRoom`); the server answers `Welcome` after joining a room, or
@@ -33,12 +34,12 @@ use ledge_shared::protocol::{
     NoticeKind, PlayerId, ProtocolError, RejectReason, ServerControl, SessionToken,
     PROTOCOL_VERSION,
 };
-use quinn::{Connection, RecvStream, SendStream};
 use tokio::sync::{mpsc, watch};
 use tracing::{debug, info, warn, Instrument};
 
 use crate::admission::{Admission, Refusal, Ticket};
 use crate::config::Limits;
+use crate::link::{Acceptor, ControlSend, Gone, Incoming, Link, Received, Receiver, Transport};
 use crate::metrics::{Channel, ClientBytes, DropReason, KickLabel, KickReason, Metrics};
 use crate::ratelimit::TokenBucket;
 use crate::room::{self, ClientLink, JoinError, Outbound, PlayerInbox, RoomHandle};
@@ -95,30 +96,32 @@ pub struct Shared {
     pub shutdown: watch::Receiver<bool>,
 }
 
-/// Counts an open connection (the `connections` gauge) while it lives.
-struct OpenGuard<'a>(&'a Shared);
+/// Counts an open connection (the `connections` gauges) while it lives.
+struct OpenGuard<'a>(&'a Shared, Transport);
 
 impl Drop for OpenGuard<'_> {
     fn drop(&mut self) {
-        self.0.metrics.connections.dec();
+        self.0.metrics.closed_connection(self.1);
     }
 }
 
 /// Serves one admitted connection to its end; `ticket` counts it for
 /// admission. It has [`AdmissionConfig::hello_timeout`] from now to finish
-/// the QUIC handshake and send its hello, and is closed at once if evicted
-/// from the pending pool meanwhile. Errors are logged, not returned.
+/// its transport's handshake and send its hello, and is closed at once if
+/// evicted from the pending pool meanwhile. Errors are logged, not
+/// returned.
 ///
 /// [`AdmissionConfig::hello_timeout`]: crate::admission::AdmissionConfig::hello_timeout
-pub async fn serve(incoming: quinn::Incoming, mut ticket: Ticket, shared: Arc<Shared>) {
-    let _open = OpenGuard(&shared);
-    shared.metrics.connections.inc();
+pub async fn serve(incoming: Incoming, mut ticket: Ticket, shared: Arc<Shared>) {
+    let transport = incoming.transport();
+    let _open = OpenGuard(&shared, transport);
+    shared.metrics.opened_connection(transport);
     let remote = incoming.remote_address();
-    let span = tracing::info_span!("conn", %remote);
+    let span = tracing::info_span!("conn", %remote, transport = transport.as_str());
     let deadline = tokio::time::Instant::now() + shared.admission.config().hello_timeout;
     async {
-        let handshake = tokio::time::timeout_at(deadline, incoming);
-        let connection = tokio::select! {
+        let handshake = tokio::time::timeout_at(deadline, incoming.connect());
+        let (link, acceptor) = tokio::select! {
             connection = handshake => match connection {
                 Ok(Ok(connection)) => connection,
                 Ok(Err(e)) => {
@@ -126,20 +129,21 @@ pub async fn serve(incoming: quinn::Incoming, mut ticket: Ticket, shared: Arc<Sh
                     return;
                 }
                 Err(_) => {
-                    shared.metrics.refused(Refusal::HelloTimeout);
+                    shared.metrics.refused_on(transport, Refusal::HelloTimeout);
                     debug!("handshake not finished in time");
                     return;
                 }
             },
             () = ticket.evicted() => {
+                shared.metrics.evicted_on(transport);
                 debug!("evicted from the pending pool during the handshake");
                 return;
             }
         };
         ticket.handshaken();
         debug!("connected");
-        match session(&connection, &shared, &mut ticket, deadline).await {
-            Ok(()) => close(&connection, CloseCode::Normal, "bye"),
+        match session(&link, acceptor, &shared, &mut ticket, deadline).await {
+            Ok(()) => link.close(CloseCode::Normal, "bye"),
             Err(End::Closed(e)) => debug!("connection lost: {e}"),
             Err(End::Close(code, reason)) => {
                 if code == CloseCode::ProtocolViolation {
@@ -147,7 +151,7 @@ pub async fn serve(incoming: quinn::Incoming, mut ticket: Ticket, shared: Arc<Sh
                 } else {
                     info!("closing: {reason}");
                 }
-                close(&connection, code, &reason);
+                link.close(code, &reason);
             }
         }
     }
@@ -202,25 +206,31 @@ impl Drop for Membership<'_> {
 }
 
 async fn session(
-    connection: &Connection,
+    connection: &Link,
+    acceptor: Acceptor,
     shared: &Shared,
     ticket: &mut Ticket,
     deadline: tokio::time::Instant,
 ) -> Result<(), End> {
     let mut shutdown = shared.shutdown.clone();
+    let transport = connection.transport();
     let (mut send, mut recv, hello, mut decoder) = tokio::select! {
-        handshake = tokio::time::timeout_at(deadline, handshake(connection, shared)) => {
+        handshake = tokio::time::timeout_at(deadline, handshake(acceptor, shared)) => {
             handshake.map_err(|_| {
-                shared.metrics.refused(Refusal::HelloTimeout);
+                shared.metrics.refused_on(transport, Refusal::HelloTimeout);
                 End::Close(CloseCode::Timeout, "no hello in time".into())
             })??
         }
-        () = ticket.evicted() => return Err(evicted()),
+        () = ticket.evicted() => {
+            shared.metrics.evicted_on(transport);
+            return Err(evicted());
+        }
         () = crate::server::stopped(&mut shutdown) => {
             return Err(End::Close(CloseCode::ServerShutdown, "server shutting down".into()))
         }
     };
     if !ticket.join() {
+        shared.metrics.evicted_on(transport);
         return Err(evicted());
     }
 
@@ -252,7 +262,7 @@ async fn session(
 
     let (control, queue) = mpsc::channel(CONTROL_QUEUE);
     let link = |player_id: PlayerId| ClientLink {
-        connection: connection.clone(),
+        link: connection.clone(),
         control: control.clone(),
         bytes: shared.metrics.client(player_id.0),
     };
@@ -328,7 +338,7 @@ async fn session(
         decoder: &mut decoder,
         buckets: Buckets::new(&shared.limits, Instant::now()),
     };
-    let ending = client.run(connection, &mut recv, &mut shutdown).await;
+    let ending = client.run(&mut recv, &mut shutdown).await;
     if let Some(download) = client.download.take() {
         download.abort();
     }
@@ -406,7 +416,7 @@ async fn join(
 
 /// Answers a `ListRooms` (or rejects another protocol version) and ends
 /// the session normally.
-async fn list_rooms(send: &mut SendStream, shared: &Shared, version: u32) -> Result<(), End> {
+async fn list_rooms(send: &mut ControlSend, shared: &Shared, version: u32) -> Result<(), End> {
     if check_version(version).is_err() {
         let reason = RejectReason::ProtocolVersion {
             server: PROTOCOL_VERSION,
@@ -430,28 +440,40 @@ type Hello = Result<ClientControl, RejectReason>;
 /// hello or `ListRooms`. A hello whose name is invalid is answered with
 /// [`RejectReason::InvalidName`]; anything else malformed closes.
 async fn handshake(
-    connection: &Connection,
+    acceptor: Acceptor,
     shared: &Shared,
-) -> Result<(SendStream, RecvStream, Hello, FrameDecoder), End> {
-    let (send, mut recv) = connection
-        .accept_bi()
+) -> Result<(ControlSend, Receiver, Hello, FrameDecoder), End> {
+    let (send, mut recv) = acceptor
+        .accept_control()
         .await
         .map_err(|e| End::Closed(e.to_string()))?;
     let mut decoder = FrameDecoder::new(CLIENT_MAX_FRAME);
-    let mut buf = [0u8; 2048];
     let payload = loop {
         if let Some(payload) = decoder.pop() {
             break payload;
         }
-        let n = match recv.read(&mut buf).await {
-            Ok(Some(n)) => n,
-            Ok(None) => {
+        let bytes = match recv.next_stream().await {
+            Received::Stream(bytes) => bytes,
+            Received::StreamEnd => {
                 return Err(End::Close(
                     CloseCode::ProtocolViolation,
                     "stream ended before hello".into(),
                 ))
             }
-            Err(e) => return Err(End::Closed(e.to_string())),
+            Received::Gone(e) => return Err(End::Closed(e.to_string())),
+            // Not asked for; never returned before the hello.
+            Received::Datagram(_) => continue,
+            Received::Malformed(e) => {
+                shared.metrics.malformed(Channel::WebSocket);
+                return Err(End::Close(
+                    CloseCode::ProtocolViolation,
+                    format!("reading hello: {e}"),
+                ));
+            }
+            Received::Broken(e) => {
+                shared.metrics.malformed(Channel::WebSocket);
+                return Err(End::Close(CloseCode::ProtocolViolation, e));
+            }
         };
         shared
             .metrics
@@ -459,8 +481,8 @@ async fn handshake(
             .get_or_create(&crate::metrics::ChannelLabel {
                 channel: Channel::Stream,
             })
-            .inc_by(n as u64);
-        if let Err(e) = decoder.push(&buf[..n]) {
+            .inc_by(bytes.len() as u64);
+        if let Err(e) = decoder.push(&bytes) {
             shared.metrics.malformed(Channel::Stream);
             return Err(End::Close(
                 CloseCode::ProtocolViolation,
@@ -515,11 +537,10 @@ impl Ending {
     /// The connection ended under the session: the client closing it on
     /// purpose (it quit) is a leave; a timeout or reset is a loss, and the
     /// player is kept for a resume.
-    fn gone(e: quinn::ConnectionError) -> Ending {
+    fn gone(e: Gone) -> Ending {
         match e {
-            quinn::ConnectionError::ApplicationClosed(_)
-            | quinn::ConnectionError::ConnectionClosed(_) => Ending::Left,
-            e => Ending::Lost(e.to_string()),
+            Gone::Closed(_) => Ending::Left,
+            Gone::Lost(e) => Ending::Lost(e),
         }
     }
 
@@ -564,7 +585,7 @@ impl Buckets {
 /// A joined client's receive side.
 struct Client<'a> {
     shared: &'a Shared,
-    connection: Connection,
+    connection: Link,
     /// Level downloads started.
     downloads: u32,
     /// The level download running, if any.
@@ -579,13 +600,7 @@ struct Client<'a> {
 }
 
 impl Client<'_> {
-    async fn run(
-        &mut self,
-        connection: &Connection,
-        recv: &mut RecvStream,
-        shutdown: &mut watch::Receiver<bool>,
-    ) -> Ending {
-        let mut buf = vec![0u8; 4096];
+    async fn run(&mut self, recv: &mut Receiver, shutdown: &mut watch::Receiver<bool>) -> Ending {
         // Frames that arrived with the hello.
         if let Err(ending) = self.drain_frames() {
             return ending;
@@ -593,10 +608,11 @@ impl Client<'_> {
         loop {
             let step = tokio::select! {
                 () = crate::server::stopped(shutdown) => Err(Ending::Shutdown),
-                read = recv.read(&mut buf) => match read {
-                    Ok(Some(n)) => {
+                received = recv.next() => match received {
+                    Received::Stream(bytes) => {
+                        let n = bytes.len();
                         self.shared.metrics.received(&self.bytes, Channel::Stream, n);
-                        match self.decoder.push(&buf[..n]) {
+                        match self.decoder.push(&bytes) {
                             Ok(()) => self.drain_frames(),
                             Err(e) => {
                                 self.shared.metrics.malformed(Channel::Stream);
@@ -605,13 +621,18 @@ impl Client<'_> {
                         }
                     }
                     // The client finished its side: it left.
-                    Ok(None) => Err(Ending::Left),
-                    Err(quinn::ReadError::ConnectionLost(e)) => Err(Ending::gone(e)),
-                    Err(e) => Err(Ending::Lost(e.to_string())),
-                },
-                datagram = connection.read_datagram() => match datagram {
-                    Ok(datagram) => self.datagram(&datagram),
-                    Err(e) => Err(Ending::gone(e)),
+                    Received::StreamEnd => Err(Ending::Left),
+                    Received::Datagram(datagram) => self.datagram(&datagram),
+                    Received::Malformed(e) => {
+                        self.shared.metrics.malformed(Channel::WebSocket);
+                        debug!("malformed WebSocket message: {e}");
+                        self.strike_malformed(Instant::now(), "WebSocket message", &e.to_string())
+                    }
+                    Received::Broken(e) => {
+                        self.shared.metrics.malformed(Channel::WebSocket);
+                        Err(Ending::malformed(e))
+                    }
+                    Received::Gone(e) => Err(Ending::gone(e)),
                 },
             };
             if let Err(ending) = step {
@@ -636,7 +657,7 @@ impl Client<'_> {
                 Err(e) => {
                     self.shared.metrics.malformed(Channel::Stream);
                     debug!("malformed control message: {e}");
-                    self.strike_malformed(now, "control message", &e)?;
+                    self.strike_malformed(now, "control message", &e.to_string())?;
                     continue;
                 }
             };
@@ -694,16 +715,16 @@ impl Client<'_> {
         debug!(offset, rest, "sending the level");
         self.download = Some(tokio::spawn(async move {
             let at = bundle.len() - rest;
-            let Ok(mut stream) = connection.open_uni().await else {
+            let Some(mut stream) = connection.open_level().await else {
                 return;
             };
             for chunk in bundle[at..].chunks(LEVEL_CHUNK) {
-                if stream.write_all(chunk).await.is_err() {
+                if !stream.write_all(chunk).await {
                     return;
                 }
                 metrics.level_download_bytes.inc_by(chunk.len() as u64);
             }
-            if stream.finish().is_ok() {
+            if stream.finish().await {
                 metrics.level_downloads_completed.inc();
             }
         }));
@@ -741,23 +762,18 @@ impl Client<'_> {
                         what: "input datagram",
                         detail: "acknowledges a snapshot never sent".into(),
                     };
-                    return self.strike_malformed(now, "input datagram", &e);
+                    return self.strike_malformed(now, "input datagram", &e.to_string());
                 }
                 Ok(())
             }
             Err(e) => {
                 self.shared.metrics.malformed(Channel::Datagram);
-                self.strike_malformed(now, "input datagram", &e)
+                self.strike_malformed(now, "input datagram", &e.to_string())
             }
         }
     }
 
-    fn strike_malformed(
-        &mut self,
-        now: Instant,
-        what: &str,
-        error: &ProtocolError,
-    ) -> Result<(), Ending> {
+    fn strike_malformed(&mut self, now: Instant, what: &str, error: &str) -> Result<(), Ending> {
         if self.buckets.malformed.try_take(now) {
             Ok(())
         } else {
@@ -780,9 +796,9 @@ impl Client<'_> {
 /// [`Outbound::Finish`] (or when every sender is gone) finishes the stream
 /// and waits until the client has everything.
 async fn write_control(
-    mut send: SendStream,
+    mut send: ControlSend,
     mut queue: mpsc::Receiver<Outbound>,
-    connection: Connection,
+    connection: Link,
     metrics: Arc<Metrics>,
     bytes: ClientBytes,
 ) {
@@ -802,7 +818,7 @@ async fn write_control(
             }
         }
     }
-    if send.finish().is_ok() {
+    if send.finish().await {
         // Bounded when closing: the client may not read at all.
         let stopped = send.stopped();
         if close.is_some() {
@@ -812,12 +828,12 @@ async fn write_control(
         }
     }
     if let Some((code, reason)) = close {
-        self::close(&connection, code, &reason);
+        connection.close(code, &reason);
     }
 }
 
 /// Sends a `Reject` and waits (briefly) until the client has it.
-async fn reject(send: &mut SendStream, reason: &RejectReason) {
+async fn reject(send: &mut ControlSend, reason: &RejectReason) {
     let reject = ServerControl::Reject {
         reason: reason.clone(),
     };
@@ -827,22 +843,13 @@ async fn reject(send: &mut SendStream, reason: &RejectReason) {
 /// Sends the session's last message and waits (briefly) until the client
 /// has it, since closing the connection discards unacknowledged stream
 /// data.
-async fn say_last(send: &mut SendStream, message: &ServerControl) {
+async fn say_last(send: &mut ControlSend, message: &ServerControl) {
     let mut frame = Vec::new();
     if write_frame(message, &mut frame).is_err()
         || send.write_all(&frame).await.is_err()
-        || send.finish().is_err()
+        || !send.finish().await
     {
         return;
     }
     let _ = tokio::time::timeout(REJECT_LINGER, send.stopped()).await;
-}
-
-/// Closes `connection` with `code` and `reason` (cut to fit one packet).
-pub fn close(connection: &Connection, code: CloseCode, reason: &str) {
-    let mut end = reason.len().min(200);
-    while !reason.is_char_boundary(end) {
-        end -= 1;
-    }
-    connection.close(code.to_u32().into(), &reason.as_bytes()[..end]);
 }

@@ -22,7 +22,12 @@
 //! * [`record`]: optional match recording (inputs, joins, hashes per tick);
 //! * [`admission`]: which new connections are taken on (per address, the
 //!   pending pool and its eviction, Retry under load);
-//! * [`connection`]: one client's handshake, control stream and datagrams;
+//! * [`link`]: the transports (QUIC, WebTransport, WebSocket) behind one
+//!   interface;
+//! * [`connection`]: one client's handshake, control stream and datagrams,
+//!   whatever its transport;
+//! * [`web`]: browsers: the web port (page, `/web.json`, `/level`,
+//!   WebSocket) and WebTransport with its rotating certificates;
 //! * [`ratelimit`]: token buckets;
 //! * [`metrics`]: Prometheus metrics and their HTTP endpoint;
 //! * [`fleet`]: what a server in an Agones fleet reports, and when
@@ -44,6 +49,7 @@ pub mod fingerprint;
 pub mod fleet;
 pub mod inputs;
 pub mod levels;
+pub mod link;
 pub mod metrics;
 pub mod ratelimit;
 pub mod record;
@@ -53,6 +59,7 @@ pub mod server;
 pub mod sessions;
 pub mod snapshots;
 pub mod tls;
+pub mod web;
 
 pub use config::ServerConfig;
 pub use fingerprint::Fingerprint;

@@ -93,6 +93,15 @@ async fn run() -> anyhow::Result<()> {
     if let Some(addr) = server.metrics_addr() {
         say(format_args!("metrics at http://{addr}/metrics"));
     }
+    if let Some(addr) = server.web_addr() {
+        let webtransport = match server.webtransport_addr() {
+            Some(wt) => format!("WebTransport on UDP port {}", wt.port()),
+            None => "no WebTransport".to_owned(),
+        };
+        say(format_args!(
+            "browsers: http://{addr}/ (WebSocket at /ws, {webtransport})"
+        ));
+    }
     say(format_args!(
         "certificate SHA-256 fingerprint: {fingerprint}"
     ));

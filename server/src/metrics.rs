@@ -22,6 +22,7 @@ use tokio::sync::{mpsc, watch};
 use tracing::{debug, warn};
 
 pub use crate::admission::Refusal;
+pub use crate::link::Transport;
 
 /// Label: a room.
 #[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
@@ -44,6 +45,9 @@ pub enum Channel {
     Datagram,
     /// The reliable control stream.
     Stream,
+    /// A WebSocket message that is neither (text, empty, unknown tag,
+    /// too large: [`ledge_shared::protocol::web::WebError`]).
+    WebSocket,
 }
 
 /// Label: a channel.
@@ -85,6 +89,22 @@ pub struct DropLabel {
 /// Label: why a connection was refused ([`Refusal`]).
 #[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
 pub struct RefusalLabel {
+    /// The reason.
+    pub reason: Refusal,
+}
+
+/// Label: a transport.
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct TransportLabel {
+    /// The transport.
+    pub transport: Transport,
+}
+
+/// Label: a transport and why one of its connections was refused.
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct TransportRefusalLabel {
+    /// The transport.
+    pub transport: Transport,
     /// The reason.
     pub reason: Refusal,
 }
@@ -163,6 +183,12 @@ pub struct Metrics {
     pub connections_refused: Family<RefusalLabel, Counter>,
     /// New connections sent a QUIC Retry (address validation under load).
     pub retries: Counter,
+    /// Open connections by transport.
+    pub transport_connections: Family<TransportLabel, Gauge>,
+    /// Connections opened by transport (handshakes included).
+    pub transport_connections_opened: Family<TransportLabel, Counter>,
+    /// [`Metrics::connections_refused`] by transport too.
+    pub transport_connections_refused: Family<TransportRefusalLabel, Counter>,
     /// Connections not yet past their hello.
     pub pending_connections: Gauge,
     /// Bytes received per client.
@@ -237,6 +263,9 @@ impl Metrics {
             connections: Gauge::default(),
             connections_refused: Family::default(),
             retries: Counter::default(),
+            transport_connections: Family::default(),
+            transport_connections_opened: Family::default(),
+            transport_connections_refused: Family::default(),
             pending_connections: Gauge::default(),
             client_bytes_in: Family::default(),
             client_bytes_out: Family::default(),
@@ -303,6 +332,26 @@ impl Metrics {
             "New connections sent a QUIC Retry to validate their address",
             m.retries.clone(),
         );
+        r.register(
+            "transport_connections",
+            "Open connections (in their handshake or joined) by transport",
+            m.transport_connections.clone(),
+        );
+        r.register(
+            "transport_connections_opened",
+            "Connections admitted by transport",
+            m.transport_connections_opened.clone(),
+        );
+        r.register(
+            "transport_connections_refused",
+            "Connections refused, or closed before their hello, by transport and reason",
+            m.transport_connections_refused.clone(),
+        );
+        for transport in Transport::ALL {
+            m.transport_connections
+                .get_or_create(&TransportLabel { transport })
+                .set(0);
+        }
         r.register(
             "pending_connections",
             "Connections not yet past their hello",
@@ -387,6 +436,45 @@ impl Metrics {
         self.connections_refused
             .get_or_create(&RefusalLabel { reason })
             .inc();
+    }
+
+    /// Counts a connection of `transport` refused, or closed before its
+    /// hello (in both families).
+    pub fn refused_on(&self, transport: Transport, reason: Refusal) {
+        self.refused(reason);
+        self.refused_by_transport(transport, reason);
+    }
+
+    /// Counts a refusal in the per-transport family only.
+    pub fn refused_by_transport(&self, transport: Transport, reason: Refusal) {
+        self.transport_connections_refused
+            .get_or_create(&TransportRefusalLabel { transport, reason })
+            .inc();
+    }
+
+    /// Counts a connection of `transport` evicted from the pending pool
+    /// (per transport: the unlabelled family counts it when the newcomer
+    /// that evicted it is admitted).
+    pub fn evicted_on(&self, transport: Transport) {
+        self.refused_by_transport(transport, Refusal::Evicted);
+    }
+
+    /// Counts a connection opened (the `connections` gauges).
+    pub fn opened_connection(&self, transport: Transport) {
+        self.connections.inc();
+        let label = TransportLabel { transport };
+        self.transport_connections.get_or_create(&label).inc();
+        self.transport_connections_opened
+            .get_or_create(&label)
+            .inc();
+    }
+
+    /// Counts a connection closed.
+    pub fn closed_connection(&self, transport: Transport) {
+        self.connections.dec();
+        self.transport_connections
+            .get_or_create(&TransportLabel { transport })
+            .dec();
     }
 
     /// Counts `n` dropped messages.

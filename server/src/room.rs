@@ -34,6 +34,7 @@ use tracing::{debug, error, info, warn};
 
 use crate::clock::TickSchedule;
 use crate::inputs::{InputBuffer, Received};
+use crate::link::{DatagramError, Link};
 use crate::metrics::{
     Channel, ClientBytes, DropReason, KickLabel, KickReason, Metrics, RoomLabel, SnapshotKind,
     SnapshotLabel,
@@ -106,8 +107,8 @@ pub struct RoomStatus {
 /// What a connection gives the room to reach its client.
 #[derive(Debug, Clone)]
 pub struct ClientLink {
-    /// The connection, for snapshot datagrams.
-    pub connection: quinn::Connection,
+    /// The connection (any transport), for snapshot datagrams and closing.
+    pub link: Link,
     /// The client's control-stream writer.
     pub control: mpsc::Sender<Outbound>,
     /// The client's byte counters.
@@ -585,7 +586,7 @@ impl Room {
         let m = self.members.get_mut(&player_id)?;
         if m.attached {
             // The client gave up on it before we noticed.
-            crate::connection::close(&m.link.connection, CloseCode::Normal, "resumed elsewhere");
+            m.link.link.close(CloseCode::Normal, "resumed elsewhere");
         }
         m.link = link;
         m.inbox = inbox.clone();
@@ -718,7 +719,7 @@ impl Room {
                 let close = Outbound::Close(CloseCode::Kicked, reason.clone());
                 if m.link.control.try_send(close).is_err() {
                     // Its queue is full (it reads nothing): close at once.
-                    crate::connection::close(&m.link.connection, CloseCode::Kicked, &reason);
+                    m.link.link.close(CloseCode::Kicked, &reason);
                 }
             }
             info!(room = %self.config.name, player = %id, "removed: {reason}");
@@ -765,7 +766,7 @@ impl Room {
             };
             let max = m
                 .link
-                .connection
+                .link
                 .max_datagram_size()
                 .map(|max| max.min(DATAGRAM_SEND_BUFFER / 2));
             let outgoing = match snapshot.into_outgoing(max) {
@@ -778,12 +779,12 @@ impl Room {
             match outgoing {
                 Outgoing::Datagram(bytes) => {
                     let len = bytes.len();
-                    match m.link.connection.send_datagram(bytes.into()) {
+                    match m.link.link.send_datagram(bytes.into()) {
                         Ok(()) => {
                             record_snapshot(&self.metrics, &m.link.bytes, kind, len);
                         }
-                        Err(quinn::SendDatagramError::ConnectionLost(_)) => {}
-                        Err(e) => {
+                        Err(DatagramError::Lost) => {}
+                        Err(DatagramError::Failed(e)) => {
                             debug!(tick, "snapshot datagram not sent: {e}");
                             self.metrics.count_drop(DropReason::SnapshotSendFailed);
                         }

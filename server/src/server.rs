@@ -21,6 +21,7 @@ use crate::config::{ConfigError, ServerConfig};
 use crate::connection::{self, Shared, SHUTDOWN_LINGER};
 use crate::fingerprint::Fingerprint;
 use crate::levels::{self, LevelLoadError};
+use crate::link::Incoming;
 use crate::metrics::{self, Metrics};
 use crate::record::Recorder;
 use crate::room::RoomConfig;
@@ -28,6 +29,9 @@ use crate::rooms::Rooms;
 use crate::sessions::Sessions;
 use crate::snapshots::DEFAULT_HISTORY;
 use crate::tls::{self, TlsError};
+use crate::web::files::{WebRoot, WebRootError};
+use crate::web::webtransport::{self as wt, WebCerts, WebTransportError};
+use crate::web::{self, WebState};
 
 /// How long shutdown waits for connection tasks, then for the endpoint.
 const SHUTDOWN_GRACE: Duration = Duration::from_secs(3);
@@ -70,6 +74,12 @@ pub enum ServerError {
         /// The limit, MiB.
         max_mib: u64,
     },
+    /// The web page's directory cannot be served (`--web-root`).
+    #[error("--web-root {0}")]
+    WebRoot(#[from] WebRootError),
+    /// The WebTransport endpoint could not be set up.
+    #[error(transparent)]
+    WebTransport(#[from] WebTransportError),
     /// `--agones` was asked of a server built without the `agones` feature,
     /// or the Agones SDK sidecar did not answer.
     #[error("{0}")]
@@ -112,34 +122,50 @@ pub(crate) async fn stopped(flag: &mut watch::Receiver<bool>) {
     let _ = flag.wait_for(|&stop| stop).await;
 }
 
-/// Decides on a new connection ([`Admission::consider`]) and acts:
-/// a Retry, a refusal (counted), or a task serving it.
+/// Decides on a new QUIC or WebTransport connection
+/// ([`Admission::consider`]) and acts: a Retry, a refusal (counted), or a
+/// task serving it. (WebSockets are admitted by the web port, before
+/// their upgrade.)
 fn admit(
-    incoming: quinn::Incoming,
+    incoming: Incoming,
     shared: &Arc<Shared>,
     connections: &mut JoinSet<()>,
     refusals: &mut RefusalLog,
 ) {
     let remote = incoming.remote_address();
-    let verdict = shared.admission.consider(
-        remote.ip(),
-        incoming.remote_address_validated(),
-        incoming.may_retry(),
-    );
+    let (validated, may_retry) = match &incoming {
+        Incoming::Quic(i) => (i.remote_address_validated(), i.may_retry()),
+        Incoming::WebTransport(i) => {
+            let validated = i.remote_address_validated();
+            (validated, !validated)
+        }
+        Incoming::WebSocket(_) => (true, false),
+    };
+    let verdict = shared.admission.consider(remote.ip(), validated, may_retry);
     let metrics = &shared.metrics;
     match verdict {
         Verdict::Retry => {
             metrics.retries.inc();
-            if let Err(e) = incoming.retry() {
-                debug!(%remote, "cannot send a Retry: {e}");
-                e.into_incoming().ignore();
+            match incoming {
+                Incoming::Quic(incoming) => {
+                    if let Err(e) = incoming.retry() {
+                        debug!(%remote, "cannot send a Retry: {e}");
+                        e.into_incoming().ignore();
+                    }
+                }
+                Incoming::WebTransport(incoming) => incoming.retry(),
+                Incoming::WebSocket(_) => {}
             }
         }
         Verdict::Refuse(reason) => {
-            metrics.refused(reason);
+            metrics.refused_on(incoming.transport(), reason);
             refusals.count(reason);
             debug!(%remote, ?reason, "connection refused");
-            incoming.refuse();
+            match incoming {
+                Incoming::Quic(incoming) => incoming.refuse(),
+                Incoming::WebTransport(incoming) => incoming.refuse(),
+                Incoming::WebSocket(_) => {}
+            }
         }
         Verdict::Admit { ticket, evicted } => {
             if evicted {
@@ -188,6 +214,31 @@ impl RefusalLog {
     }
 }
 
+/// The web port and WebTransport, bound.
+#[derive(Debug)]
+struct WebParts {
+    listener: tokio::net::TcpListener,
+    addr: SocketAddr,
+    root: WebRoot,
+    webtransport: Option<WebTransportParts>,
+}
+
+struct WebTransportParts {
+    endpoint: Arc<wt::Endpoint>,
+    certs: Arc<WebCerts>,
+    settings: wt::Settings,
+    addr: SocketAddr,
+}
+
+impl std::fmt::Debug for WebTransportParts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("WebTransportParts")
+            .field("addr", &self.addr)
+            .field("certs", &self.certs)
+            .finish_non_exhaustive()
+    }
+}
+
 /// A bound, not yet running server.
 ///
 /// `bind` then `run`; keep a [`ShutdownHandle`] to stop it. Tests bind to
@@ -209,6 +260,8 @@ pub struct Server {
     shutdown: watch::Sender<bool>,
     /// One per room when `record_ticks` is set, in room order.
     recorders: Vec<Recorder>,
+    /// The web port and WebTransport (`--web-bind`), if on.
+    web: Option<WebParts>,
 }
 
 /// Asks a running server to shut down gracefully. Cloneable; any clone works.
@@ -272,6 +325,55 @@ impl Server {
             }
             None => None,
         };
+        let web = match &config.web {
+            Some(w) => {
+                let listener = web::bind(w.bind).map_err(bind_err(w.bind, "--web-bind"))?;
+                let addr = listener
+                    .local_addr()
+                    .map_err(bind_err(w.bind, "--web-bind"))?;
+                let root = WebRoot::load(&w.root)?;
+                if let Some(missing) = root.missing() {
+                    warn!("{missing}; / answers 503 until then");
+                }
+                let webtransport = match w.webtransport {
+                    Some(mut bind) => {
+                        // The same port number as the web port by default.
+                        if bind.port() == 0 && w.webtransport == Some(w.bind) {
+                            bind.set_port(addr.port());
+                        }
+                        let settings = wt::Settings {
+                            bind,
+                            idle_timeout: config.idle_timeout,
+                        };
+                        let (endpoint, certs) = wt::bind(&settings).map_err(|e| match e {
+                            wt::BindError::Setup(e) => ServerError::WebTransport(e),
+                            wt::BindError::Io(source) => ServerError::Bind {
+                                addr: bind,
+                                option: "--webtransport-bind",
+                                source,
+                            },
+                        })?;
+                        let addr = endpoint
+                            .local_addr()
+                            .map_err(bind_err(bind, "--webtransport-bind"))?;
+                        Some(WebTransportParts {
+                            endpoint,
+                            certs,
+                            settings,
+                            addr,
+                        })
+                    }
+                    None => None,
+                };
+                Some(WebParts {
+                    listener,
+                    addr,
+                    root,
+                    webtransport,
+                })
+            }
+            None => None,
+        };
         let (metrics, registry) = Metrics::new();
         let recorders = match config.record_ticks {
             Some(limit) => {
@@ -295,7 +397,28 @@ impl Server {
             metrics_listener,
             shutdown: watch::Sender::new(false),
             recorders,
+            web,
         })
+    }
+
+    /// The web port's address (`--web-bind`), if on.
+    pub fn web_addr(&self) -> Option<SocketAddr> {
+        self.web.as_ref().map(|w| w.addr)
+    }
+
+    /// WebTransport's UDP address, if on.
+    pub fn webtransport_addr(&self) -> Option<SocketAddr> {
+        self.web.as_ref()?.webtransport.as_ref().map(|w| w.addr)
+    }
+
+    /// SHA-256 of the WebTransport certificates a page may meet, current
+    /// first (as `/web.json` lists them); empty when WebTransport is off.
+    pub fn webtransport_hashes(&self) -> Vec<[u8; 32]> {
+        self.web
+            .as_ref()
+            .and_then(|w| w.webtransport.as_ref())
+            .map(|w| w.certs.hashes())
+            .unwrap_or_default()
     }
 
     /// The UDP address actually bound (the real port when binding port 0).
@@ -362,6 +485,7 @@ impl Server {
             shutdown,
             recorders,
             fingerprint,
+            web,
             ..
         } = self;
         let mut stop = shutdown.subscribe();
@@ -396,6 +520,7 @@ impl Server {
             info!(%addr, "serving metrics at /metrics");
             tokio::spawn(metrics::serve(listener, registry, stop.clone()))
         });
+        let level_bytes = bytes::Bytes::from(Vec::clone(&level_bundle));
         let shared = Arc::new(Shared {
             rooms,
             sessions: Sessions::new(config.reconnect_grace),
@@ -435,6 +560,54 @@ impl Server {
             snapshot_interval = config.snapshot_interval(),
             "listening"
         );
+        // Browsers: the web port's task hands admitted WebSockets to this
+        // loop; WebTransport sessions are accepted here like QUIC ones.
+        let (accepted_tx, mut accepted) = tokio::sync::mpsc::channel::<web::Accepted>(64);
+        let mut web_tasks = Vec::new();
+        let mut webtransport = None;
+        if let Some(w) = web {
+            let wt_port = w
+                .webtransport
+                .as_ref()
+                .map(|t| (t.addr.port(), t.certs.clone()));
+            if let Some(t) = &w.webtransport {
+                info!(
+                    addr = %t.addr,
+                    cert_sha256 = %crate::Fingerprint(t.certs.current().sha256),
+                    "WebTransport sessions at {}",
+                    crate::link::webtransport::PATH
+                );
+                web_tasks.push(tokio::spawn(wt::rotate(
+                    t.endpoint.clone(),
+                    t.certs.clone(),
+                    t.settings.clone(),
+                    stop.clone(),
+                )));
+                webtransport = Some(t.endpoint.clone());
+            }
+            info!(addr = %w.addr, files = w.root.len(), "serving browsers (the page, /web.json, /ws)");
+            let state = Arc::new(WebState {
+                shared: shared.clone(),
+                root: w.root,
+                level_hex: level_offer.hex(),
+                level: level_bytes,
+                webtransport: wt_port,
+                accepted: accepted_tx,
+                idle_timeout: config.idle_timeout,
+            });
+            web_tasks.push(tokio::spawn(web::serve(w.listener, state, stop.clone())));
+        } else {
+            drop(accepted_tx);
+        }
+        let wt_accept = |endpoint: &Option<Arc<wt::Endpoint>>| {
+            let endpoint = endpoint.clone();
+            async move {
+                match endpoint {
+                    Some(e) => e.accept().await,
+                    None => std::future::pending().await,
+                }
+            }
+        };
         let mut connections = JoinSet::new();
         let mut sweep = tokio::time::interval(SWEEP);
         let mut refusals = RefusalLog::default();
@@ -454,9 +627,17 @@ impl Server {
                     refusals.warn(now);
                 }
                 incoming = endpoint.accept() => match incoming {
-                    Some(incoming) => admit(incoming, &shared, &mut connections, &mut refusals),
+                    Some(incoming) => {
+                        admit(Incoming::Quic(incoming), &shared, &mut connections, &mut refusals)
+                    }
                     None => break,
                 },
+                incoming = wt_accept(&webtransport) => {
+                    admit(Incoming::WebTransport(incoming), &shared, &mut connections, &mut refusals)
+                }
+                Some((incoming, ticket)) = accepted.recv() => {
+                    connections.spawn(connection::serve(incoming, ticket, shared.clone()));
+                }
                 Some(done) = connections.join_next(), if !connections.is_empty() => {
                     if let Err(e) = done {
                         error!("connection task failed: {e}");
@@ -477,6 +658,11 @@ impl Server {
                     done = connections.join_next() => if done.is_none() { break },
                     // Newcomers are refused at once rather than left waiting.
                     Some(incoming) = endpoint.accept() => incoming.refuse(),
+                    incoming = wt_accept(&webtransport) => incoming.refuse(),
+                    // Upgraded meanwhile: told the server is shutting down.
+                    Some((incoming, ticket)) = accepted.recv() => {
+                        connections.spawn(connection::serve(incoming, ticket, shared.clone()));
+                    }
                 }
             }
         })
@@ -494,6 +680,21 @@ impl Server {
             .is_err()
         {
             warn!("endpoint not idle after {SHUTDOWN_GRACE:?}");
+        }
+        if let Some(endpoint) = &webtransport {
+            endpoint.close(
+                wtransport::VarInt::from_u32(CloseCode::ServerShutdown.to_u32()),
+                b"server shutting down",
+            );
+            if tokio::time::timeout(SHUTDOWN_GRACE, endpoint.wait_idle())
+                .await
+                .is_err()
+            {
+                warn!("WebTransport endpoint not idle after {SHUTDOWN_GRACE:?}");
+            }
+        }
+        for task in web_tasks {
+            let _ = task.await;
         }
         #[cfg(feature = "agones")]
         if let Some(thread) = agones_task {

@@ -107,6 +107,12 @@ pub struct TestServer {
     /// Room `room-1`'s match record, when recording is configured
     /// ([`ServerConfig::record_ticks`]).
     pub recorder: Option<Recorder>,
+    /// The web port, when configured ([`ServerConfig::web`]).
+    pub web_addr: Option<SocketAddr>,
+    /// WebTransport's UDP address, when on.
+    pub webtransport_addr: Option<SocketAddr>,
+    /// The level bundle offered (hash and size).
+    pub level_offer: ledge_shared::protocol::LevelOffer,
     registry: Arc<Registry>,
     shutdown: ShutdownHandle,
     task: Option<JoinHandle<Result<(), ServerError>>>,
@@ -144,6 +150,9 @@ impl TestServer {
             fingerprint: server.fingerprint(),
             metrics_addr: server.metrics_addr(),
             recorder: server.recorder("room-1"),
+            web_addr: server.web_addr(),
+            webtransport_addr: server.webtransport_addr(),
+            level_offer: server.level_offer(),
             registry: server.registry(),
             shutdown: server.shutdown_handle(),
             task: Some(tokio::spawn(server.run())),
@@ -493,6 +502,7 @@ impl PredictedClient {
     }
 }
 pub mod e2e;
+pub mod web;
 
 /// A file of the level corpus (`target/level-corpus`, made by
 /// `scripts/fetch-level-corpus`: Tiled's own examples, with their

@@ -26,6 +26,7 @@ mod fingerprint;
 mod frame;
 pub mod snapshot;
 mod varint;
+pub mod web;
 
 pub use codec::Message;
 pub use control::{
