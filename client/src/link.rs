@@ -22,7 +22,9 @@ use std::collections::{BTreeMap, VecDeque};
 use std::time::Duration;
 
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::{write_frame, ClientControl, CloseCode, Message, PlayerId, Welcome};
+use ledge_shared::protocol::{
+    write_frame, ClientControl, CloseCode, Message, NoticeKind, PlayerId, Welcome,
+};
 
 use crate::download::{embedded, Download, Fetched};
 use crate::error::ClientError;
@@ -90,6 +92,9 @@ pub struct Link {
     out: VecDeque<Transmit>,
     sample: TransportSample,
     last_ping: Option<Instant>,
+    /// The server's last word before a close: a kick or its shutdown (a
+    /// WebTransport close may reach a browser without its code).
+    last_word: Option<(CloseCode, String)>,
     /// Messages or events dropped because a queue was full.
     dropped: u64,
 }
@@ -104,6 +109,7 @@ impl Link {
             out: VecDeque::new(),
             sample: TransportSample::default(),
             last_ping: None,
+            last_word: None,
             dropped: 0,
         }
     }
@@ -237,6 +243,15 @@ impl Link {
             if let crate::session::SessionEvent::Pong { rtt: Some(rtt), .. } = &event {
                 self.sample.rtt = *rtt;
             }
+            match &event {
+                crate::session::SessionEvent::Notice(NoticeKind::Kick { reason }) => {
+                    self.last_word = Some((CloseCode::Kicked, reason.clone()));
+                }
+                crate::session::SessionEvent::Notice(NoticeKind::Shutdown) => {
+                    self.last_word = Some((CloseCode::ServerShutdown, String::new()));
+                }
+                _ => {}
+            }
             moved.extend(NetEvent::from_session(event));
         }
         for event in moved {
@@ -245,13 +260,21 @@ impl Link {
     }
 
     /// The transport closed with `code` (the server's [`CloseCode`] when it
-    /// sent one) and `reason`.
+    /// sent one) and `reason`. Without a code, the server's last notice (a
+    /// kick, its shutdown) says why.
     pub fn on_closed(&mut self, code: Option<u32>, reason: &str) {
         let error = match code.and_then(CloseCode::from_u32) {
             Some(code) => ClientError::ClosedByServer {
                 code: Some(code),
                 reason: reason.to_owned(),
             },
+            None if self.last_word.is_some() => {
+                let (code, said) = self.last_word.clone().expect("checked");
+                ClientError::ClosedByServer {
+                    code: Some(code),
+                    reason: said,
+                }
+            }
             None if reason.is_empty() => ClientError::StreamEnded,
             None => ClientError::Stream(reason.to_owned()),
         };
@@ -600,6 +623,53 @@ mod tests {
         let got = events(&mut link);
         assert!(
             matches!(&got[..], [NetEvent::Disconnected(r)] if r.contains("flooding")),
+            "{got:?}"
+        );
+
+        // A close without a code (WebTransport in a browser) after a kick
+        // notice: the notice says why.
+        let mut link = joining("friends");
+        link.on_open(now);
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
+            now,
+        );
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Notice {
+                kind: NoticeKind::Kick {
+                    reason: "sent too many datagrams".into(),
+                },
+            })),
+            now,
+        );
+        events(&mut link);
+        link.on_failed("the WebTransport session broke");
+        link.on_closed(None, "");
+        let got = events(&mut link);
+        assert!(
+            matches!(&got[..], [NetEvent::Disconnected(r)] if r.contains("broke")),
+            "a failure is a failure: {got:?}"
+        );
+
+        let mut link = joining("friends");
+        link.on_open(now);
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
+            now,
+        );
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Notice {
+                kind: NoticeKind::Kick {
+                    reason: "sent too many datagrams".into(),
+                },
+            })),
+            now,
+        );
+        events(&mut link);
+        link.on_closed(None, "");
+        let got = events(&mut link);
+        assert!(
+            matches!(&got[..], [NetEvent::Disconnected(r)] if r.contains("removed us") && r.contains("too many datagrams")),
             "{got:?}"
         );
 
