@@ -9,6 +9,8 @@
 //! endpoint.
 //! [`PredictedClient`] drives a predicting client ([`ClientGame`]) in real
 //! time with a scripted input, the way a player or bot would.
+//! [`browser`] drives headless Chromium over the DevTools protocol, for
+//! the browser client's tests.
 
 use std::collections::BTreeSet;
 use std::net::SocketAddr;
@@ -501,6 +503,7 @@ impl PredictedClient {
         }
     }
 }
+pub mod browser;
 pub mod e2e;
 pub mod web;
 
