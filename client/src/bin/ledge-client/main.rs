@@ -475,7 +475,25 @@ async fn game(mut setup: Setup) {
             played,
             status: &setup.play.status_line(),
             failure: failed.as_deref(),
+            joined: setup.play.joined(),
             me: me.as_ref().map(|m| m.pos),
+            players: local
+                .iter()
+                .map(|p| (p, true, local_label.unwrap_or(&setup.name)))
+                .chain(remotes.iter().zip(&labels).map(|(p, l)| (p, false, l.as_str())))
+                .map(|(p, ours, label)| {
+                    let top_left = view.to_screen(p.pos - p.size / 2.0);
+                    let size = p.size * view.zoom;
+                    let c = render::player_color(p.id, ours);
+                    web::DrawnPlayer {
+                        id: p.id,
+                        name: label.to_owned(),
+                        local: ours,
+                        screen: [top_left.x, top_left.y, size.x, size.y],
+                        rgb: [c.r, c.g, c.b].map(|v| (v * 255.0).round() as u8),
+                    }
+                })
+                .collect(),
         });
 
         // Done? (A failed run after a few frames showing why.)

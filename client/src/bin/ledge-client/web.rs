@@ -276,19 +276,49 @@ pub struct Report<'a> {
     pub status: &'a str,
     /// The failure shown, if any.
     pub failure: Option<&'a str>,
+    /// Whether we are in a game (offline, or welcomed with the level).
+    pub joined: bool,
     /// Our player's centre, units (the predicted game's).
     pub me: Option<glam::IVec2>,
+    /// The players drawn (ours first, if drawn).
+    pub players: Vec<DrawnPlayer>,
+}
+
+/// A player as drawn this frame: its box on the canvas and its colour.
+pub struct DrawnPlayer {
+    /// Its id.
+    pub id: u32,
+    /// Its name label (ours: our name).
+    pub name: String,
+    /// Ours.
+    pub local: bool,
+    /// Its box's top left corner and size, canvas pixels.
+    pub screen: [f32; 4],
+    /// Its body colour, RGB 0..=255.
+    pub rgb: [u8; 3],
 }
 
 /// Publishes `report` as `window.ledgeState` (a few times a second is
 /// plenty; every frame is cheap too).
 pub fn report(r: &Report<'_>) {
     let px = |v: i32| f64::from(v) / f64::from(UNITS_PER_PX);
+    let players: Vec<serde_json::Value> = r
+        .players
+        .iter()
+        .map(|p| {
+            serde_json::json!({
+                "id": p.id, "name": p.name, "local": p.local,
+                "screen": p.screen, "rgb": p.rgb,
+            })
+        })
+        .collect();
     let json = serde_json::json!({
         "played": r.played,
         "status": r.status,
         "failure": r.failure,
+        "joined": r.joined,
         "me": r.me.map(|p| serde_json::json!({"x": px(p.x), "y": px(p.y)})),
+        "players": players,
     })
     .to_string();
     // SAFETY: a valid buffer and its length.
