@@ -406,7 +406,7 @@ async fn malformed_websocket_messages_are_counted_and_a_client_that_keeps_sendin
 }
 
 #[tokio::test]
-async fn the_fifth_websocket_from_one_address_is_refused_and_counted() {
+async fn the_fifth_connection_from_one_address_is_refused_over_websocket_and_webtransport() {
     let root = page();
     let server = web_server(root.path(), |c| {
         c.admission = AdmissionConfig::default();
@@ -436,6 +436,23 @@ async fn the_fifth_websocket_from_one_address_is_refused_and_counted() {
         ),
         1.0,
         "{m}"
+    );
+    // WebTransport counts against the same address.
+    let hashes = cert_hashes(&server).await;
+    let wt = WtClient::connect(server.webtransport_addr.unwrap(), "/ledge", &hashes).await;
+    assert!(wt.is_err(), "refused at its first packet");
+    let m = server.metrics();
+    assert_eq!(
+        metric(
+            &m,
+            "ledge_transport_connections_refused_total{transport=\"webtransport\",reason=\"AddressConnections\"}"
+        ),
+        1.0,
+        "{m}"
+    );
+    assert_eq!(
+        metric(&m, "ledge_connections_refused_total{reason=\"AddressConnections\"}"),
+        2.0
     );
     // One leaves: a place again.
     drop(open.pop());
@@ -579,4 +596,30 @@ async fn shutdown_closes_web_sessions_like_native_ones() {
     server.stop().await.unwrap();
     // The web port is closed too.
     assert!(tokio::net::TcpStream::connect(web).await.is_err());
+}
+
+#[tokio::test]
+async fn a_silent_websocket_gets_the_hello_timeout() {
+    let root = page();
+    let server = web_server(root.path(), |c| {
+        c.admission.hello_timeout = Duration::from_millis(300);
+    })
+    .await;
+    let mut silent = WsClient::connect(server.web_addr.unwrap()).await.unwrap();
+    match silent.next(WAIT).await {
+        Some(WebEvent::Closed(code, raw, _)) => {
+            assert_eq!((code, raw), (Some(CloseCode::Timeout), 4003));
+        }
+        other => panic!("closed, not {other:?}"),
+    }
+    let m = server.metrics();
+    assert_eq!(
+        metric(
+            &m,
+            "ledge_transport_connections_refused_total{transport=\"websocket\",reason=\"HelloTimeout\"}"
+        ),
+        1.0,
+        "{m}"
+    );
+    server.stop().await.unwrap();
 }
