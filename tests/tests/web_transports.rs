@@ -406,7 +406,7 @@ async fn malformed_websocket_messages_are_counted_and_a_client_that_keeps_sendin
 }
 
 #[tokio::test]
-async fn the_fifth_websocket_from_one_address_is_refused_and_counted() {
+async fn the_fifth_connection_from_one_address_is_refused_over_websocket_and_webtransport() {
     let root = page();
     let server = web_server(root.path(), |c| {
         c.admission = AdmissionConfig::default();
@@ -436,6 +436,26 @@ async fn the_fifth_websocket_from_one_address_is_refused_and_counted() {
         ),
         1.0,
         "{m}"
+    );
+    // WebTransport counts against the same address.
+    let hashes = cert_hashes(&server).await;
+    let wt = WtClient::connect(server.webtransport_addr.unwrap(), "/ledge", &hashes).await;
+    assert!(wt.is_err(), "refused at its first packet");
+    let m = server.metrics();
+    assert_eq!(
+        metric(
+            &m,
+            "ledge_transport_connections_refused_total{transport=\"webtransport\",reason=\"AddressConnections\"}"
+        ),
+        1.0,
+        "{m}"
+    );
+    assert_eq!(
+        metric(
+            &m,
+            "ledge_connections_refused_total{reason=\"AddressConnections\"}"
+        ),
+        2.0
     );
     // One leaves: a place again.
     drop(open.pop());
@@ -477,6 +497,14 @@ async fn the_web_port_serves_the_page_web_json_and_the_level() {
     }
     // A plain GET of /ws is not an upgrade.
     assert_ne!(http_get(addr, "/ws").await.status, 200);
+    // A request head over the server's buffer is refused, not buffered.
+    let huge = format!("/{}", "a".repeat(32 * 1024));
+    let refused = huge_request(addr, &huge).await;
+    assert!(
+        refused.as_deref().is_none_or(|head| head.contains(" 431 ")),
+        "{refused:?}"
+    );
+    assert_eq!(http_get(addr, "/").await.status, 200, "still serving");
 
     let doc = web_json(&server).await;
     assert_eq!(doc["protocol"], PROTOCOL_VERSION);
@@ -504,6 +532,19 @@ async fn the_web_port_serves_the_page_web_json_and_the_level() {
             .is_err()
     );
     server.stop().await.unwrap();
+}
+
+/// Sends `GET path` and returns the answer's head, if any came.
+async fn huge_request(addr: SocketAddr, path: &str) -> Option<String> {
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    let mut stream = tokio::net::TcpStream::connect(addr).await.unwrap();
+    let request = format!("GET {path} HTTP/1.1\r\nHost: localhost\r\n\r\n");
+    let _ = stream.write_all(request.as_bytes()).await;
+    let mut answer = Vec::new();
+    let read = tokio::time::timeout(WAIT, stream.read_to_end(&mut answer)).await;
+    assert!(read.is_ok(), "answered or closed in time");
+    let text = String::from_utf8_lossy(&answer).into_owned();
+    (!text.is_empty()).then_some(text)
 }
 
 #[tokio::test]
@@ -579,4 +620,58 @@ async fn shutdown_closes_web_sessions_like_native_ones() {
     server.stop().await.unwrap();
     // The web port is closed too.
     assert!(tokio::net::TcpStream::connect(web).await.is_err());
+}
+
+#[tokio::test]
+async fn a_silent_websocket_gets_the_hello_timeout() {
+    let root = page();
+    let server = web_server(root.path(), |c| {
+        c.admission.hello_timeout = Duration::from_millis(300);
+    })
+    .await;
+    let mut silent = WsClient::connect(server.web_addr.unwrap()).await.unwrap();
+    match silent.next(WAIT).await {
+        Some(WebEvent::Closed(code, raw, _)) => {
+            assert_eq!((code, raw), (Some(CloseCode::Timeout), 4003));
+        }
+        other => panic!("closed, not {other:?}"),
+    }
+    let m = server.metrics();
+    assert_eq!(
+        metric(
+            &m,
+            "ledge_transport_connections_refused_total{transport=\"websocket\",reason=\"HelloTimeout\"}"
+        ),
+        1.0,
+        "{m}"
+    );
+    server.stop().await.unwrap();
+}
+
+#[tokio::test]
+async fn a_lost_websocket_session_is_resumed_with_its_token() {
+    let root = page();
+    let server = web_server(root.path(), |_| {}).await;
+    let addr = server.web_addr.unwrap();
+    let mut first = Web::Ws(WsClient::connect(addr).await.unwrap());
+    let welcome = first.join("wanderer", "room-1").await;
+    // Gone without a close frame (a dropped network, not a left page).
+    drop(first);
+    let mut again = Web::Ws(WsClient::connect(addr).await.unwrap());
+    again
+        .send_control(&ClientControl::Resume {
+            version: PROTOCOL_VERSION,
+            name: "wanderer".into(),
+            room: Some("room-1".into()),
+            token: welcome.session_token,
+        })
+        .await;
+    let resumed = match again.next(WAIT).await {
+        Some(WebEvent::Control(ServerControl::Welcome(w))) => w,
+        other => panic!("a Welcome, not {other:?}"),
+    };
+    assert_eq!(resumed.player_id, welcome.player_id, "the same player");
+    let m = server.metrics();
+    assert_eq!(metric(&m, "ledge_sessions_resumed_total"), 1.0, "{m}");
+    server.stop().await.unwrap();
 }

@@ -50,6 +50,9 @@ pub const HEADER_TIMEOUT: Duration = Duration::from_secs(5);
 /// is handed over at the upgrade).
 pub const REQUEST_TIMEOUT: Duration = Duration::from_secs(60);
 
+/// Most bytes of a request buffered (its head: no route reads a body).
+pub const MAX_REQUEST_BUFFER: usize = 16 * 1024;
+
 /// A WebSocket admitted and upgraded, for the server's accept loop.
 pub type Accepted = (Incoming, Ticket);
 
@@ -271,6 +274,7 @@ pub async fn serve(listener: TcpListener, state: Arc<WebState>, mut stop: watch:
             let connection = hyper::server::conn::http1::Builder::new()
                 .timer(TokioTimer::new())
                 .header_read_timeout(HEADER_TIMEOUT)
+                .max_buf_size(MAX_REQUEST_BUFFER)
                 .serve_connection(TokioIo::new(stream), service)
                 .with_upgrades();
             match tokio::time::timeout(REQUEST_TIMEOUT, connection).await {
