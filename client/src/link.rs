@@ -33,6 +33,11 @@ use crate::netstats::TransportSample;
 use crate::session::{Handshake, JoinOptions, SessionState};
 use crate::time::Instant;
 
+/// Something that arrived on the transport: the control stream's bytes,
+/// a datagram, the level stream's bytes or its end (the kinds of the
+/// WebSocket framing, whichever transport carried them).
+pub use ledge_shared::protocol::web::WebMessage as Incoming;
+
 /// Events waiting for the front end; beyond, the oldest are dropped.
 pub const MAX_EVENTS: usize = 512;
 /// Messages waiting for the transport; beyond, the oldest datagrams are
@@ -42,19 +47,6 @@ pub const MAX_TRANSMITS: usize = 256;
 pub const PING_EVERY: Duration = Duration::from_secs(1);
 /// How long the server has to answer the hello.
 pub const HELLO_TIMEOUT: Duration = crate::session::REPLY_TIMEOUT;
-
-/// Something that arrived on the transport.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Incoming<'a> {
-    /// Bytes of the control stream, in order (any slice of it).
-    Stream(&'a [u8]),
-    /// One datagram (a snapshot).
-    Datagram(&'a [u8]),
-    /// The next bytes of the level stream (after `GetLevel`).
-    Level(&'a [u8]),
-    /// The level stream ended.
-    LevelEnd,
-}
 
 /// Something to send.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -592,6 +584,26 @@ mod tests {
         assert!(matches!(&got[2], NetEvent::PlayerLeft { id: PlayerId(9) }));
     }
 
+    /// A joined link that was just told it is kicked (events taken).
+    fn kicked(now: Instant) -> Link {
+        let mut link = joining("friends");
+        link.on_open(now);
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
+            now,
+        );
+        link.on_message(
+            Incoming::Stream(&frame(&ServerControl::Notice {
+                kind: NoticeKind::Kick {
+                    reason: "sent too many datagrams".into(),
+                },
+            })),
+            now,
+        );
+        events(&mut link);
+        link
+    }
+
     #[test]
     fn refusals_closes_and_silence_end_the_session_with_the_reason() {
         let now = Instant::now();
@@ -628,21 +640,7 @@ mod tests {
 
         // A close without a code (WebTransport in a browser) after a kick
         // notice: the notice says why.
-        let mut link = joining("friends");
-        link.on_open(now);
-        link.on_message(
-            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
-            now,
-        );
-        link.on_message(
-            Incoming::Stream(&frame(&ServerControl::Notice {
-                kind: NoticeKind::Kick {
-                    reason: "sent too many datagrams".into(),
-                },
-            })),
-            now,
-        );
-        events(&mut link);
+        let mut link = kicked(now);
         link.on_failed("the WebTransport session broke");
         link.on_closed(None, "");
         let got = events(&mut link);
@@ -651,21 +649,7 @@ mod tests {
             "a failure is a failure: {got:?}"
         );
 
-        let mut link = joining("friends");
-        link.on_open(now);
-        link.on_message(
-            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
-            now,
-        );
-        link.on_message(
-            Incoming::Stream(&frame(&ServerControl::Notice {
-                kind: NoticeKind::Kick {
-                    reason: "sent too many datagrams".into(),
-                },
-            })),
-            now,
-        );
-        events(&mut link);
+        let mut link = kicked(now);
         link.on_closed(None, "");
         let got = events(&mut link);
         assert!(

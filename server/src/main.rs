@@ -93,20 +93,9 @@ async fn run() -> anyhow::Result<()> {
     if let Some(addr) = server.metrics_addr() {
         say(format_args!("metrics at http://{addr}/metrics"));
     }
-    if let Some(addr) = server.web_addr() {
-        let webtransport = match server.webtransport_addr() {
-            Some(wt) => format!("WebTransport on UDP port {}", wt.port()),
-            None => "no WebTransport".to_owned(),
-        };
-        say(format_args!(
-            "browsers: http://{addr}/ (WebSocket at /ws, {webtransport})"
-        ));
-    }
-    say(format_args!(
-        "certificate SHA-256 fingerprint: {fingerprint}"
-    ));
-    // Players need nothing but the address: clients download the level.
-    let interfaces = if bound.ip().is_unspecified() {
+    let interfaces = if bound.ip().is_unspecified()
+        || server.web_addr().is_some_and(|a| a.ip().is_unspecified())
+    {
         match if_addrs::get_if_addrs() {
             Ok(list) => list
                 .into_iter()
@@ -121,6 +110,27 @@ async fn run() -> anyhow::Result<()> {
     } else {
         Vec::new()
     };
+    if let Some(addr) = server.web_addr() {
+        for join in join_addresses(addr, &interfaces) {
+            say(format_args!(
+                "{}: http://{}/",
+                join.who_browser(),
+                join.addr
+            ));
+        }
+        let webtransport = match server.webtransport_addr() {
+            Some(wt) => format!("WebTransport on UDP port {}", wt.port()),
+            None => "no WebTransport".to_owned(),
+        };
+        say(format_args!(
+            "(browsers: add ?room=NAME&name=YOUR_NAME; they connect by WebSocket at /ws or \
+             {webtransport})"
+        ));
+    }
+    say(format_args!(
+        "certificate SHA-256 fingerprint: {fingerprint}"
+    ));
+    // Players need nothing but the address: clients download the level.
     let joins = join_addresses(bound, &interfaces);
     for join in &joins {
         say(format_args!(
@@ -164,6 +174,15 @@ impl JoinAddress {
             None if self.addr.ip().is_loopback() => "join from this machine".to_owned(),
             None => "join from this machine or your network".to_owned(),
             Some(name) => format!("join from your network ({name})"),
+        }
+    }
+
+    /// Whom the address is for, as a browser's line starts.
+    fn who_browser(&self) -> String {
+        match &self.interface {
+            None if self.addr.ip().is_loopback() => "play in a browser on this machine".to_owned(),
+            None => "play in a browser on this machine or your network".to_owned(),
+            Some(name) => format!("play in a browser from your network ({name})"),
         }
     }
 }

@@ -480,17 +480,21 @@ async fn game(mut setup: Setup) {
             players: local
                 .iter()
                 .map(|p| (p, true, local_label.unwrap_or(&setup.name)))
-                .chain(remotes.iter().zip(&labels).map(|(p, l)| (p, false, l.as_str())))
+                .chain(
+                    remotes
+                        .iter()
+                        .zip(&labels)
+                        .map(|(p, l)| (p, false, l.as_str())),
+                )
                 .map(|(p, ours, label)| {
                     let top_left = view.to_screen(p.pos - p.size / 2.0);
                     let size = p.size * view.zoom;
-                    let c = render::player_color(p.id, ours);
                     web::DrawnPlayer {
                         id: p.id,
                         name: label.to_owned(),
                         local: ours,
                         screen: [top_left.x, top_left.y, size.x, size.y],
-                        rgb: [c.r, c.g, c.b].map(|v| (v * 255.0).round() as u8),
+                        rgb: render::palette::bytes(render::player_color(p.id, ours)),
                     }
                 })
                 .collect(),

@@ -11,14 +11,14 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use ledge_client::link::{Incoming, Link, Transmit};
+use ledge_client::link::{Link, Transmit};
 use ledge_client::net::{NetEvent, Network};
 use ledge_client::netstats::TransportSample;
 use ledge_client::time::Instant;
 use ledge_client::JoinOptions;
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::PlayerId;
+use ledge_shared::protocol::{web, PlayerId};
 
 use crate::keys::Bindings;
 use crate::{game, play, tell, Setup};
@@ -50,13 +50,9 @@ extern "C" {
     fn ledge_net_send(kind: u32, bytes: *const u8, len: u32) -> u32;
 }
 
-/// Message tags from the glue (`web/ledge.js`): the WebSocket framing's
-/// (`0x00`..`0x03`), and the connection's own news.
+/// Message tags from the glue (`web/ledge.js`) besides the WebSocket
+/// framing's ([`web::Tag`]): the connection's own news.
 mod tag {
-    pub const STREAM: u8 = 0x00;
-    pub const DATAGRAM: u8 = 0x01;
-    pub const LEVEL: u8 = 0x02;
-    pub const LEVEL_END: u8 = 0x03;
     pub const OPENED: u8 = 0xF0;
     pub const CLOSED: u8 = 0xF1;
     pub const FAILED: u8 = 0xF2;
@@ -101,14 +97,11 @@ impl WebNet {
             // most that many bytes.
             let n = unsafe { ledge_net_poll(self.buf.as_mut_ptr(), self.buf.len() as u32) };
             let Ok(n) = usize::try_from(n) else { break };
-            let Some((&t, payload)) = self.buf[..n.min(self.buf.len())].split_first() else {
+            let message = &self.buf[..n.min(self.buf.len())];
+            let Some((&t, payload)) = message.split_first() else {
                 continue;
             };
             match t {
-                tag::STREAM => self.link.on_message(Incoming::Stream(payload), now),
-                tag::DATAGRAM => self.link.on_message(Incoming::Datagram(payload), now),
-                tag::LEVEL => self.link.on_message(Incoming::Level(payload), now),
-                tag::LEVEL_END => self.link.on_message(Incoming::LevelEnd, now),
                 tag::OPENED => {
                     self.transport = Some(String::from_utf8_lossy(payload).into_owned());
                     self.link.on_open(now);
@@ -122,9 +115,11 @@ impl WebNet {
                     self.link.on_closed(code, &reason);
                 }
                 tag::FAILED => self.link.on_failed(&String::from_utf8_lossy(payload)),
-                other => tell(&format!(
-                    "the page's glue sent an unknown message {other:#x}"
-                )),
+                // The session's own messages, in the WebSocket framing.
+                _ => match web::decode(message) {
+                    Ok(m) => self.link.on_message(m, now),
+                    Err(e) => tell(&format!("the page's glue sent a bad message: {e}")),
+                },
             }
         }
         self.link.poll(now);
@@ -135,8 +130,8 @@ impl WebNet {
     fn flush(&mut self) {
         while let Some(t) = self.link.poll_transmit() {
             let (kind, bytes) = match &t {
-                Transmit::Stream(b) => (u32::from(tag::STREAM), b),
-                Transmit::Datagram(b) => (u32::from(tag::DATAGRAM), b),
+                Transmit::Stream(b) => (web::Tag::Stream as u32, b),
+                Transmit::Datagram(b) => (web::Tag::Datagram as u32, b),
             };
             // SAFETY: a valid buffer and its length.
             unsafe { ledge_net_send(kind, bytes.as_ptr(), bytes.len() as u32) };
@@ -319,6 +314,12 @@ pub fn report(r: &Report<'_>) {
         "joined": r.joined,
         "me": r.me.map(|p| serde_json::json!({"x": px(p.x), "y": px(p.y)})),
         "players": players,
+        // The level's flat colours, for tests of what the canvas shows.
+        "palette": {
+            "sky": crate::render::palette::bytes(crate::render::palette::SKY),
+            "solid": crate::render::palette::bytes(crate::render::palette::SOLID),
+            "grass": crate::render::palette::bytes(crate::render::palette::GRASS),
+        },
     })
     .to_string();
     // SAFETY: a valid buffer and its length.

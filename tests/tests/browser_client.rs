@@ -1,0 +1,269 @@
+//! The browser client end to end: the real web page (`scripts/build-web`:
+//! the client's wasm, miniquad's loader, ledge's glue) served by a real
+//! server's web port, in headless Chromium, once over WebTransport and once
+//! with WebTransport removed from the page (the WebSocket fallback, chosen
+//! by the page itself).
+//!
+//! Each time the page joins room "friends", where a native player ("bob")
+//! stands; real key events (held Right, then Space) move the page's player,
+//! and bob's session, fed by the server, sees it move; the screenshot shows
+//! the level (ground and grass in the level's colours), our player, and bob
+//! in his colour where the page says it drew him.
+//!
+//! Without `chromium` these tests print a loud SKIPPED notice and pass,
+//! except with `CI=true`, where they fail.
+
+use std::collections::BTreeMap;
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::process::Command;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use ledge_client::{JoinOptions, SessionEvent};
+use ledge_server::config::WebConfig;
+use ledge_shared::fixed::UNITS_PER_PX;
+use ledge_shared::protocol::PlayerId;
+use ledge_tests::browser::{skip_without_chromium, Browser, Key, Options, Page};
+use ledge_tests::TestServer;
+use serde_json::Value;
+
+/// Builds the page into `web/dist` (a no-op when it is up to date: CI
+/// builds it before the tests) and returns that directory.
+fn build_web() -> PathBuf {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = Command::new("bash")
+        .arg(root.join("scripts/build-web"))
+        .current_dir(&root)
+        .output()
+        .expect("run scripts/build-web");
+    assert!(
+        out.status.success(),
+        "scripts/build-web failed:\n{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    root.join("web/dist")
+}
+
+/// Where the server says each player is (x, world pixels), by name, as
+/// bob's session hears it.
+type Seen = Arc<Mutex<BTreeMap<String, Vec<f64>>>>;
+
+/// Joins room "friends" as bob (a native QUIC client that stands still)
+/// and records every player's x from the server's snapshots.
+async fn bob(server: SocketAddr, fingerprint: ledge_client::Fingerprint, seen: Seen) {
+    let mut session = ledge_client::connect_with(
+        server,
+        "localhost",
+        fingerprint,
+        &JoinOptions {
+            room: Some("friends".into()),
+            ..JoinOptions::new("bob")
+        },
+    )
+    .await
+    .expect("bob joins");
+    let mut tick = session.welcome().server_tick;
+    loop {
+        let event = tokio::time::timeout(Duration::from_millis(16), session.recv()).await;
+        tick += 1;
+        let _ = session.send_input(tick, ledge_shared::input::Buttons::NONE);
+        let update = match event {
+            Ok(Ok(SessionEvent::Snapshot(update))) => update,
+            Ok(Ok(_)) | Err(_) => continue,
+            // The session ended (the server stopped).
+            Ok(Err(_)) => return,
+        };
+        if let Some(last) = update.last_input_tick {
+            tick = tick.max(last + 4);
+        }
+        let names: BTreeMap<PlayerId, String> = session.players().clone();
+        let mut seen = seen.lock().unwrap();
+        for (id, name) in names {
+            if let Some(e) = update.state.get(id.0) {
+                let x = f64::from(e.pos.x) / f64::from(UNITS_PER_PX);
+                seen.entry(name).or_default().push(x);
+            }
+        }
+    }
+}
+
+/// The page's state (`window.ledgeState`).
+fn state(page: &mut Page) -> Value {
+    page.eval("window.ledgeState || null")
+        .expect("read the page's state")
+}
+
+/// Pixels of `png` (RGBA) within `tolerance` of `rgb` inside `rect`
+/// (x, y, w, h), and how many pixels the rect held.
+fn count(png: &[u8], rect: [f64; 4], rgb: [u8; 3], tolerance: i32) -> (u32, u32) {
+    let decoder = png::Decoder::new(png);
+    let mut reader = decoder.read_info().expect("a PNG");
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).expect("a frame");
+    let channels = info.color_type.samples();
+    let (w, h) = (info.width as i64, info.height as i64);
+    let (mut hits, mut total) = (0, 0);
+    let x0 = (rect[0].floor() as i64).clamp(0, w);
+    let y0 = (rect[1].floor() as i64).clamp(0, h);
+    let x1 = ((rect[0] + rect[2]).ceil() as i64).clamp(0, w);
+    let y1 = ((rect[1] + rect[3]).ceil() as i64).clamp(0, h);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let at = ((y * w + x) as usize) * channels;
+            let p = &buf[at..at + 3];
+            total += 1;
+            if (0..3).all(|i| (i32::from(p[i]) - i32::from(rgb[i])).abs() <= tolerance) {
+                hits += 1;
+            }
+        }
+    }
+    (hits, total)
+}
+
+fn rgb_of(v: &Value) -> [u8; 3] {
+    let a = v.as_array().expect("an RGB triple");
+    [0, 1, 2].map(|i| a[i].as_u64().expect("a byte") as u8)
+}
+
+fn rect_of(v: &Value) -> [f64; 4] {
+    let a = v.as_array().expect("a rectangle");
+    [0, 1, 2, 3].map(|i| a[i].as_f64().expect("a number"))
+}
+
+/// Plays once in a fresh browser: joins, moves, checks what the server and
+/// the screenshot say. `webtransport`: whether the browser has it.
+fn play(web: SocketAddr, name: &str, webtransport: bool, seen: &Seen) {
+    let transport = if webtransport {
+        "WebTransport"
+    } else {
+        "WebSocket"
+    };
+    let browser = Browser::launch_with(Options {
+        webtransport,
+        ..Options::default()
+    })
+    .expect("launch chromium");
+    let mut page = browser.new_page().expect("a tab");
+    let url = format!("http://{web}/?name={name}&room=friends");
+    page.open(&url).expect("the page loads");
+    let joined = page.wait_until(
+        "window.ledgeState && ledgeState.joined && ledgeState.players.length >= 2",
+        Duration::from_secs(30),
+    );
+    if let Err(e) = joined {
+        panic!(
+            "{transport}: not joined with bob drawn: {e}\nstate: {}\nconsole:\n{}",
+            state(&mut page),
+            page.console_text()
+        );
+    }
+    let s = state(&mut page);
+    let status = s["status"].as_str().unwrap_or_default();
+    assert!(
+        status.contains("friends") && status.contains(&format!("via {transport}")),
+        "{transport}: the status line says where and how: {status}"
+    );
+    let x0 = s["me"]["x"].as_f64().expect("our position");
+
+    // Real keys: hold Right for 1.5 s, jumping over the crate on the way
+    // (Space held a few frames: the game reads held buttons each tick).
+    page.key_down(Key::ArrowRight).unwrap();
+    std::thread::sleep(Duration::from_millis(350));
+    page.key_down(Key::Space).unwrap();
+    std::thread::sleep(Duration::from_millis(250));
+    page.key_up(Key::Space).unwrap();
+    std::thread::sleep(Duration::from_millis(900));
+    page.key_up(Key::ArrowRight).unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+
+    let s = state(&mut page);
+    let x1 = s["me"]["x"].as_f64().expect("our position");
+    assert!(
+        x1 > x0 + 60.0,
+        "{transport}: the held key moved us right on the page: {x0} -> {x1}"
+    );
+    // The server saw it: bob's snapshots put us far right of where we
+    // started.
+    let server_xs = seen.lock().unwrap().get(name).cloned().unwrap_or_default();
+    let (first, last) = (
+        server_xs.first().copied().unwrap_or(0.0),
+        server_xs.iter().copied().fold(f64::MIN, f64::max),
+    );
+    assert!(
+        last > first + 60.0,
+        "{transport}: the server moved {name}: {first} -> {last} ({} snapshots)",
+        server_xs.len()
+    );
+
+    // The screenshot: the level, us, bob.
+    let png = page.screenshot_png().expect("a screenshot");
+    std::fs::write(
+        std::env::temp_dir().join(format!("ledge-browser-{transport}.png")),
+        &png,
+    )
+    .ok();
+    let whole = [0.0, 0.0, 960.0, 540.0];
+    let palette = &s["palette"];
+    let (solid, total) = count(&png, whole, rgb_of(&palette["solid"]), 6);
+    let (grass, _) = count(&png, whole, rgb_of(&palette["grass"]), 6);
+    assert!(
+        solid * 20 > total && grass > 200,
+        "{transport}: the level is drawn: {solid} ground and {grass} grass pixels of {total}"
+    );
+    let players = s["players"].as_array().expect("players drawn");
+    for who in [name, "bob"] {
+        let p = players
+            .iter()
+            .find(|p| p["name"] == who)
+            .unwrap_or_else(|| panic!("{transport}: {who} is drawn: {s}"));
+        let (hits, pixels) = count(&png, rect_of(&p["screen"]), rgb_of(&p["rgb"]), 24);
+        assert!(
+            hits * 5 > pixels,
+            "{transport}: {who} is on the screenshot in its colour where the page drew it: \
+             {hits} of {pixels} pixels ({})",
+            p
+        );
+    }
+    assert_eq!(s["failure"], Value::Null, "{transport}: no failure shown");
+}
+
+#[test]
+fn a_browser_joins_over_webtransport_and_over_websocket_plays_and_sees_a_native_player() {
+    if skip_without_chromium("browser_client") {
+        return;
+    }
+    let dist = build_web();
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    let server = runtime.block_on(TestServer::start_with(move |c| {
+        let mut web = WebConfig::new(SocketAddr::from(([127, 0, 0, 1], 0)));
+        web.root = dist;
+        c.web = Some(web);
+        // Bob only stands there.
+        c.idle_kick = Duration::from_secs(600);
+    }));
+    let web = server.web_addr.expect("the web port");
+    let seen: Seen = Arc::default();
+    runtime.spawn(bob(server.addr, server.fingerprint, seen.clone()));
+
+    play(web, "ada", true, &seen);
+    play(web, "cy", false, &seen);
+
+    let m = server.metrics();
+    for transport in ["webtransport", "websocket"] {
+        let opened = ledge_tests::metric(
+            &m,
+            &format!("ledge_transport_connections_opened_total{{transport=\"{transport}\"}}"),
+        );
+        assert!(
+            opened >= 1.0,
+            "a {transport} connection was counted: {opened}"
+        );
+    }
+    runtime.block_on(server.stop()).unwrap();
+}
