@@ -218,6 +218,30 @@
                 bytes(out, n).set(encoded.subarray(0, n));
                 return n;
             };
+            // The gamepads (standard mapping) into `out`, 12 bytes each: the
+            // pressed buttons' bits (u32 LE), the left stick's x and y (f32
+            // LE); returns the bytes written.
+            env.ledge_gamepads = function (out, cap) {
+                const pads = navigator.getGamepads ? navigator.getGamepads() : [];
+                const view = new DataView(wasm_memory.buffer);
+                let n = 0;
+                for (const pad of pads) {
+                    if (!pad || !pad.connected || pad.mapping !== "standard" || n + 12 > cap) {
+                        continue;
+                    }
+                    let bits = 0;
+                    for (let i = 0; i < Math.min(pad.buttons.length, 32); i++) {
+                        if (pad.buttons[i].pressed) {
+                            bits |= 1 << i;
+                        }
+                    }
+                    view.setUint32(out + n, bits >>> 0, true);
+                    view.setFloat32(out + n + 4, pad.axes[0] || 0, true);
+                    view.setFloat32(out + n + 8, pad.axes[1] || 0, true);
+                    n += 12;
+                }
+                return n;
+            };
             // Starts connecting to the server that served the page.
             env.ledge_net_open = function () {
                 connect();

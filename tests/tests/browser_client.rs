@@ -267,3 +267,93 @@ fn a_browser_joins_over_webtransport_and_over_websocket_plays_and_sees_a_native_
     }
     runtime.block_on(server.stop()).unwrap();
 }
+
+/// A standard-mapping gamepad the page sees through `navigator.getGamepads`
+/// (headless Chromium has no gamepads and the DevTools protocol cannot make
+/// one): `window.fakePad.buttons[i].pressed` and `.axes` are the test's.
+const FAKE_GAMEPAD: &str = r#"
+window.fakePad = {
+  connected: true, mapping: "standard", id: "ledge test pad", index: 0,
+  axes: [0, 0, 0, 0],
+  buttons: Array.from({ length: 17 }, () => ({ pressed: false, value: 0 })),
+};
+navigator.getGamepads = () => [window.fakePad, null, null, null];
+"#;
+
+#[test]
+fn a_gamepad_moves_and_jumps_the_player_in_the_page() {
+    if skip_without_chromium("browser_client gamepad") {
+        return;
+    }
+    let dist = build_web();
+    // The page alone (offline: the embedded level), from a server's web
+    // port.
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
+        .enable_all()
+        .build()
+        .unwrap();
+    let server = runtime.block_on(TestServer::start_with(move |c| {
+        let mut web = WebConfig::new(SocketAddr::from(([127, 0, 0, 1], 0)));
+        web.root = dist;
+        web.webtransport = None;
+        c.web = Some(web);
+    }));
+    let web = server.web_addr.expect("the web port");
+    let browser = Browser::launch().expect("launch chromium");
+    let mut page = browser.new_page().expect("a tab");
+    page.call(
+        "Page.addScriptToEvaluateOnNewDocument",
+        serde_json::json!({ "source": FAKE_GAMEPAD }),
+    )
+    .expect("install the fake gamepad");
+    page.open(&format!("http://{web}/?offline&name=pad"))
+        .expect("the page loads");
+    page.wait_until(
+        "window.ledgeState && ledgeState.joined && ledgeState.me",
+        Duration::from_secs(20),
+    )
+    .unwrap_or_else(|e| panic!("the offline game starts: {e}\n{}", page.console_text()));
+    let start = state(&mut page);
+    let (x0, y0) = (
+        start["me"]["x"].as_f64().unwrap(),
+        start["me"]["y"].as_f64().unwrap(),
+    );
+
+    // The d-pad's right (button 15) for a second: we walk right.
+    page.eval("fakePad.buttons[15].pressed = true").unwrap();
+    std::thread::sleep(Duration::from_millis(1000));
+    page.eval("fakePad.buttons[15].pressed = false").unwrap();
+    std::thread::sleep(Duration::from_millis(200));
+    let walked = state(&mut page);
+    let x1 = walked["me"]["x"].as_f64().unwrap();
+    // (The crate 50 px to the right stops us there.)
+    assert!(x1 > x0 + 30.0, "the d-pad walked us right: {x0} -> {x1}");
+
+    // The south button (0) jumps: we rise above the ground we stood on.
+    page.eval("fakePad.buttons[0].pressed = true").unwrap();
+    let rose = page.wait_until(
+        &format!(
+            "ledgeState.me.y < {} - 20",
+            walked["me"]["y"].as_f64().unwrap()
+        ),
+        Duration::from_secs(3),
+    );
+    page.eval("fakePad.buttons[0].pressed = false").unwrap();
+    rose.unwrap_or_else(|e| panic!("button 0 jumped: {e}: {}", state(&mut page)));
+
+    // The left stick past half way walks left.
+    std::thread::sleep(Duration::from_millis(600));
+    let before = state(&mut page)["me"]["x"].as_f64().unwrap();
+    page.eval("fakePad.axes[0] = -1").unwrap();
+    std::thread::sleep(Duration::from_millis(600));
+    page.eval("fakePad.axes[0] = 0").unwrap();
+    let after = state(&mut page)["me"]["x"].as_f64().unwrap();
+    assert!(
+        after < before - 30.0,
+        "the stick walked us left: {before} -> {after}"
+    );
+    assert!(y0 > 0.0);
+    drop(browser);
+    runtime.block_on(server.stop()).unwrap();
+}

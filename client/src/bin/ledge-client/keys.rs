@@ -275,8 +275,61 @@ pub fn key_by_name(name: &str) -> Option<KeyCode> {
         .find(|k| format!("{k:?}").to_ascii_lowercase() == wanted)
 }
 
-/// Gamepads through gilrs: d-pad or left stick to move, south (A/cross)
-/// or east to jump, down + jump to drop through, select to restart.
+/// One gamepad's controls that ledge reads, whatever reports them (gilrs
+/// natively, the browser's Gamepad API in a page).
+#[cfg_attr(
+    not(any(feature = "gamepad", target_arch = "wasm32")),
+    allow(dead_code, reason = "read only by builds with gamepads")
+)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PadState {
+    /// D-pad directions held.
+    pub left: bool,
+    pub right: bool,
+    pub up: bool,
+    pub down: bool,
+    /// The south (A/cross) and east (B/circle) face buttons.
+    pub south: bool,
+    pub east: bool,
+    /// Select (back/share).
+    pub select: bool,
+    /// The left stick, -1..=1, x to the right and y up.
+    pub stick: (f32, f32),
+}
+
+#[cfg_attr(
+    not(any(feature = "gamepad", target_arch = "wasm32")),
+    allow(dead_code, reason = "read only by builds with gamepads")
+)]
+impl PadState {
+    /// D-pad or left stick to move, south or east to jump (down + jump
+    /// drops through), select to restart.
+    pub fn buttons(&self) -> Buttons {
+        let (x, y) = self.stick;
+        let mut bits = 0;
+        if self.left || x < -0.5 {
+            bits |= Buttons::LEFT;
+        }
+        if self.right || x > 0.5 {
+            bits |= Buttons::RIGHT;
+        }
+        if self.up || y > 0.5 {
+            bits |= Buttons::UP;
+        }
+        if self.down || y < -0.5 {
+            bits |= Buttons::DOWN;
+        }
+        if self.south || self.east {
+            bits |= Buttons::JUMP;
+        }
+        if self.select {
+            bits |= Buttons::RESTART;
+        }
+        Buttons(bits)
+    }
+}
+
+/// Gamepads through gilrs (see [`PadState::buttons`]).
 #[cfg(all(feature = "gamepad", not(target_arch = "wasm32")))]
 pub struct Gamepads {
     gilrs: Option<gilrs::Gilrs>,
@@ -305,36 +358,49 @@ impl Gamepads {
         while gilrs.next_event().is_some() {}
         let mut bits = 0;
         for (_, pad) in gilrs.gamepads() {
-            let x = pad.value(Axis::LeftStickX);
-            let y = pad.value(Axis::LeftStickY);
-            if pad.is_pressed(Button::DPadLeft) || x < -0.5 {
-                bits |= Buttons::LEFT;
-            }
-            if pad.is_pressed(Button::DPadRight) || x > 0.5 {
-                bits |= Buttons::RIGHT;
-            }
-            if pad.is_pressed(Button::DPadUp) || y > 0.5 {
-                bits |= Buttons::UP;
-            }
-            if pad.is_pressed(Button::DPadDown) || y < -0.5 {
-                bits |= Buttons::DOWN;
-            }
-            if pad.is_pressed(Button::South) || pad.is_pressed(Button::East) {
-                bits |= Buttons::JUMP;
-            }
-            if pad.is_pressed(Button::Select) {
-                bits |= Buttons::RESTART;
-            }
+            let state = PadState {
+                left: pad.is_pressed(Button::DPadLeft),
+                right: pad.is_pressed(Button::DPadRight),
+                up: pad.is_pressed(Button::DPadUp),
+                down: pad.is_pressed(Button::DPadDown),
+                south: pad.is_pressed(Button::South),
+                east: pad.is_pressed(Button::East),
+                select: pad.is_pressed(Button::Select),
+                stick: (pad.value(Axis::LeftStickX), pad.value(Axis::LeftStickY)),
+            };
+            bits |= state.buttons().0;
         }
         Buttons(bits)
     }
 }
 
-/// Without the `gamepad` feature: no gamepads.
-#[cfg(not(all(feature = "gamepad", not(target_arch = "wasm32"))))]
+/// Gamepads in a browser: the page's Gamepad API, read each frame (see
+/// [`PadState::buttons`]).
+#[cfg(target_arch = "wasm32")]
 pub struct Gamepads;
 
-#[cfg(not(all(feature = "gamepad", not(target_arch = "wasm32"))))]
+#[cfg(target_arch = "wasm32")]
+impl Gamepads {
+    /// The page's gamepads (none until one is touched: browsers hide
+    /// them until then).
+    pub fn new() -> Gamepads {
+        Gamepads
+    }
+
+    /// The buttons held on any connected gamepad.
+    pub fn held(&mut self) -> Buttons {
+        let bits = crate::web::gamepads()
+            .iter()
+            .fold(0, |bits, pad| bits | pad.buttons().0);
+        Buttons(bits)
+    }
+}
+
+/// Without the `gamepad` feature: no gamepads.
+#[cfg(not(any(feature = "gamepad", target_arch = "wasm32")))]
+pub struct Gamepads;
+
+#[cfg(not(any(feature = "gamepad", target_arch = "wasm32")))]
 impl Gamepads {
     /// No gamepad support in this build.
     pub fn new() -> Gamepads {
@@ -349,6 +415,39 @@ impl Gamepads {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn a_gamepad_moves_jumps_and_restarts_like_the_keys() {
+        let none = PadState::default();
+        assert_eq!(none.buttons(), Buttons::NONE);
+        let dpad = PadState {
+            right: true,
+            south: true,
+            ..none
+        };
+        assert_eq!(dpad.buttons(), Buttons(Buttons::RIGHT | Buttons::JUMP));
+        // The stick past half way counts; a resting stick's drift does not.
+        let stick = PadState {
+            stick: (-0.9, -0.8),
+            east: true,
+            ..none
+        };
+        assert_eq!(
+            stick.buttons(),
+            Buttons(Buttons::LEFT | Buttons::DOWN | Buttons::JUMP)
+        );
+        let drift = PadState {
+            stick: (0.2, -0.3),
+            ..none
+        };
+        assert_eq!(drift.buttons(), Buttons::NONE);
+        let restart = PadState {
+            select: true,
+            ..none
+        };
+        assert_eq!(restart.buttons(), Buttons(Buttons::RESTART));
+    }
+
     use super::*;
 
     #[test]

@@ -40,6 +40,11 @@ extern "C" {
     /// Writes the page's `HOST:PORT` into `out` (at most `cap` bytes);
     /// returns its length.
     fn ledge_page_host(out: *mut u8, cap: u32) -> u32;
+    /// The page's gamepads (standard mapping) into `out`, 12 bytes each:
+    /// the pressed buttons as a bit set (bit i: `buttons[i]`, u32 LE),
+    /// then the left stick's x and y (f32 LE, y down); returns the bytes
+    /// written.
+    fn ledge_gamepads(out: *mut u8, cap: u32) -> u32;
     /// Starts connecting to the server that served the page.
     fn ledge_net_open();
     /// The next message from the connection (tag byte, payload) into
@@ -186,6 +191,39 @@ fn param(name: &str) -> Option<String> {
     let n = usize::try_from(n).ok()?.min(MAX_PARAM);
     out.truncate(n);
     Some(String::from_utf8_lossy(&out).into_owned())
+}
+
+/// Gamepads read at most.
+const MAX_PADS: usize = 4;
+
+/// The page's gamepads now (the Gamepad API's standard mapping: buttons
+/// 0 south, 1 east, 8 select, 12 to 15 the d-pad up, down, left, right).
+pub fn gamepads() -> Vec<crate::keys::PadState> {
+    let mut out = [0u8; 12 * MAX_PADS];
+    // SAFETY: `out` is valid for its length; the glue writes at most that.
+    let n = unsafe { ledge_gamepads(out.as_mut_ptr(), out.len() as u32) } as usize;
+    out[..n.min(out.len())]
+        .chunks_exact(12)
+        .map(|pad| {
+            let word = |at: usize| [pad[at], pad[at + 1], pad[at + 2], pad[at + 3]];
+            let bits = u32::from_le_bytes(word(0));
+            let held = |i: u32| bits & (1 << i) != 0;
+            let x = f32::from_le_bytes(word(4));
+            let y = f32::from_le_bytes(word(8));
+            let finite = |v: f32| if v.is_finite() { v } else { 0.0 };
+            crate::keys::PadState {
+                south: held(0),
+                east: held(1),
+                select: held(8),
+                up: held(12),
+                down: held(13),
+                left: held(14),
+                right: held(15),
+                // The Gamepad API's y points down; ledge's up.
+                stick: (finite(x), -finite(y)),
+            }
+        })
+        .collect()
 }
 
 /// The page's `HOST:PORT` (the server that served it).
