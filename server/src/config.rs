@@ -181,6 +181,9 @@ pub struct WebConfig {
     pub root: PathBuf,
     /// UDP address of WebTransport sessions; `None`: WebTransport off.
     pub webtransport: Option<SocketAddr>,
+    /// How long WebTransport certificates live (13 days; tests shorten it
+    /// to see a rotation).
+    pub cert_life: crate::web::certs::CertLife,
 }
 
 impl WebConfig {
@@ -191,6 +194,7 @@ impl WebConfig {
             bind,
             root: PathBuf::from(DEFAULT_WEB_ROOT),
             webtransport: Some(bind),
+            cert_life: Default::default(),
         }
     }
 }

@@ -344,6 +344,7 @@ impl Server {
                         let settings = wt::Settings {
                             bind,
                             idle_timeout: config.idle_timeout,
+                            cert_life: w.cert_life,
                         };
                         let (endpoint, certs) = wt::bind(&settings).map_err(|e| match e {
                             wt::BindError::Setup(e) => ServerError::WebTransport(e),

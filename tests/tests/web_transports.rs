@@ -675,3 +675,91 @@ async fn a_lost_websocket_session_is_resumed_with_its_token() {
     assert_eq!(metric(&m, "ledge_sessions_resumed_total"), 1.0, "{m}");
     server.stop().await.unwrap();
 }
+
+/// The WebTransport certificate's rotation on the live endpoint, with its
+/// life shortened to 8 s (made at 40 % = 3.2 s and listed in /web.json,
+/// served to new sessions from 50 % = 4 s): a session from before the
+/// switch goes on with the old certificate, a page that fetched /web.json
+/// before the switch already knows the new one, and a new session gets it.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_webtransport_certificate_is_replaced_before_it_expires_and_sessions_go_on() {
+    let root = page();
+    let server = TestServer::start_with({
+        let root = root.path().to_owned();
+        move |c| {
+            let mut web = WebConfig::new(SocketAddr::from(([127, 0, 0, 1], 0)));
+            web.root = root;
+            web.cert_life = ledge_server::web::certs::CertLife {
+                validity: Duration::from_secs(8),
+                backdate: Duration::ZERO,
+            };
+            c.web = Some(web);
+        }
+    })
+    .await;
+    let wt_addr = server.webtransport_addr.unwrap();
+    let first = cert_hashes(&server).await;
+    assert_eq!(first.len(), 1, "one certificate at first");
+    let mut old = Web::Wt(WtClient::connect(wt_addr, "/ledge", &first).await.unwrap());
+    let Web::Wt(c) = &old else { unreachable!() };
+    assert_eq!(c.server_cert_sha256(), first[0]);
+    old.join("early", "room-1").await;
+
+    // Between 40 % and 50 %: the next one is listed, after the current.
+    let started = Instant::now();
+    let listed = loop {
+        let hashes = cert_hashes(&server).await;
+        if hashes.len() == 2 {
+            break hashes;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(6),
+            "the next certificate was listed by 40 % of the life: {hashes:02x?}"
+        );
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    };
+    assert_eq!(listed[0], first[0], "the current one first");
+    let next = listed[1];
+    assert_ne!(next, first[0]);
+
+    // After 50 %: new sessions get the next one, which a page holding the
+    // earlier /web.json list already trusts.
+    let started = Instant::now();
+    loop {
+        let hashes = cert_hashes(&server).await;
+        if hashes[0] == next {
+            break;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(6),
+            "the next certificate was served by 50 % of the life"
+        );
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    let mut late = Web::Wt(WtClient::connect(wt_addr, "/ledge", &listed).await.unwrap());
+    let Web::Wt(c) = &late else { unreachable!() };
+    assert_eq!(
+        c.server_cert_sha256(),
+        next,
+        "a new session gets the next one"
+    );
+    late.join("late", "room-1").await;
+    let refused = WtClient::connect(wt_addr, "/ledge", &first).await;
+    assert!(
+        refused.is_err(),
+        "only the old hash: the new certificate is refused, as a browser would"
+    );
+
+    // The session from before the switch is still served.
+    let snapshots = old
+        .drain(Duration::from_millis(500))
+        .await
+        .into_iter()
+        .filter(|e| matches!(e, WebEvent::Datagram(_)))
+        .count();
+    assert!(
+        snapshots > 5,
+        "the early session still gets snapshots: {snapshots}"
+    );
+    server.stop().await.unwrap();
+}

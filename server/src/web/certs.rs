@@ -26,6 +26,25 @@ pub const VALIDITY: Duration = Duration::from_secs(13 * 24 * 3600);
 /// little behind.
 pub const BACKDATE: Duration = Duration::from_secs(3600);
 
+/// How long certificates live: [`VALIDITY`] from [`BACKDATE`] before they
+/// are made, unless a test shortens it (browsers accept at most 14 days).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CertLife {
+    /// From `not_before` to `not_after`.
+    pub validity: Duration,
+    /// How far before its making `not_before` is.
+    pub backdate: Duration,
+}
+
+impl Default for CertLife {
+    fn default() -> CertLife {
+        CertLife {
+            validity: VALIDITY,
+            backdate: BACKDATE,
+        }
+    }
+}
+
 /// When a certificate is valid and what it hashes to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CertInfo {
@@ -141,11 +160,16 @@ impl std::fmt::Debug for WebCert {
 }
 
 /// Makes a self-signed ECDSA P-256 certificate valid from `now` −
-/// [`BACKDATE`] for [`VALIDITY`], for `names` (host names or addresses).
-pub fn generate(now: SystemTime, names: &[String]) -> Result<WebCert, rcgen::Error> {
+/// `life.backdate` for `life.validity` (by default [`BACKDATE`] and
+/// [`VALIDITY`]), for `names` (host names or addresses).
+pub fn generate(
+    now: SystemTime,
+    names: &[String],
+    life: CertLife,
+) -> Result<WebCert, rcgen::Error> {
     let key = rcgen::KeyPair::generate_for(&rcgen::PKCS_ECDSA_P256_SHA256)?;
     let mut params = rcgen::CertificateParams::new(names.to_vec())?;
-    let not_before = now.checked_sub(BACKDATE).unwrap_or(now);
+    let not_before = now.checked_sub(life.backdate).unwrap_or(now);
     // Whole seconds: the certificate stores no more.
     let secs = |t: SystemTime| {
         t.duration_since(SystemTime::UNIX_EPOCH)
@@ -153,7 +177,7 @@ pub fn generate(now: SystemTime, names: &[String]) -> Result<WebCert, rcgen::Err
             .unwrap_or_default()
     };
     let not_before = SystemTime::UNIX_EPOCH + Duration::from_secs(secs(not_before));
-    let not_after = not_before + VALIDITY;
+    let not_after = not_before + life.validity;
     params.not_before = time::OffsetDateTime::from(not_before);
     params.not_after = time::OffsetDateTime::from(not_after);
     params
@@ -268,7 +292,7 @@ mod tests {
     #[test]
     fn generated_certificates_are_p256_and_valid_13_days_from_an_hour_ago() {
         let now = SystemTime::now();
-        let cert = generate(now, &["localhost".to_owned()]).unwrap();
+        let cert = generate(now, &["localhost".to_owned()], CertLife::default()).unwrap();
         let i = cert.info;
         assert_eq!(i.not_after.duration_since(i.not_before).unwrap(), VALIDITY);
         let back = now.duration_since(i.not_before).unwrap();
@@ -279,7 +303,7 @@ mod tests {
         let p256 = [0x06, 0x08, 0x2a, 0x86, 0x48, 0xce, 0x3d, 0x03, 0x01, 0x07];
         let has = |needle: &[u8]| cert.der.windows(needle.len()).any(|w| w == needle);
         assert!(has(&ec_public_key) && has(&p256));
-        let other = generate(now, &["localhost".to_owned()]).unwrap();
+        let other = generate(now, &["localhost".to_owned()], CertLife::default()).unwrap();
         assert_ne!(other.info.sha256, i.sha256, "a new key each time");
     }
 }

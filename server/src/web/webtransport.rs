@@ -72,6 +72,8 @@ pub struct Settings {
     pub bind: SocketAddr,
     /// Idle timeout (keep-alives at a third of it).
     pub idle_timeout: Duration,
+    /// How long its certificates live.
+    pub cert_life: certs::CertLife,
 }
 
 /// The names in the certificate (browsers check only its hash).
@@ -113,8 +115,8 @@ fn server_config(
 
 /// Makes the first certificate and binds the endpoint.
 pub fn bind(settings: &Settings) -> Result<(Arc<Endpoint>, Arc<WebCerts>), BindError> {
-    let cert =
-        certs::generate(SystemTime::now(), &names()).map_err(|e| BindError::Setup(e.into()))?;
+    let cert = certs::generate(SystemTime::now(), &names(), settings.cert_life)
+        .map_err(|e| BindError::Setup(e.into()))?;
     let config = server_config(settings, &cert).map_err(BindError::Setup)?;
     let endpoint = Endpoint::server(config).map_err(BindError::Io)?;
     let certs = WebCerts {
@@ -156,7 +158,7 @@ pub async fn rotate(
         let step = certs.lock().rotation.poll(now);
         match step {
             None => {}
-            Some(Step::Prepare) => match certs::generate(now, &names()) {
+            Some(Step::Prepare) => match certs::generate(now, &names(), settings.cert_life) {
                 Ok(next) => {
                     info!(
                         sha256 = %crate::Fingerprint(next.info.sha256),
