@@ -137,7 +137,7 @@ impl Link {
     fn handle(&mut self, message: Incoming<'_>, now: Instant) -> Result<(), ClientError> {
         match (&mut self.phase, message) {
             (Phase::Hello(handshake, _), Incoming::Stream(bytes)) => {
-                if let Some(state) = handshake.on_stream(bytes)? {
+                if let Some(state) = handshake.on_stream(bytes, now)? {
                     self.joined(state);
                 }
             }

@@ -72,15 +72,24 @@ pub async fn handshake(dialed: Dialed, hello: ClientControl) -> Result<Session, 
                 other.kind()
             ))),
         });
+    // The roster often arrives with the welcome: the state handles what
+    // the decoder already holds.
+    let result = result.and_then(|(send, recv, welcome)| {
+        Ok((
+            send,
+            recv,
+            SessionState::new(welcome, decoder, Instant::now())?,
+        ))
+    });
     match result {
-        Ok((send, recv, welcome)) => Ok(Session {
+        Ok((send, recv, state)) => Ok(Session {
             endpoint,
             connection,
             send,
             recv,
             buf: vec![0u8; 8192],
             stream_ended: false,
-            state: SessionState::new(welcome, decoder),
+            state,
         }),
         Err(e) => {
             let e = explain(&connection, e);

@@ -95,19 +95,22 @@ impl Handshake {
         Ok(frame)
     }
 
-    /// Feeds bytes of the control stream. `Ok(None)`: no answer yet;
-    /// `Ok(Some(state))`: welcomed (bytes after the welcome are kept for
-    /// the session); a `Reject` or another message is an error.
-    pub fn on_stream(&mut self, bytes: &[u8]) -> Result<Option<SessionState>, ClientError> {
+    /// Feeds bytes of the control stream, received at `now`. `Ok(None)`:
+    /// no answer yet; `Ok(Some(state))`: welcomed (what followed the
+    /// welcome is the session's); a `Reject` or another message is an
+    /// error.
+    pub fn on_stream(
+        &mut self,
+        bytes: &[u8],
+        now: Instant,
+    ) -> Result<Option<SessionState>, ClientError> {
         self.decoder.push(bytes)?;
         match self.decoder.pop_message::<ServerControl>() {
             None => Ok(None),
             Some(message) => match message? {
                 ServerControl::Welcome(welcome) => {
                     let decoder = std::mem::replace(&mut self.decoder, FrameDecoder::new(0));
-                    let mut state = SessionState::new(welcome, decoder);
-                    state.drain_stream()?;
-                    Ok(Some(state))
+                    SessionState::new(welcome, decoder, now).map(Some)
                 }
                 ServerControl::Reject { reason } => Err(ClientError::Rejected(reason)),
                 other => Err(ClientError::Unexpected(format!(
@@ -136,10 +139,15 @@ pub struct SessionState {
 }
 
 impl SessionState {
-    /// The state after `welcome`; `decoder` holds the control stream's
-    /// bytes that followed it.
-    pub fn new(welcome: Welcome, decoder: FrameDecoder) -> SessionState {
-        SessionState {
+    /// The state after `welcome`, at `now`; `decoder` holds the control
+    /// stream's bytes that followed it (often the roster, read with the
+    /// welcome), handled here. A broken stream is an error.
+    pub fn new(
+        welcome: Welcome,
+        decoder: FrameDecoder,
+        now: Instant,
+    ) -> Result<SessionState, ClientError> {
+        let mut state = SessionState {
             decoder,
             inputs: InputHistory::default(),
             redundancy: usize::from(welcome.timing.input_redundancy).clamp(1, MAX_INPUT_HISTORY),
@@ -150,7 +158,9 @@ impl SessionState {
             players: BTreeMap::new(),
             next_nonce: 0,
             stats: SessionStats::default(),
-        }
+        };
+        state.drain_stream_at(now)?;
+        Ok(state)
     }
 
     /// What the server said when we joined.
@@ -221,11 +231,6 @@ impl SessionState {
     pub fn on_stream(&mut self, bytes: &[u8], now: Instant) -> Result<(), ClientError> {
         self.decoder.push(bytes)?;
         self.drain_stream_at(now)
-    }
-
-    /// Handles the messages already buffered (after the welcome).
-    fn drain_stream(&mut self) -> Result<(), ClientError> {
-        self.drain_stream_at(Instant::now())
     }
 
     fn drain_stream_at(&mut self, now: Instant) -> Result<(), ClientError> {
@@ -380,6 +385,51 @@ impl SessionState {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn what_came_with_the_welcome_is_handled_at_once() {
+        use ledge_shared::protocol::{NetTiming, RosterEntry};
+        let welcome = Welcome {
+            player_id: PlayerId(1),
+            room: "room-1".into(),
+            level_id: "level".into(),
+            level_hash: 0,
+            level: Default::default(),
+            session_token: Default::default(),
+            server_tick: 0,
+            timing: NetTiming {
+                tick_rate: 60,
+                snapshot_interval: 2,
+                input_redundancy: 4,
+            },
+            sim_config: vec![],
+        };
+        // The roster read in the same chunk as the welcome.
+        let mut bytes = Vec::new();
+        write_frame(&ServerControl::Welcome(welcome.clone()), &mut bytes).unwrap();
+        let roster = ServerControl::Roster {
+            players: vec![RosterEntry {
+                id: PlayerId(1),
+                name: "ada".into(),
+            }],
+        };
+        write_frame(&roster, &mut bytes).unwrap();
+        let mut decoder = FrameDecoder::new(MAX_FRAME);
+        decoder.push(&bytes).unwrap();
+        let first = decoder.pop_message::<ServerControl>().unwrap().unwrap();
+        assert_eq!(first, ServerControl::Welcome(welcome.clone()));
+        let mut state = SessionState::new(welcome, decoder, Instant::now()).unwrap();
+        assert_eq!(
+            state.poll_event(),
+            Some(SessionEvent::PlayerJoined {
+                id: PlayerId(1),
+                name: "ada".into()
+            }),
+            "the roster is an event before any more bytes arrive"
+        );
+        assert_eq!(state.players().len(), 1);
+    }
+
     use super::*;
 
     fn ticks(h: &InputHistory) -> Vec<(u64, u8)> {
