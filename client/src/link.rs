@@ -584,14 +584,21 @@ mod tests {
         assert!(matches!(&got[2], NetEvent::PlayerLeft { id: PlayerId(9) }));
     }
 
-    /// A joined link that was just told it is kicked (events taken).
-    fn kicked(now: Instant) -> Link {
+    /// A link welcomed in "friends" on the embedded level (its events not
+    /// taken).
+    fn joined(now: Instant) -> Link {
         let mut link = joining("friends");
         link.on_open(now);
         link.on_message(
             Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
             now,
         );
+        link
+    }
+
+    /// A joined link that was just told it is kicked (events taken).
+    fn kicked(now: Instant) -> Link {
+        let mut link = joined(now);
         link.on_message(
             Incoming::Stream(&frame(&ServerControl::Notice {
                 kind: NoticeKind::Kick {
@@ -624,12 +631,7 @@ mod tests {
         link.on_closed(Some(CloseCode::Rejected.to_u32()), "full");
         assert!(events(&mut link).is_empty(), "only the first reason counts");
 
-        let mut link = joining("friends");
-        link.on_open(now);
-        link.on_message(
-            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
-            now,
-        );
+        let mut link = joined(now);
         events(&mut link);
         link.on_closed(Some(CloseCode::Kicked.to_u32()), "flooding");
         let got = events(&mut link);
@@ -668,14 +670,9 @@ mod tests {
     }
 
     #[test]
-    fn a_level_stream_nobody_asked_for_or_too_long_is_an_error() {
+    fn a_level_stream_nobody_asked_for_is_an_error() {
         let now = Instant::now();
-        let mut link = joining("friends");
-        link.on_open(now);
-        link.on_message(
-            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
-            now,
-        );
+        let mut link = joined(now);
         events(&mut link);
         link.on_message(Incoming::Level(&[1, 2, 3]), now);
         assert!(matches!(
@@ -687,12 +684,7 @@ mod tests {
     #[test]
     fn queues_stay_bounded() {
         let now = Instant::now();
-        let mut link = joining("friends");
-        link.on_open(now);
-        link.on_message(
-            Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
-            now,
-        );
+        let mut link = joined(now);
         for tick in 0..(MAX_TRANSMITS as u64 * 3) {
             link.send_input(tick, Buttons::NONE);
         }

@@ -46,6 +46,26 @@ fn build_web() -> PathBuf {
     root.join("web/dist")
 }
 
+/// A server on its own runtime serving the freshly built page on a web
+/// port (loopback, WebTransport on), after `adjust` changed its settings.
+fn web_server(
+    adjust: impl FnOnce(&mut ledge_server::ServerConfig),
+) -> (tokio::runtime::Runtime, TestServer) {
+    let dist = build_web();
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    let server = runtime.block_on(TestServer::start_with(move |c| {
+        let mut web = WebConfig::new(SocketAddr::from(([127, 0, 0, 1], 0)));
+        web.root = dist;
+        c.web = Some(web);
+        adjust(c);
+    }));
+    (runtime, server)
+}
+
 /// Where the server says each player is (x, world pixels), by name, as
 /// bob's session hears it.
 type Seen = Arc<Mutex<BTreeMap<String, Vec<f64>>>>;
@@ -234,19 +254,10 @@ fn a_browser_joins_over_webtransport_and_over_websocket_plays_and_sees_a_native_
     if skip_without_chromium("browser_client") {
         return;
     }
-    let dist = build_web();
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .unwrap();
-    let server = runtime.block_on(TestServer::start_with(move |c| {
-        let mut web = WebConfig::new(SocketAddr::from(([127, 0, 0, 1], 0)));
-        web.root = dist;
-        c.web = Some(web);
+    let (runtime, server) = web_server(|c| {
         // Bob only stands there.
         c.idle_kick = Duration::from_secs(600);
-    }));
+    });
     let web = server.web_addr.expect("the web port");
     let seen: Seen = Arc::default();
     runtime.spawn(bob(server.addr, server.fingerprint, seen.clone()));
@@ -285,20 +296,13 @@ fn a_gamepad_moves_and_jumps_the_player_in_the_page() {
     if skip_without_chromium("browser_client gamepad") {
         return;
     }
-    let dist = build_web();
     // The page alone (offline: the embedded level), from a server's web
     // port.
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(1)
-        .enable_all()
-        .build()
-        .unwrap();
-    let server = runtime.block_on(TestServer::start_with(move |c| {
-        let mut web = WebConfig::new(SocketAddr::from(([127, 0, 0, 1], 0)));
-        web.root = dist;
-        web.webtransport = None;
-        c.web = Some(web);
-    }));
+    let (runtime, server) = web_server(|c| {
+        if let Some(web) = &mut c.web {
+            web.webtransport = None;
+        }
+    });
     let web = server.web_addr.expect("the web port");
     let browser = Browser::launch().expect("launch chromium");
     let mut page = browser.new_page().expect("a tab");
