@@ -390,10 +390,11 @@ impl Network for Link {
             return false;
         };
         match state.input_datagram(tick, buttons) {
-            Ok(datagram) => {
+            Ok(Some(datagram)) => {
                 self.transmit(Transmit::Datagram(datagram));
                 true
             }
+            Ok(None) => true,
             Err(_) => false,
         }
     }
@@ -526,16 +527,22 @@ mod tests {
         );
         assert_eq!(link.players().len(), 1);
 
+        // At 60 Hz a datagram goes every other tick, carrying the one
+        // between.
         assert!(link.send_input(11, Buttons(Buttons::RIGHT)));
-        assert!(link.send_input(12, Buttons(Buttons::RIGHT)));
+        assert!(link.send_input(12, Buttons(Buttons::JUMP)));
+        assert!(link.send_input(13, Buttons(Buttons::RIGHT)));
         link.poll(now);
         let (controls, datagrams) = sent(&mut link);
         assert!(
             matches!(controls[..], [ClientControl::Ping { .. }]),
             "{controls:?}"
         );
+        assert_eq!(datagrams.len(), 2, "ticks 11 and 13");
+        assert_eq!(InputPacket::decode(&datagrams[0]).unwrap().newest_tick, 11);
         let packet = InputPacket::decode(&datagrams[1]).unwrap();
-        assert_eq!(packet.newest_tick, 12);
+        assert_eq!(packet.newest_tick, 13);
+        assert_eq!(packet.get(12), Some(Buttons(Buttons::JUMP)));
         assert_eq!(packet.get(11), Some(Buttons(Buttons::RIGHT)));
         assert!(link.transport().unwrap().bytes_out > 0);
     }

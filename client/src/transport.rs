@@ -54,7 +54,9 @@ fn client_config(
     let mut config = quinn::ClientConfig::new(Arc::new(quic));
     let mut transport = quinn::TransportConfig::default();
     // Resume within a round trip after an outage (see `ledge_quic`).
-    ledge_quic::install(&mut transport)
+    ledge_quic::install(&mut transport);
+    // ACKs ride on the server's snapshots (see `ledge_quic::packets`).
+    ledge_quic::packets::ride_acks(&mut transport)
         .keep_alive_interval(Some(KEEP_ALIVE))
         // Inputs repeat the last ticks, so an old queued one is worthless:
         // keep the queue short and let quinn drop the oldest.
@@ -106,7 +108,8 @@ pub async fn dial_from(
     pin: Option<Fingerprint>,
 ) -> Result<(Dialed, Fingerprint), ClientError> {
     let (config, refused, presented) = client_config(pin)?;
-    let endpoint = bind(local, config)?;
+    let mut endpoint = ledge_quic::packets::client_endpoint(local).map_err(ClientError::Socket)?;
+    endpoint.set_default_client_config(config);
     let connecting = endpoint.connect(addr, server_name)?;
     match connecting.await {
         Ok(connection) => {

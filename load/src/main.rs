@@ -42,6 +42,9 @@ enum Client {
     /// snapshot decoded, no prediction): the same server work for far less
     /// CPU.
     Thin,
+    /// ledge-bot --brain thin-idle: thin bots that hold no button (an
+    /// idle room: what quiet players cost).
+    ThinIdle,
 }
 
 /// Server load benchmark: ledge-server plus ledge-bot on this machine.
@@ -325,6 +328,7 @@ fn load(cli: LoadArgs) -> anyhow::Result<bool> {
     let client = match cli.client {
         Client::Bot => ClientKind::Bot,
         Client::Thin => ClientKind::Thin,
+        Client::ThinIdle => ClientKind::ThinIdle,
     };
     for bin in ["ledge-server", BOT_BINARY] {
         let path = bin_dir.join(bin);
@@ -351,6 +355,7 @@ fn load(cli: LoadArgs) -> anyhow::Result<bool> {
         match cli.client {
             Client::Bot => format!("ledge-bot --brain {}", cli.brain),
             Client::Thin => "ledge-bot --brain thin".to_owned(),
+            Client::ThinIdle => "ledge-bot --brain thin-idle".to_owned(),
         },
         cli.duration,
         cli.warmup,
@@ -414,6 +419,16 @@ fn load(cli: LoadArgs) -> anyhow::Result<bool> {
             r.bots,
             P99_GOAL * 1e3,
             if met { "met" } else { "NOT met" }
+        );
+        let per_player = r.cpu_ms_per_player_s();
+        println!(
+            "{} bots: {:.2} ms of server CPU per player-second: {:.0} players per core \
+             (wire per client: {:.0} B/s up, {:.0} B/s down)",
+            r.bots,
+            per_player,
+            1000.0 / per_player.max(1e-9),
+            r.wire_up_bytes_per_client_s,
+            r.wire_down_bytes_per_client_s,
         );
     }
     if let Some(path) = &cli.csv {

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use crate::run::RunResult;
 
 /// Columns of the table and the CSV, in order.
-const COLUMNS: [&str; 19] = [
+const COLUMNS: [&str; 24] = [
     "bots",
     "clients",
     "rooms",
@@ -19,7 +19,12 @@ const COLUMNS: [&str; 19] = [
     "wake-up lateness p99 ms",
     "up B/s per client",
     "down B/s per client",
+    "wire up B/s per client",
+    "wire down B/s per client",
+    "packets up/s per client",
+    "packets down/s per client",
     "server CPU %",
+    "server CPU ms per player-s",
     "server run-queue wait ms/s",
     "server peak RSS MiB",
     "bots CPU %",
@@ -31,7 +36,7 @@ fn ms(v: Option<f64>) -> String {
     v.map_or_else(|| "-".to_owned(), |s| format!("{:.3}", s * 1e3))
 }
 
-fn cells(r: &RunResult) -> [String; 19] {
+fn cells(r: &RunResult) -> [String; 24] {
     [
         r.bots.to_string(),
         r.client.clone(),
@@ -46,7 +51,12 @@ fn cells(r: &RunResult) -> [String; 19] {
         ms(r.lateness_p99),
         format!("{:.0}", r.up_bytes_per_client_s),
         format!("{:.0}", r.down_bytes_per_client_s),
+        format!("{:.0}", r.wire_up_bytes_per_client_s),
+        format!("{:.0}", r.wire_down_bytes_per_client_s),
+        format!("{:.1}", r.packets_up_per_client_s),
+        format!("{:.1}", r.packets_down_per_client_s),
         format!("{:.0}", r.server_cpu_pct),
+        format!("{:.2}", r.cpu_ms_per_player_s()),
         format!("{:.0}", r.server_run_queue_wait_ms_s),
         format!("{:.1}", r.server_peak_rss_mib),
         format!("{:.0}", r.bot_cpu_pct),
@@ -75,6 +85,8 @@ fn csv_name(column: &str) -> String {
     column
         .replace("B/s", "B per s")
         .replace("ms/s", "ms per s")
+        .replace("up/s", "up per s")
+        .replace("down/s", "down per s")
         .replace('%', "pct")
         .split(|c: char| !c.is_ascii_alphanumeric())
         .filter(|w| !w.is_empty())
@@ -136,10 +148,15 @@ mod tests {
             lateness_p99: Some(0.001),
             up_bytes_per_client_s: 4100.4,
             down_bytes_per_client_s: 2500.6,
+            wire_up_bytes_per_client_s: 1900.2,
+            wire_down_bytes_per_client_s: 3900.7,
+            packets_up_per_client_s: 30.04,
+            packets_down_per_client_s: 31.96,
             server_cpu_pct: 55.2,
             server_run_queue_wait_ms_s: 12.3,
             server_peak_rss_mib: 40.3,
             bot_cpu_pct: 120.0,
+            mean_players: 256.0,
             connected: 256,
             min_players: 256,
             dropped: 0,
@@ -154,7 +171,7 @@ mod tests {
         assert_eq!(
             row,
             "| 256 | thin | 16 | 2 | 30 | 0.123 | 1.500 | 4.000 | 0 | 3 | 1.000 | 4100 | 2501 \
-             | 55 | 12 | 40.3 | 120 | 256 / 0 | 0.50 |"
+             | 1900 | 3901 | 30.0 | 32.0 | 55 | 2.16 | 12 | 40.3 | 120 | 256 / 0 | 0.50 |"
         );
         let header = markdown_header();
         let cols = header.lines().next().unwrap().matches('|').count();
@@ -171,6 +188,16 @@ mod tests {
         assert!(lines[0].starts_with("bots,clients,rooms,bot_procs,window_s,tick_p50_ms,"));
         assert!(lines[0].contains(",up_B_per_s_per_client,"), "{}", lines[0]);
         assert!(lines[0].contains(",server_run_queue_wait_ms_per_s,"));
+        assert!(
+            lines[0].contains(",packets_up_per_s_per_client,"),
+            "{}",
+            lines[0]
+        );
+        assert!(
+            lines[0].contains(",server_CPU_ms_per_player_s,"),
+            "{}",
+            lines[0]
+        );
         assert!(lines[0].contains(",connected_dropped,inputs_starved_pct,"));
         assert!(lines[1].ends_with(",0.200,28800,3.00,3.50"));
     }

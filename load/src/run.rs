@@ -37,6 +37,8 @@ pub enum ClientKind {
     /// `ledge-bot --brain thin`: thin bots (inputs and snapshots, no
     /// prediction).
     Thin,
+    /// `ledge-bot --brain thin-idle`: thin bots holding no button.
+    ThinIdle,
 }
 
 /// The program that plays the bots, of either kind.
@@ -48,6 +50,7 @@ impl ClientKind {
         match self {
             ClientKind::Bot => brain,
             ClientKind::Thin => "thin",
+            ClientKind::ThinIdle => "thin-idle",
         }
     }
 }
@@ -85,6 +88,7 @@ impl RunConfig {
         match self.client {
             ClientKind::Bot => format!("ledge-bot {}", self.brain),
             ClientKind::Thin => "thin".to_owned(),
+            ClientKind::ThinIdle => "thin-idle".to_owned(),
         }
     }
 
@@ -141,6 +145,16 @@ pub struct RunResult {
     pub up_bytes_per_client_s: f64,
     /// Bytes per second per client sent by the server (payload).
     pub down_bytes_per_client_s: f64,
+    /// Bytes per second per client the server received on the wire: UDP
+    /// payload plus 28 bytes of IPv4 and UDP header per datagram, every
+    /// packet (inputs, ACKs, control), native QUIC clients.
+    pub wire_up_bytes_per_client_s: f64,
+    /// The same, sent by the server.
+    pub wire_down_bytes_per_client_s: f64,
+    /// UDP datagrams per second per client received by the server.
+    pub packets_up_per_client_s: f64,
+    /// UDP datagrams per second per client sent by the server.
+    pub packets_down_per_client_s: f64,
     /// Server CPU, percent of one core.
     pub server_cpu_pct: f64,
     /// Time the server's threads waited for a CPU while runnable, in
@@ -150,6 +164,8 @@ pub struct RunResult {
     pub server_peak_rss_mib: f64,
     /// CPU of all bot processes, percent of one core.
     pub bot_cpu_pct: f64,
+    /// Players in the server, mean of the window's two ends.
+    pub mean_players: f64,
     /// Players in the server when the window started.
     pub connected: u64,
     /// Fewest players seen during the window.
@@ -160,6 +176,14 @@ pub struct RunResult {
     pub starved_pct: f64,
     /// 1-minute load average at the start and end of the window.
     pub load: (f64, f64),
+}
+
+impl RunResult {
+    /// Server CPU per player and second of play, milliseconds: one core
+    /// holds `1000 / this` players.
+    pub fn cpu_ms_per_player_s(&self) -> f64 {
+        self.server_cpu_pct / 100.0 * 1000.0 / self.mean_players.max(1.0)
+    }
 }
 
 /// A running server and how to reach it.
@@ -433,6 +457,11 @@ pub fn run(config: &RunConfig, stop: &Stop) -> anyhow::Result<RunResult> {
     })
 }
 
+/// Bytes of IPv4 (20) and UDP (8) header on every datagram: the wire
+/// figures add them to the UDP payload the server counts (link-layer
+/// framing is not counted).
+const IP_UDP_HEADER: f64 = 28.0;
+
 fn summarise(
     config: &RunConfig,
     first: &Reading,
@@ -473,12 +502,23 @@ fn summarise(
         lateness_p99: lateness.quantile(0.99),
         up_bytes_per_client_s: delta("ledge_bytes_in_total") / window / clients,
         down_bytes_per_client_s: delta("ledge_bytes_out_total") / window / clients,
+        wire_up_bytes_per_client_s: (delta("ledge_wire_bytes_in_total")
+            + IP_UDP_HEADER * delta("ledge_wire_datagrams_in_total"))
+            / window
+            / clients,
+        wire_down_bytes_per_client_s: (delta("ledge_wire_bytes_out_total")
+            + IP_UDP_HEADER * delta("ledge_wire_datagrams_out_total"))
+            / window
+            / clients,
+        packets_up_per_client_s: delta("ledge_wire_datagrams_in_total") / window / clients,
+        packets_down_per_client_s: delta("ledge_wire_datagrams_out_total") / window / clients,
         server_cpu_pct: cpu_pct(last.server_cpu.saturating_sub(first.server_cpu)),
         server_run_queue_wait_ms_s: last.server_wait_ns.saturating_sub(first.server_wait_ns) as f64
             / 1e6
             / window,
         server_peak_rss_mib: peak_rss_kib as f64 / 1024.0,
         bot_cpu_pct: cpu_pct(last.bot_cpu.saturating_sub(first.bot_cpu)),
+        mean_players: clients,
         connected: 0,
         min_players: 0,
         dropped: 0,

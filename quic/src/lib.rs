@@ -1,9 +1,11 @@
 //! `ledge-quic`: QUIC transport settings that the server and the client
 //! must agree on, kept in one place.
 //!
-//! Today that is one thing: [`GameWindow`], the congestion controller both
-//! ends install (see [`install`]).
+//! [`GameWindow`], the congestion controller both ends install (see
+//! [`install`]), and fewer, smaller packets ([`packets`]): ACKs that ride
+//! on the game's packets and short connection ids.
 
+pub mod packets;
 mod window;
 
 pub use window::{install, GameWindow, GameWindowFactory, WINDOW_FLOOR};

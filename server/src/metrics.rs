@@ -22,7 +22,7 @@ use tokio::sync::{mpsc, watch};
 use tracing::{debug, warn};
 
 pub use crate::admission::Refusal;
-pub use crate::link::Transport;
+pub use crate::link::{Transport, Wire};
 
 /// Label: a room.
 #[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
@@ -199,6 +199,15 @@ pub struct Metrics {
     pub bytes_in: Family<ChannelLabel, Counter>,
     /// Bytes sent, all clients, per channel.
     pub bytes_out: Family<ChannelLabel, Counter>,
+    /// UDP datagrams received from native QUIC players (every packet, ACKs
+    /// included), sampled once a second by their rooms.
+    pub wire_datagrams_in: Counter,
+    /// Their UDP payload bytes (IP and UDP headers not included).
+    pub wire_bytes_in: Counter,
+    /// UDP datagrams sent to native QUIC players, sampled likewise.
+    pub wire_datagrams_out: Counter,
+    /// Their UDP payload bytes.
+    pub wire_bytes_out: Counter,
     /// Encoded snapshot sizes in bytes.
     pub snapshot_bytes: Family<SnapshotLabel, Histogram, fn() -> Histogram>,
     /// Ticks a player's input was missing and the previous one repeated.
@@ -271,6 +280,10 @@ impl Metrics {
             client_bytes_out: Family::default(),
             bytes_in: Family::default(),
             bytes_out: Family::default(),
+            wire_datagrams_in: Counter::default(),
+            wire_bytes_in: Counter::default(),
+            wire_datagrams_out: Counter::default(),
+            wire_bytes_out: Counter::default(),
             snapshot_bytes: Family::new_with_constructor(size_histogram as fn() -> Histogram),
             input_starvation: Family::default(),
             dropped: Family::default(),
@@ -378,6 +391,26 @@ impl Metrics {
             m.bytes_out.clone(),
         );
         r.register(
+            "wire_datagrams_in",
+            "UDP datagrams received from native QUIC players, sampled each second",
+            m.wire_datagrams_in.clone(),
+        );
+        r.register(
+            "wire_bytes_in",
+            "UDP payload bytes received from native QUIC players, sampled each second",
+            m.wire_bytes_in.clone(),
+        );
+        r.register(
+            "wire_datagrams_out",
+            "UDP datagrams sent to native QUIC players, sampled each second",
+            m.wire_datagrams_out.clone(),
+        );
+        r.register(
+            "wire_bytes_out",
+            "UDP payload bytes sent to native QUIC players, sampled each second",
+            m.wire_bytes_out.clone(),
+        );
+        r.register(
             "snapshot_bytes",
             "Encoded snapshot sizes",
             m.snapshot_bytes.clone(),
@@ -409,6 +442,20 @@ impl Metrics {
             m.tick_lateness.clone(),
         );
         (Arc::new(m), r)
+    }
+
+    /// Adds what a connection put through its socket since `seen` (its
+    /// previous sample), and makes `now` the new one.
+    pub fn wire(&self, seen: &mut Wire, now: Wire) {
+        self.wire_datagrams_in
+            .inc_by(now.datagrams_in.saturating_sub(seen.datagrams_in));
+        self.wire_bytes_in
+            .inc_by(now.bytes_in.saturating_sub(seen.bytes_in));
+        self.wire_datagrams_out
+            .inc_by(now.datagrams_out.saturating_sub(seen.datagrams_out));
+        self.wire_bytes_out
+            .inc_by(now.bytes_out.saturating_sub(seen.bytes_out));
+        *seen = now;
     }
 
     /// Counts one dropped message.

@@ -34,7 +34,7 @@ use tracing::{debug, error, info, warn};
 
 use crate::clock::TickSchedule;
 use crate::inputs::{InputBuffer, Received};
-use crate::link::{DatagramError, Link};
+use crate::link::{DatagramError, Link, Wire};
 use crate::metrics::{
     Channel, ClientBytes, DropReason, KickLabel, KickReason, Metrics, RoomLabel, SnapshotKind,
     SnapshotLabel,
@@ -393,6 +393,8 @@ struct Member {
     packets_seen: u64,
     /// A connection holds it (false: lost, kept for a resume).
     attached: bool,
+    /// Its connection's UDP totals at the last sample.
+    wire: Wire,
 }
 
 /// The room task's state.
@@ -567,6 +569,7 @@ impl Room {
                 attached: true,
                 heard_at: tick,
                 packets_seen: 0,
+                wire: Wire::default(),
             },
         );
         self.players.store(self.members.len(), Ordering::Relaxed);
@@ -589,6 +592,7 @@ impl Room {
             m.link.link.close(CloseCode::Normal, "resumed elsewhere");
         }
         m.link = link;
+        m.wire = Wire::default();
         m.inbox = inbox.clone();
         m.buttons = Buttons::NONE;
         m.last_applied = None;
@@ -676,6 +680,9 @@ impl Room {
         if let Some(r) = &self.config.record {
             r.tick(tick, &self.inputs, || self.game.state_hash());
         }
+        if tick % u64::from(self.config.tick_rate.max(1)) == 0 {
+            self.sample_wire();
+        }
         let interval = u64::from(self.config.snapshot_interval.max(1));
         if self.game.tick() % interval == 0 && !self.members.is_empty() {
             self.send_snapshots();
@@ -683,6 +690,17 @@ impl Room {
         let took = started.elapsed().as_secs_f64();
         self.tick_duration.observe(took);
         self.metrics.tick_duration_fine.observe(took);
+    }
+
+    /// Adds what each player's connection put through its socket since the
+    /// last sample to the wire metrics (once a second: reading quinn's
+    /// statistics takes the connection's lock).
+    fn sample_wire(&mut self) {
+        for m in self.members.values_mut().filter(|m| m.attached) {
+            if let Some(now) = m.link.link.wire() {
+                self.metrics.wire(&mut m.wire, now);
+            }
+        }
     }
 
     /// Removes the connected players that sent no input for the idle time

@@ -313,7 +313,7 @@ impl Server {
             }
         };
         let udp = bind_err(config.bind, "--bind");
-        let endpoint = quinn::Endpoint::server(quic, config.bind).map_err(udp)?;
+        let endpoint = ledge_quic::packets::server_endpoint(quic, config.bind).map_err(udp)?;
         let local_addr = endpoint.local_addr().map_err(udp)?;
         let metrics_listener = match config.metrics_bind {
             Some(addr) => {

@@ -1028,13 +1028,13 @@ fn idle_and_typical_deltas_are_small() {
     );
     assert_eq!(decode_delta(Some(&base), &moving).unwrap(), cur);
 
-    let input = InputPacket::new(
-        t0 + 5,
-        &[Buttons(Buttons::RIGHT); DEFAULT_INPUT_REDUNDANCY as usize],
-        Some(t0 + 3),
-    )
-    .encode()
-    .unwrap();
+    // 16 ticks of input with one change among them, the ack 3 ticks back.
+    let mut ticks = [Buttons(Buttons::RIGHT); DEFAULT_INPUT_REDUNDANCY as usize];
+    ticks[..5].fill(Buttons(Buttons::RIGHT | Buttons::JUMP));
+    let input = InputPacket::new(t0 + 5, &ticks, Some(t0 + 2))
+        .encode()
+        .unwrap();
+    assert!(input.len() <= 12, "input datagram: {} bytes", input.len());
     eprintln!(
         "sizes: idle delta (200 entities) {idle_len} B, idle snapshot datagram {} B; \
          8 moving players delta {} B, datagram {} B; full state of 200 entities {} B; \
@@ -1103,7 +1103,7 @@ fn documented_example_bytes() {
     let input = InputPacket::new(300, &[Buttons(Buttons::JUMP), Buttons(0)], Some(297));
     assert_eq!(
         input.encode().unwrap(),
-        [0xFB, 0x2C, 0x01, 0x02, 0x10, 0x00, 0x01, 0xFB, 0x29, 0x01]
+        [0xFB, 0x2C, 0x01, 0x04, 0x00, 0x10, 0x00, 0x00, 0x01, 0x05]
     );
 }
 

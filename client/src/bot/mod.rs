@@ -10,4 +10,4 @@ pub use brain::{Brain, Idle, RandomWalker, SplitMix64};
 pub use misbehave::{misbehave, MisbehaveReport, Misbehavior, Outcome};
 pub use run::{connect_and_run, run_bot, BotOptions, BotReport};
 pub use runner::{Runner, RunnerProgress};
-pub use thin::{run_thin, THIN};
+pub use thin::{run_thin, run_thin_with, THIN};

@@ -10,6 +10,7 @@
 
 use std::time::Instant;
 
+use ledge_shared::input::Buttons;
 use ledge_shared::protocol::NoticeKind;
 
 use super::brain::RandomWalker;
@@ -34,6 +35,17 @@ pub async fn run_thin(
     server: &str,
     trust: &Trust,
     walker: &mut RandomWalker,
+    options: &BotOptions,
+) -> BotReport {
+    run_thin_with(server, trust, &mut || walker.next_buttons(), options).await
+}
+
+/// [`run_thin`] with the buttons of each tick from `next` (e.g. none at
+/// all: an idle player, to measure what a quiet room costs).
+pub async fn run_thin_with(
+    server: &str,
+    trust: &Trust,
+    next: &mut (dyn FnMut() -> Buttons + Send),
     options: &BotOptions,
 ) -> BotReport {
     let mut report = BotReport {
@@ -65,7 +77,7 @@ pub async fn run_thin(
         }
         let tick = clock.input_tick(now);
         if last_sent.is_none_or(|t| tick > t) {
-            let buttons = walker.next_buttons();
+            let buttons = next();
             if let Err(e) = session.send_input(tick, buttons) {
                 break Some(format!("input not sent: {e}"));
             }
@@ -111,7 +123,6 @@ pub async fn run_thin(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ledge_shared::input::Buttons;
 
     fn walk(seed: u64, ticks: usize) -> Vec<Buttons> {
         let mut w = RandomWalker::new(seed);

@@ -98,7 +98,10 @@ pub struct SnapshotUpdate {
     /// Newest tick of our input the server had applied (`None` before the
     /// first): inputs after it are not in `state` yet.
     pub last_input_tick: Option<u64>,
-    /// How early (+) or late (-), in ticks, our inputs arrive at the server.
+    /// How early (+) or late (-), in ticks, our inputs arrive at the server:
+    /// the server's figure for a datagram's newest tick, less the ticks it
+    /// brings that were due earlier ([`state::input_interval`] - 1), so
+    /// that clocks steering by it keep every tick early.
     pub input_timing: i16,
     /// Whether it came on the control stream (too big for a datagram).
     pub via_stream: bool,

@@ -232,14 +232,15 @@ impl Session {
         self.state.stats()
     }
 
-    /// Records our buttons for `tick` and sends an input datagram carrying
-    /// it and the ticks before it (as many as the server asked for in
-    /// `Welcome`), plus the acknowledgement of the newest snapshot. Never
-    /// blocks: quinn drops the oldest queued datagram when its small buffer
-    /// is full.
+    /// Records our buttons for `tick` and, when one is due, sends an input
+    /// datagram carrying it and the ticks before it (as many as the server
+    /// asked for in `Welcome`), plus the acknowledgement of the newest
+    /// snapshot ([`SessionState::input_datagram`]). Never blocks: quinn
+    /// drops the oldest queued datagram when its small buffer is full.
     pub fn send_input(&mut self, tick: u64, buttons: Buttons) -> Result<(), ClientError> {
-        let datagram = self.state.input_datagram(tick, buttons)?;
-        self.connection.send_datagram(datagram.into())?;
+        if let Some(datagram) = self.state.input_datagram(tick, buttons)? {
+            self.connection.send_datagram(datagram.into())?;
+        }
         Ok(())
     }
 

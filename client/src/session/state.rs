@@ -122,6 +122,20 @@ impl Handshake {
     }
 }
 
+/// Most input datagrams a client sends per second: at 60 Hz ticks every
+/// datagram carries two ticks. Every datagram costs its ~50 bytes of
+/// QUIC, UDP and IP header and the server a receive, a decryption and an
+/// ACK to track, whatever it carries; the tick between two datagrams
+/// reaches the server one tick later (and the input clock leads by that
+/// tick more: see [`SnapshotUpdate::input_timing`]).
+pub const INPUT_SEND_HZ: u32 = 30;
+
+/// Ticks between input datagrams at `tick_rate`: the fewest that keep
+/// them at most [`INPUT_SEND_HZ`] (1 at 30 Hz and below, 2 at 60 Hz).
+pub fn input_interval(tick_rate: u32) -> u64 {
+    u64::from(tick_rate.div_ceil(INPUT_SEND_HZ).max(1))
+}
+
 /// A welcomed session's protocol state: the roster, the snapshot history,
 /// our recent inputs, pings in flight, and the events not yet taken.
 #[derive(Debug)]
@@ -130,6 +144,12 @@ pub struct SessionState {
     welcome: Welcome,
     inputs: InputHistory,
     redundancy: usize,
+    /// Ticks between input datagrams ([`input_interval`]).
+    input_every: u64,
+    /// Newest tick sent in an input datagram.
+    input_sent: Option<u64>,
+    /// The server's last `input_timing` (for a datagram's newest tick).
+    server_timing: i16,
     history: SnapshotHistory,
     pending: VecDeque<SessionEvent>,
     pings: VecDeque<(u64, Instant)>,
@@ -151,6 +171,9 @@ impl SessionState {
             decoder,
             inputs: InputHistory::default(),
             redundancy: usize::from(welcome.timing.input_redundancy).clamp(1, MAX_INPUT_HISTORY),
+            input_every: input_interval(welcome.timing.tick_rate),
+            input_sent: None,
+            server_timing: 0,
             welcome,
             history: SnapshotHistory::new(SNAPSHOT_HISTORY),
             pending: VecDeque::new(),
@@ -198,18 +221,53 @@ impl SessionState {
         self.stats
     }
 
-    /// Records our buttons for `tick` and returns the input datagram to
-    /// send: it and the ticks before it (as many as the server asked for
-    /// in `Welcome`), plus the acknowledgement of the newest snapshot.
-    pub fn input_datagram(&mut self, tick: u64, buttons: Buttons) -> Result<Vec<u8>, ClientError> {
+    /// Records our buttons for `tick` and, when one is due (every
+    /// [`input_interval`] ticks), returns the input datagram to send: this
+    /// tick and the ticks before it (as many as the server asked for in
+    /// `Welcome`, so those between datagrams go too), plus the
+    /// acknowledgement of the newest snapshot.
+    pub fn input_datagram(
+        &mut self,
+        tick: u64,
+        buttons: Buttons,
+    ) -> Result<Option<Vec<u8>>, ClientError> {
         self.inputs.record(tick, buttons);
+        let due = match self.input_sent {
+            None => true,
+            Some(sent) if tick < sent => true,
+            Some(sent) => {
+                tick >= sent.saturating_add(self.input_every)
+                    || (tick > sent && self.lands_before_snapshot(tick))
+            }
+        };
+        if !due {
+            return Ok(None);
+        }
         let packet = self
             .inputs
             .packet(self.redundancy, self.ack())
             .expect("just recorded");
         let bytes = packet.encode()?;
+        self.input_sent = Some(tick);
         self.stats.inputs_sent += 1;
-        Ok(bytes)
+        Ok(Some(bytes))
+    }
+
+    /// Whether a datagram whose newest tick is `tick` should reach the
+    /// server in the tick before it sends snapshots, so that the server's
+    /// ACK of it rides on the next snapshot instead of going alone when its
+    /// ACK timer runs out first (quinn holds an ACK for at most the larger
+    /// of the RTT and 25 ms, less than a snapshot interval at 60 Hz on a
+    /// LAN). Input for `tick` arrives while the server's next tick is
+    /// about `tick - timing`; snapshots go after a tick `k` with
+    /// `(k + 1) % every == 0`.
+    /// (Only when snapshots go every `input_every` ticks, as at 60 Hz.)
+    fn lands_before_snapshot(&self, tick: u64) -> bool {
+        if u64::from(self.welcome.timing.snapshot_interval) != self.input_every {
+            return false;
+        }
+        let arrives = i128::from(tick) - i128::from(self.server_timing);
+        (arrives + 1).rem_euclid(i128::from(self.input_every)) == 0
     }
 
     /// A ping sent at `now`: its nonce and the control frame to write; the
@@ -368,6 +426,7 @@ impl SessionState {
             return;
         }
         self.stats.snapshots += 1;
+        self.server_timing = snapshot.input_timing;
         if snapshot.baseline_tick.is_none() {
             self.stats.full_snapshots += 1;
         }
@@ -375,7 +434,11 @@ impl SessionState {
             state,
             baseline_tick: snapshot.baseline_tick,
             last_input_tick: snapshot.last_input_tick,
-            input_timing: snapshot.input_timing,
+            // The server times a datagram by its newest tick; the oldest
+            // tick it brings first is `input_every - 1` ticks less early.
+            input_timing: snapshot
+                .input_timing
+                .saturating_sub(i16::try_from(self.input_every - 1).unwrap_or(i16::MAX)),
             via_stream,
             wire_bytes,
             received: now,
@@ -462,5 +525,105 @@ mod tests {
         assert_eq!(p.buttons.len(), 16);
         assert_eq!(p.get(190), Some(Buttons(190)));
         assert_eq!(p.ack_snapshot, Some(7));
+    }
+
+    #[test]
+    fn inputs_go_at_most_thirty_times_a_second_and_the_timing_counts_the_wait() {
+        assert_eq!(
+            [1, 20, 30, 31, 60, 120, 144].map(input_interval),
+            [1, 1, 1, 2, 2, 4, 5]
+        );
+        use ledge_shared::protocol::{NetTiming, Snapshot};
+        let welcome = Welcome {
+            player_id: PlayerId(1),
+            room: "room-1".into(),
+            level_id: "level".into(),
+            level_hash: 0,
+            level: Default::default(),
+            session_token: Default::default(),
+            server_tick: 0,
+            timing: NetTiming {
+                tick_rate: 120,
+                snapshot_interval: 2,
+                input_redundancy: 8,
+            },
+            sim_config: vec![],
+        };
+        let now = Instant::now();
+        let mut state = SessionState::new(welcome, FrameDecoder::new(MAX_FRAME), now).unwrap();
+        let sent: Vec<u64> = (10..20)
+            .filter(|&t| state.input_datagram(t, Buttons(1)).unwrap().is_some())
+            .collect();
+        assert_eq!(sent, [10, 14, 18], "every fourth tick at 120 Hz");
+        assert_eq!(state.stats().inputs_sent, 3);
+        // A clock set back (a resync) sends at once.
+        assert!(state.input_datagram(12, Buttons(1)).unwrap().is_some());
+        // A datagram the server saw 5 ticks early brought 3 ticks due
+        // earlier: the oldest was 2 ticks early.
+        let mut delta = Vec::new();
+        let empty = StateSnapshot {
+            tick: 2,
+            ..StateSnapshot::default()
+        };
+        ledge_shared::protocol::encode_delta(None, &empty, &mut delta).unwrap();
+        let snapshot = Snapshot {
+            tick: 2,
+            baseline_tick: None,
+            last_input_tick: None,
+            input_timing: 5,
+            delta,
+        };
+        state.on_datagram(&snapshot.encode().unwrap(), now);
+        match state.poll_event() {
+            Some(SessionEvent::Snapshot(update)) => assert_eq!(update.input_timing, 2),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn inputs_land_in_the_tick_before_a_snapshot() {
+        use ledge_shared::protocol::{NetTiming, Snapshot};
+        let welcome = Welcome {
+            player_id: PlayerId(1),
+            room: "room-1".into(),
+            level_id: "level".into(),
+            level_hash: 0,
+            level: Default::default(),
+            session_token: Default::default(),
+            server_tick: 0,
+            timing: NetTiming {
+                tick_rate: 60,
+                snapshot_interval: 2,
+                input_redundancy: 8,
+            },
+            sim_config: vec![],
+        };
+        let now = Instant::now();
+        let mut state = SessionState::new(welcome, FrameDecoder::new(MAX_FRAME), now).unwrap();
+        let sent = |state: &mut SessionState, ticks: std::ops::Range<u64>| -> Vec<u64> {
+            ticks
+                .filter(|&t| state.input_datagram(t, Buttons(1)).unwrap().is_some())
+                .collect()
+        };
+        // Timing 0 until told: tick T arrives while the server is at T,
+        // and snapshots go after odd ticks: the odd ones are sent.
+        assert_eq!(sent(&mut state, 10..17), [10, 11, 13, 15]);
+        // The server says inputs arrive 3 ticks early: now the even ones
+        // (17 still goes: no tick waits longer than the interval).
+        let mut delta = Vec::new();
+        let empty = StateSnapshot {
+            tick: 2,
+            ..StateSnapshot::default()
+        };
+        ledge_shared::protocol::encode_delta(None, &empty, &mut delta).unwrap();
+        let snapshot = Snapshot {
+            tick: 2,
+            baseline_tick: None,
+            last_input_tick: None,
+            input_timing: 3,
+            delta,
+        };
+        state.on_datagram(&snapshot.encode().unwrap(), now);
+        assert_eq!(sent(&mut state, 17..24), [17, 18, 20, 22]);
     }
 }

@@ -307,6 +307,20 @@ pub enum DatagramError {
     Failed(String),
 }
 
+/// UDP totals of a connection: datagrams and their payload bytes (QUIC
+/// packets, coalesced ones counted once; IP and UDP headers not included).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Wire {
+    /// Datagrams received.
+    pub datagrams_in: u64,
+    /// Their UDP payload bytes.
+    pub bytes_in: u64,
+    /// Datagrams sent.
+    pub datagrams_out: u64,
+    /// Their UDP payload bytes.
+    pub bytes_out: u64,
+}
+
 /// What the room keeps to reach a client: cheap to clone.
 #[derive(Debug, Clone)]
 pub enum Link {
@@ -343,6 +357,23 @@ impl Link {
             Link::Quic(c) => c.max_datagram_size(),
             Link::WebTransport(c) => c.max_datagram_size(),
             Link::WebSocket(_) => Some(websocket::MAX_DATAGRAM),
+        }
+    }
+
+    /// What the connection has put through its UDP socket so far (native
+    /// QUIC only: the other transports' counts are not exposed).
+    pub fn wire(&self) -> Option<Wire> {
+        match self {
+            Link::Quic(c) => {
+                let s = c.stats();
+                Some(Wire {
+                    datagrams_in: s.udp_rx.datagrams,
+                    bytes_in: s.udp_rx.bytes,
+                    datagrams_out: s.udp_tx.datagrams,
+                    bytes_out: s.udp_tx.bytes,
+                })
+            }
+            Link::WebTransport(_) | Link::WebSocket(_) => None,
         }
     }
 

@@ -12,34 +12,76 @@ use super::{
 };
 use crate::input::Buttons;
 
-/// Serde helper: `Vec<Buttons>` as one byte string, one byte per tick.
-mod buttons {
-    use super::Buttons;
-    use serde::{Deserializer, Serializer};
+/// An [`InputPacket`] as it goes on the wire: the buttons as runs of equal
+/// ticks (a held button costs two bytes however long it is held) and the
+/// acknowledgement relative to the newest tick (one byte when near).
+#[derive(Serialize, Deserialize)]
+struct InputWire {
+    newest_tick: u64,
+    /// `(ticks - 1, buttons)` byte pairs, newest run first.
+    #[serde(with = "bytes")]
+    runs: Vec<u8>,
+    /// `ack_snapshot - newest_tick`, wrapping (any `u64` round-trips).
+    ack: Option<i64>,
+}
 
-    pub fn serialize<S: Serializer>(v: &[Buttons], s: S) -> Result<S::Ok, S::Error> {
-        let raw: Vec<u8> = v.iter().map(|b| b.0).collect();
-        super::bytes::serialize(&raw, s)
+impl From<InputPacket> for InputWire {
+    fn from(p: InputPacket) -> InputWire {
+        let mut runs: Vec<u8> = Vec::new();
+        for b in &p.buttons {
+            match runs.len() {
+                n if n >= 2 && runs[n - 1] == b.0 && runs[n - 2] < u8::MAX => runs[n - 2] += 1,
+                _ => runs.extend([0, b.0]),
+            }
+        }
+        InputWire {
+            newest_tick: p.newest_tick,
+            runs,
+            ack: p.ack_snapshot.map(|a| a.wrapping_sub(p.newest_tick) as i64),
+        }
     }
+}
 
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Buttons>, D::Error> {
-        Ok(super::bytes::deserialize(d)?
-            .into_iter()
-            .map(Buttons)
-            .collect())
+impl TryFrom<InputWire> for InputPacket {
+    type Error = String;
+
+    fn try_from(w: InputWire) -> Result<InputPacket, String> {
+        if w.runs.len() % 2 != 0 {
+            return Err("input runs: an odd number of bytes".into());
+        }
+        let mut buttons = Vec::new();
+        for run in w.runs.chunks_exact(2) {
+            let ticks = usize::from(run[0]) + 1;
+            // Bounded before growing: never more than the history allows.
+            if buttons.len() + ticks > MAX_INPUT_HISTORY {
+                return Err(format!(
+                    "input history: over {MAX_INPUT_HISTORY} ticks of buttons"
+                ));
+            }
+            buttons.extend(std::iter::repeat_n(Buttons(run[1]), ticks));
+        }
+        Ok(InputPacket {
+            newest_tick: w.newest_tick,
+            buttons,
+            ack_snapshot: w.ack.map(|d| w.newest_tick.wrapping_add(d as u64)),
+        })
     }
 }
 
 /// A client's input datagram, sent every tick: the buttons of the newest
 /// tick and of the ticks before it, so one lost datagram (or several in a
 /// row, up to the redundancy) costs nothing.
+///
+/// On the wire (`InputWire`) the buttons go as runs of equal ticks and the
+/// acknowledgement as an offset from `newest_tick`: 16 ticks of one held
+/// button and a recent acknowledgement take about 10 bytes.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(into = "InputWire", try_from = "InputWire")]
 pub struct InputPacket {
     /// The tick of `buttons[0]`.
     pub newest_tick: u64,
     /// Buttons newest first: `buttons[i]` is for tick `newest_tick - i`.
     /// 1..=[`MAX_INPUT_HISTORY`] entries, never before tick 0.
-    #[serde(with = "buttons")]
     pub buttons: Vec<Buttons>,
     /// Tick of the newest snapshot the client has decoded (its delta
     /// baseline), `None` before the first.

@@ -60,7 +60,10 @@ pub use snapshot::{
 /// (its `aux` then the respawn countdown) and `RESTART_HELD`, the input bit
 /// `Buttons::RESTART`, and `PlayerConfig::respawn_delay_ticks` in
 /// `Welcome::sim_config`.
-pub const PROTOCOL_VERSION: u32 = 6;
+/// 7: input datagrams carry their buttons as runs of equal ticks and the
+/// acknowledgement as an offset from the newest tick (`InputPacket`'s wire
+/// form); clients send one every other tick at 60 Hz.
+pub const PROTOCOL_VERSION: u32 = 7;
 
 /// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
 /// an unrelated QUIC peer. It names the application, not the version:
@@ -86,8 +89,8 @@ pub const MAX_INPUT_HISTORY: usize = 64;
 pub const DEFAULT_INPUT_REDUNDANCY: u8 = 16;
 
 /// Largest accepted input datagram, in bytes (the largest valid
-/// [`InputPacket`] is about 85).
-pub const MAX_INPUT_DATAGRAM: usize = 128;
+/// [`InputPacket`], 64 ticks of buttons changing every tick, is 149).
+pub const MAX_INPUT_DATAGRAM: usize = 160;
 
 // Worst case of a delta: header (1 + 10 + 10) + count (5) + removing every
 // baseline entity (id 5 + ctrl 1) + every current entity in full (id 5 +

@@ -6,14 +6,15 @@ use std::time::Duration;
 
 use clap::{Parser, ValueEnum};
 use ledge_client::bot::{
-    connect_and_run, misbehave, run_thin, BotOptions, Brain, Idle, Misbehavior, RandomWalker,
-    Runner,
+    connect_and_run, misbehave, run_thin, run_thin_with, BotOptions, Brain, Idle, Misbehavior,
+    RandomWalker, Runner,
 };
 use ledge_client::bundle::LevelCache;
 use ledge_client::transport::resolve;
 use ledge_client::trust::{KnownHosts, Trust};
 use ledge_client::Fingerprint;
 use ledge_levels::default_route;
+use ledge_shared::input::Buttons;
 
 /// Which brain the bots run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -27,6 +28,8 @@ enum BrainKind {
     /// The walker's buttons without prediction: thin clients for load
     /// generation (one input per tick, every snapshot decoded).
     Thin,
+    /// A thin client holding nothing: what an idle player costs.
+    ThinIdle,
     /// Abuses the protocol (see --mode).
     Misbehave,
 }
@@ -115,7 +118,7 @@ async fn run(cli: Cli) -> ExitCode {
             BrainKind::Runner => Some(Box::new(Runner::new(default_route()))),
             BrainKind::Idle => Some(Box::new(Idle)),
             BrainKind::Walker => Some(Box::new(RandomWalker::new(seed))),
-            BrainKind::Thin => None,
+            BrainKind::Thin | BrainKind::ThinIdle => None,
             BrainKind::Misbehave => unreachable!("handled above"),
         };
         let options = BotOptions {
@@ -128,9 +131,13 @@ async fn run(cli: Cli) -> ExitCode {
         };
         let server = cli.connect.clone();
         let trust = trust.clone();
+        let idle = cli.brain == BrainKind::ThinIdle;
         tasks.push(tokio::spawn(async move {
             match brain {
                 Some(mut brain) => connect_and_run(&server, &trust, brain.as_mut(), &options).await,
+                None if idle => {
+                    run_thin_with(&server, &trust, &mut || Buttons::NONE, &options).await
+                }
                 None => run_thin(&server, &trust, &mut RandomWalker::new(seed), &options).await,
             }
         }));
