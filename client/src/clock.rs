@@ -19,7 +19,15 @@ use crate::time::Instant;
 
 use ledge_shared::protocol::Welcome;
 
-/// Default ticks the inputs are sent ahead of the estimated server tick.
+use crate::session::state::input_interval;
+
+/// Ticks the oldest input of a datagram waits for it at `tick_rate`.
+fn batch_wait(tick_rate: u32) -> u64 {
+    input_interval(tick_rate) - 1
+}
+
+/// Default ticks the inputs are sent ahead of the estimated server tick
+/// (besides the ticks they wait for their datagram).
 pub const DEFAULT_LEAD: i64 = 2;
 /// Input timing (ticks early) the clock steers towards.
 pub const TARGET_TIMING: i16 = 2;
@@ -35,13 +43,15 @@ pub struct InputClock {
 
 impl InputClock {
     /// A clock for a session welcomed at `at` (the server was then at
-    /// `welcome.server_tick`).
+    /// `welcome.server_tick`), leading by [`DEFAULT_LEAD`] plus the ticks
+    /// an input waits for its datagram ([`input_interval`] - 1).
     pub fn new(welcome: &Welcome, at: Instant) -> InputClock {
+        let rate = welcome.timing.tick_rate.max(1);
         InputClock {
             start: at,
             start_tick: welcome.server_tick,
-            tick_rate: welcome.timing.tick_rate.max(1),
-            lead: DEFAULT_LEAD,
+            tick_rate: rate,
+            lead: DEFAULT_LEAD + batch_wait(rate) as i64,
         }
     }
 
@@ -153,10 +163,12 @@ impl SyncClock {
 
     /// A clock for a session welcomed at `now`: the server was at
     /// `welcome.server_tick` about half a round trip ago, and our inputs
-    /// need another half to arrive, plus the margin.
+    /// need another half to arrive, plus the margin and the ticks an input
+    /// waits for its datagram ([`input_interval`] - 1).
     pub fn for_welcome(welcome: &Welcome, rtt: Duration, now: Instant) -> SyncClock {
         let rate = welcome.timing.tick_rate.max(1);
-        let lead = rtt.as_secs_f64() * f64::from(rate) + BASE_MARGIN + 1.0;
+        let lead =
+            rtt.as_secs_f64() * f64::from(rate) + BASE_MARGIN + 1.0 + batch_wait(rate) as f64;
         SyncClock::new(welcome.server_tick as f64 + lead, rate, now)
     }
 
@@ -337,14 +349,16 @@ mod tests {
         let mut c = InputClock::new(&welcome(100), t0);
         assert_eq!(c.server_tick(t0), 100);
         assert_eq!(c.server_tick(t0 + Duration::from_millis(1000)), 160);
-        assert_eq!(c.input_tick(t0), 100 + DEFAULT_LEAD as u64);
+        // At 60 Hz an input may wait a tick for its datagram: one more.
+        let lead = DEFAULT_LEAD + 1;
+        assert_eq!(c.input_tick(t0), 100 + lead as u64);
         c.observe(-3);
-        assert_eq!(c.lead(), DEFAULT_LEAD + 1);
+        assert_eq!(c.lead(), lead + 1);
         c.observe(TARGET_TIMING);
-        assert_eq!(c.lead(), DEFAULT_LEAD + 1);
+        assert_eq!(c.lead(), lead + 1);
         c.observe(10);
         c.observe(10);
-        assert_eq!(c.lead(), DEFAULT_LEAD - 1);
+        assert_eq!(c.lead(), lead - 1);
         let wait = c.until_next_tick(t0 + Duration::from_millis(10));
         assert!(
             wait > Duration::from_millis(6) && wait <= Duration::from_millis(7),

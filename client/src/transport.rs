@@ -54,9 +54,7 @@ fn client_config(
     let mut config = quinn::ClientConfig::new(Arc::new(quic));
     let mut transport = quinn::TransportConfig::default();
     // Resume within a round trip after an outage (see `ledge_quic`).
-    ledge_quic::install(&mut transport);
-    // ACKs ride on the server's snapshots (see `ledge_quic::packets`).
-    ledge_quic::packets::ride_acks(&mut transport)
+    ledge_quic::install(&mut transport)
         .keep_alive_interval(Some(KEEP_ALIVE))
         // Inputs repeat the last ticks, so an old queued one is worthless:
         // keep the queue short and let quinn drop the oldest.

@@ -65,8 +65,11 @@ async fn thin_bots_play_and_the_metrics_show_it() {
     let scraped = tokio::task::spawn_blocking(move || scrape(metrics).unwrap())
         .await
         .unwrap();
-    // 3 clients x ~120 input datagrams.
-    assert!(scraped.sum("ledge_bytes_in_total") > 3.0 * 60.0 * 10.0);
+    // 3 clients x ~60 input datagrams (2 s, 30 a second) of 6 bytes or more.
+    assert!(scraped.sum("ledge_bytes_in_total") > 3.0 * 50.0 * 6.0);
+    // Each room samples its players' connections once a second.
+    assert!(scraped.sum("ledge_wire_datagrams_in_total") >= 3.0 * 25.0);
+    assert!(scraped.sum("ledge_wire_bytes_out_total") > scraped.sum("ledge_bytes_out_total"));
     assert!(scraped.sum("ledge_bytes_out_total") > 3.0 * 15.0 * 20.0);
     let ticks = scraped
         .histogram("ledge_tick_duration_fine_seconds")

@@ -2,8 +2,7 @@
 //! must agree on, kept in one place.
 //!
 //! [`GameWindow`], the congestion controller both ends install (see
-//! [`install`]), and fewer, smaller packets ([`packets`]): ACKs that ride
-//! on the game's packets and short connection ids.
+//! [`install`]), and smaller packets ([`packets`]): short connection ids.
 
 pub mod packets;
 mod window;

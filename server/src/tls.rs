@@ -55,9 +55,7 @@ pub fn server_config(
     let mut config = quinn::ServerConfig::with_crypto(Arc::new(QuicServerConfig::try_from(tls)?));
     let mut transport = quinn::TransportConfig::default();
     // Resume within a round trip after an outage (see `ledge_quic`).
-    ledge_quic::install(&mut transport);
-    // ACKs ride on the clients' inputs (see `ledge_quic::packets`).
-    ledge_quic::packets::ride_acks(&mut transport)
+    ledge_quic::install(&mut transport)
         .max_idle_timeout(Some(
             quinn::IdleTimeout::try_from(idle_timeout)
                 .map_err(|_| TlsError::IdleTimeout(idle_timeout))?,
