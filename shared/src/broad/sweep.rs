@@ -73,16 +73,6 @@ fn scan(s: &Strips, mut k: usize, x0: i32, x1: i32, y0: i32, y1: i32, mut hit: i
     }
 }
 
-/// Every overlapping pair inside one strip (`r` is a run of `s` sorted by
-/// left edge and followed by a sentinel): each box scans forward.
-#[inline]
-pub(crate) fn sweep_self<S: Sink>(s: &Strips, r: Range<usize>, sink: &mut S) {
-    for i in r {
-        let (x0, x1, y0, y1) = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
-        scan(s, i + 1, x0, x1, y0, y1, |j| sink.hit(s, i, s, j));
-    }
-}
-
 /// Moves cursor `p` of a run of `b` (sorted by left edge, ending in a
 /// sentinel, no box wider than `max_w`) past the boxes that end before `x0`
 /// can be reached: left edge `<= x0 - max_w`.
@@ -124,38 +114,119 @@ pub(crate) fn sweep_two<S: Sink>(
     }
 }
 
-/// [`sweep_self`] of run `ra` and [`sweep_two`] of `ra` against the next
-/// strip `next` of the same set, in one pass over `ra`. (Skipping the boxes
-/// that end above the next strip's highest top edge was measured: the
-/// unpredictable branch costs more than the scan it saves.)
+/// Candidate pairs `[i, j]` (entries of one set), written without a branch
+/// per block: the buffer is kept longer than its contents and `n` counts
+/// the pairs in it (a register once inlined: not a store per block).
+pub(crate) struct Cands<'a> {
+    buf: &'a mut Vec<[u32; 2]>,
+    n: usize,
+}
+
+impl<'a> Cands<'a> {
+    /// An empty list over `buf` (whose contents are overwritten).
+    #[inline]
+    pub fn new(buf: &'a mut Vec<[u32; 2]>) -> Self {
+        Self { buf, n: 0 }
+    }
+
+    /// The pairs found so far.
+    #[inline]
+    pub fn pairs(&self) -> &[[u32; 2]] {
+        &self.buf[..self.n]
+    }
+
+    /// Adds `[i, k + t]` for every bit `t` of `h`. The first is stored
+    /// whatever `h` (and kept only if `h != 0`); only a second hit in one
+    /// block (rare) takes a branch.
+    #[inline(always)]
+    fn push(&mut self, i: usize, k: usize, mut h: u32) {
+        if self.n + 2 * BLOCK > self.buf.len() {
+            self.grow();
+        }
+        self.buf[self.n] = [i as u32, (k as u32).wrapping_add(h.trailing_zeros())];
+        self.n += (h != 0) as usize;
+        h &= h.wrapping_sub(1);
+        while h != 0 {
+            self.buf[self.n] = [i as u32, (k as u32).wrapping_add(h.trailing_zeros())];
+            self.n += 1;
+            h &= h - 1;
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn grow(&mut self) {
+        let len = (2 * self.buf.len()).max(1024);
+        self.buf.resize(len, [0; 2]);
+    }
+}
+
+/// [`scan`] into a candidate list: box `i` against the entries of `s` from
+/// `k` on while they start left of `x1`.
+#[inline(always)]
+fn scan_into(s: &Strips, mut k: usize, i: usize, x: (i32, i32, i32, i32), c: &mut Cands<'_>) {
+    let (x0, x1, y0, y1) = x;
+    loop {
+        let run = lanes_lt(&s.minx, k, x1).trailing_ones();
+        c.push(i, k, lanes_rest(s, k, x0, y0, y1) & low(run));
+        if run < BLOCK as u32 {
+            return;
+        }
+        k += BLOCK;
+    }
+}
+
+/// Every overlapping pair inside run `ra` of `s` (each box scans forward)
+/// and, with `next`, of `ra` against the next strip (as [`sweep_two`]), in
+/// one pass over `ra`, into a candidate list. (Skipping the boxes that end
+/// above the next strip's highest top edge was measured: the unpredictable
+/// branch costs more than the scan it saves.)
 #[inline]
-fn sweep_self_and_next<S: Sink>(s: &Strips, ra: Range<usize>, next: &Row, sink: &mut S) {
-    let mut p = next.start as usize;
+fn sweep_self_and_next(s: &Strips, ra: Range<usize>, next: Option<&Row>, c: &mut Cands<'_>) {
+    let (mut p, max_w) = next.map_or((0, 0), |r| (r.start as usize, r.max_w));
     for i in ra {
-        let (x0, x1, y0, y1) = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
-        scan(s, i + 1, x0, x1, y0, y1, |j| sink.hit(s, i, s, j));
-        advance(s, &mut p, x0, next.max_w);
-        scan(s, p, x0, x1, y0, y1, |j| sink.hit(s, i, s, j));
+        let x = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
+        scan_into(s, i + 1, i, x, c);
+        if next.is_some() {
+            advance(s, &mut p, x.0, max_w);
+            scan_into(s, p, i, x, c);
+        }
     }
 }
 
 /// Same-level pairs for the dynamic strips `rows` (row-table indices of
 /// `dy`): inside each strip, with the next strip, and with the static strips
 /// one above, level with and one below.
-pub(crate) fn same_level<S: Sink>(dy: &Strips, st: &Strips, rows: Range<usize>, sink: &mut S) {
-    let mut cursor = None;
-    for ri in rows {
+pub(crate) fn same_level<S: Sink>(
+    dy: &Strips,
+    st: &Strips,
+    rows: Range<usize>,
+    cands: &mut Vec<[u32; 2]>,
+    sink: &mut S,
+) {
+    // Dynamic pairs: candidates first, then the sink in one sequential pass
+    // (the scans stay free of the output's branches and buffers).
+    let mut c = Cands::new(cands);
+    for ri in rows.clone() {
         let r = dy.rows[ri];
         let run = r.start as usize..r.end as usize;
         match dy.rows.get(ri + 1) {
             Some(next) if next.key == r.key + 1 && row_level(next.key) == row_level(r.key) => {
-                sweep_self_and_next(dy, run.clone(), next, sink);
+                sweep_self_and_next(dy, run, Some(next), &mut c);
             }
-            _ => sweep_self(dy, run.clone(), sink),
+            _ => sweep_self_and_next(dy, run, None, &mut c),
         }
-        if st.rows.is_empty() {
-            continue;
-        }
+    }
+    for &[i, j] in c.pairs() {
+        sink.hit(dy, i as usize, dy, j as usize);
+    }
+    if st.rows.is_empty() {
+        return;
+    }
+    let mut cursor = None;
+    for ri in rows {
+        let r = dy.rows[ri];
+        let run = r.start as usize..r.end as usize;
         // Static strips with keys r.key - 1 ..= r.key + 1 of the same level;
         // dynamic strips come in key order, so the cursor only moves forward.
         let lo = r.key.saturating_sub(1);
