@@ -116,23 +116,25 @@ pub(crate) fn sweep_two<S: Sink>(
 
 /// Candidate pairs `[i, j]` (entries of one set), written without a branch
 /// per block: the buffer is kept longer than its contents and `n` counts
-/// the pairs in it (a register once inlined: not a store per block).
-pub(crate) struct Cands<'a> {
-    buf: &'a mut Vec<[u32; 2]>,
+/// the pairs in it. Held by value and passed by value through the sweeps
+/// (never behind a reference), so that the count and the buffer's pointer
+/// stay in registers rather than being stored at every block.
+pub(crate) struct Cands {
+    buf: Vec<[u32; 2]>,
     n: usize,
 }
 
-impl<'a> Cands<'a> {
+impl Cands {
     /// An empty list over `buf` (whose contents are overwritten).
     #[inline]
-    pub fn new(buf: &'a mut Vec<[u32; 2]>) -> Self {
+    pub fn new(buf: Vec<[u32; 2]>) -> Self {
         Self { buf, n: 0 }
     }
 
-    /// The pairs found so far.
+    /// The pairs found, and the buffer to keep for the next time.
     #[inline]
-    pub fn pairs(&self) -> &[[u32; 2]] {
-        &self.buf[..self.n]
+    pub fn into_parts(self) -> (Vec<[u32; 2]>, usize) {
+        (self.buf, self.n)
     }
 
     /// Adds `[i, k + t]` for every bit `t` of `h`. The first is stored
@@ -141,7 +143,7 @@ impl<'a> Cands<'a> {
     #[inline(always)]
     fn push(&mut self, i: usize, k: usize, mut h: u32) {
         if self.n + 2 * BLOCK > self.buf.len() {
-            self.grow();
+            self.buf = grow(core::mem::take(&mut self.buf));
         }
         self.buf[self.n] = [i as u32, (k as u32).wrapping_add(h.trailing_zeros())];
         self.n += (h != 0) as usize;
@@ -152,19 +154,21 @@ impl<'a> Cands<'a> {
             h &= h - 1;
         }
     }
+}
 
-    #[cold]
-    #[inline(never)]
-    fn grow(&mut self) {
-        let len = (2 * self.buf.len()).max(1024);
-        self.buf.resize(len, [0; 2]);
-    }
+/// A longer candidate buffer (by value: no address of the list escapes).
+#[cold]
+#[inline(never)]
+fn grow(mut buf: Vec<[u32; 2]>) -> Vec<[u32; 2]> {
+    let len = (2 * buf.len()).max(1024);
+    buf.resize(len, [0; 2]);
+    buf
 }
 
 /// [`scan`] into a candidate list: box `i` against the entries of `s` from
 /// `k` on while they start left of `x1`.
 #[inline(always)]
-fn scan_into(s: &Strips, mut k: usize, i: usize, x: (i32, i32, i32, i32), c: &mut Cands<'_>) {
+fn scan_into(s: &Strips, mut k: usize, i: usize, x: (i32, i32, i32, i32), c: &mut Cands) {
     let (x0, x1, y0, y1) = x;
     loop {
         let run = lanes_lt(&s.minx, k, x1).trailing_ones();
@@ -182,16 +186,38 @@ fn scan_into(s: &Strips, mut k: usize, i: usize, x: (i32, i32, i32, i32), c: &mu
 /// above the next strip's highest top edge was measured: the unpredictable
 /// branch costs more than the scan it saves.)
 #[inline]
-fn sweep_self_and_next(s: &Strips, ra: Range<usize>, next: Option<&Row>, c: &mut Cands<'_>) {
+fn sweep_self_and_next(s: &Strips, ra: Range<usize>, next: Option<&Row>, mut c: Cands) -> Cands {
     let (mut p, max_w) = next.map_or((0, 0), |r| (r.start as usize, r.max_w));
-    for i in ra {
-        let x = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
-        scan_into(s, i + 1, i, x, c);
+    // Each box with the block after it, as windows of the four columns: the
+    // self scan's first block needs no bounds check (a run ends with its
+    // sentinel and the arrays with `PAD` more entries).
+    let r = ra.start..ra.end + BLOCK;
+    let boxes = s.minx[r.clone()]
+        .windows(BLOCK + 1)
+        .zip(s.maxx[r.clone()].windows(BLOCK + 1))
+        .zip(s.miny[r.clone()].windows(BLOCK + 1))
+        .zip(s.maxy[r].windows(BLOCK + 1));
+    for (i, (((a, b), e), d)) in ra.clone().zip(boxes) {
+        let x = (a[0], b[0], e[0], d[0]);
+        let (x0, x1, y0, y1) = x;
+        let tail = |v: &[i32]| i32x4::new([v[1], v[2], v[3], v[4]]);
+        let run = tail(a)
+            .simd_lt(i32x4::splat(x1))
+            .to_bitmask()
+            .trailing_ones();
+        let rest = tail(b).simd_gt(i32x4::splat(x0))
+            & tail(d).simd_gt(i32x4::splat(y0))
+            & i32x4::splat(y1).simd_gt(tail(e));
+        c.push(i, i + 1, rest.to_bitmask() & low(run));
+        if run == BLOCK as u32 {
+            scan_into(s, i + 1 + BLOCK, i, x, &mut c);
+        }
         if next.is_some() {
-            advance(s, &mut p, x.0, max_w);
-            scan_into(s, p, i, x, c);
+            advance(s, &mut p, x0, max_w);
+            scan_into(s, p, i, x, &mut c);
         }
     }
+    c
 }
 
 /// Same-level pairs for the dynamic strips `rows` (row-table indices of
@@ -206,20 +232,22 @@ pub(crate) fn same_level<S: Sink>(
 ) {
     // Dynamic pairs: candidates first, then the sink in one sequential pass
     // (the scans stay free of the output's branches and buffers).
-    let mut c = Cands::new(cands);
+    let mut c = Cands::new(core::mem::take(cands));
     for ri in rows.clone() {
         let r = dy.rows[ri];
         let run = r.start as usize..r.end as usize;
-        match dy.rows.get(ri + 1) {
+        c = match dy.rows.get(ri + 1) {
             Some(next) if next.key == r.key + 1 && row_level(next.key) == row_level(r.key) => {
-                sweep_self_and_next(dy, run, Some(next), &mut c);
+                sweep_self_and_next(dy, run, Some(next), c)
             }
-            _ => sweep_self_and_next(dy, run, None, &mut c),
-        }
+            _ => sweep_self_and_next(dy, run, None, c),
+        };
     }
-    for &[i, j] in c.pairs() {
+    let (buf, n) = c.into_parts();
+    for &[i, j] in &buf[..n] {
         sink.hit(dy, i as usize, dy, j as usize);
     }
+    *cands = buf;
     if st.rows.is_empty() {
         return;
     }
