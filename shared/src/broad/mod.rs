@@ -186,7 +186,7 @@ pub struct BroadPhase {
     dynamics: Strips,
     work: Vec<Work>,
     /// Candidate pairs, one buffer per work item (scratch).
-    cands: Vec<Vec<[u32; 2]>>,
+    cands: Vec<sweep::Scratch>,
     pairs: Buffers<(u32, u32)>,
     contacts: Buffers<(u32, u32, IVec2)>,
 }
@@ -346,7 +346,7 @@ impl BroadPhase {
         }
         let work = &self.work;
         if self.cands.len() < n {
-            self.cands.resize_with(n, Vec::new);
+            self.cands.resize_with(n, Default::default);
         }
         let cands = &mut self.cands[..n];
         let bufs = <Self as HasBuffers<T>>::buffers(&mut self.pairs, &mut self.contacts);
@@ -356,7 +356,7 @@ impl BroadPhase {
             1
         };
         let (item_bufs, split) = bufs.prepare(n, parts, id_lo, id_hi);
-        type Job<'a, T> = ((&'a Work, &'a mut [Vec<T>]), &'a mut Vec<[u32; 2]>);
+        type Job<'a, T> = ((&'a Work, &'a mut [Vec<T>]), &'a mut sweep::Scratch);
         let job = |((w, out), c): Job<'_, T>| {
             let mut sink = Emit {
                 out: Parts::new(out, split),
@@ -432,11 +432,11 @@ fn run_work<S: Sink>(
     dy: &Strips,
     st: &Strips,
     w: Work,
-    cands: &mut Vec<[u32; 2]>,
+    scratch: &mut sweep::Scratch,
     sink: &mut S,
 ) {
     match w {
-        Work::Rows(s, e) => sweep::same_level(dy, st, s as usize..e as usize, cands, sink),
+        Work::Rows(s, e) => sweep::same_level(lv, dy, st, s as usize..e as usize, scratch, sink),
         Work::CrossDynamic(s, e) => {
             sweep::cross_level(lv, dy, s as usize..e as usize, dy, sink);
             sweep::cross_level(lv, dy, s as usize..e as usize, st, sink);

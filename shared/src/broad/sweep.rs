@@ -114,6 +114,15 @@ pub(crate) fn sweep_two<S: Sink>(
     }
 }
 
+/// Reused buffers of one work item's sweeps.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct Scratch {
+    /// Candidate pairs.
+    cands: Vec<[u32; 2]>,
+    /// Boxes of one strip reaching into the next.
+    reach: Vec<u32>,
+}
+
 /// Candidate pairs `[i, j]` (entries of one set), written without a branch
 /// per block: the buffer is kept longer than its contents and `n` counts
 /// the pairs in it. Held by value and passed by value through the sweeps
@@ -186,8 +195,13 @@ fn scan_into(s: &Strips, mut k: usize, i: usize, x: (i32, i32, i32, i32), c: &mu
 /// above the next strip's highest top edge was measured: the unpredictable
 /// branch costs more than the scan it saves.)
 #[inline]
-fn sweep_self_and_next(s: &Strips, ra: Range<usize>, next: Option<&Row>, mut c: Cands) -> Cands {
-    let (mut p, max_w) = next.map_or((0, 0), |r| (r.start as usize, r.max_w));
+fn sweep_self_and_next(
+    s: &Strips,
+    ra: Range<usize>,
+    next: Option<(&Row, i64)>,
+    mut c: Cands,
+    reach: &mut Vec<u32>,
+) -> Cands {
     // Each box with the block after it, as windows of the four columns: the
     // self scan's first block needs no bounds check (a run ends with its
     // sentinel and the arrays with `PAD` more entries).
@@ -197,6 +211,13 @@ fn sweep_self_and_next(s: &Strips, ra: Range<usize>, next: Option<&Row>, mut c: 
         .zip(s.maxx[r.clone()].windows(BLOCK + 1))
         .zip(s.miny[r.clone()].windows(BLOCK + 1))
         .zip(s.maxy[r].windows(BLOCK + 1));
+    // The boxes reaching into the next strip (below `bottom`), listed
+    // without a branch: only they scan it.
+    if reach.len() < ra.len() {
+        reach.resize(ra.len(), 0);
+    }
+    let bottom = next.map_or(i64::MAX, |n| n.1);
+    let mut m = 0;
     for (i, (((a, b), e), d)) in ra.clone().zip(boxes) {
         let x = (a[0], b[0], e[0], d[0]);
         let (x0, x1, y0, y1) = x;
@@ -212,8 +233,15 @@ fn sweep_self_and_next(s: &Strips, ra: Range<usize>, next: Option<&Row>, mut c: 
         if run == BLOCK as u32 {
             scan_into(s, i + 1 + BLOCK, i, x, &mut c);
         }
-        if next.is_some() {
-            advance(s, &mut p, x0, max_w);
+        reach[m] = i as u32;
+        m += (y1 as i64 > bottom) as usize;
+    }
+    if let Some((next, _)) = next {
+        let mut p = next.start as usize;
+        for &i in &reach[..m] {
+            let i = i as usize;
+            let x = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
+            advance(s, &mut p, x.0, next.max_w);
             scan_into(s, p, i, x, &mut c);
         }
     }
@@ -224,30 +252,35 @@ fn sweep_self_and_next(s: &Strips, ra: Range<usize>, next: Option<&Row>, mut c: 
 /// `dy`): inside each strip, with the next strip, and with the static strips
 /// one above, level with and one below.
 pub(crate) fn same_level<S: Sink>(
+    lv: &Levels,
     dy: &Strips,
     st: &Strips,
     rows: Range<usize>,
-    cands: &mut Vec<[u32; 2]>,
+    scratch: &mut Scratch,
     sink: &mut S,
 ) {
     // Dynamic pairs: candidates first, then the sink in one sequential pass
     // (the scans stay free of the output's branches and buffers).
-    let mut c = Cands::new(core::mem::take(cands));
+    let mut c = Cands::new(core::mem::take(&mut scratch.cands));
     for ri in rows.clone() {
         let r = dy.rows[ri];
         let run = r.start as usize..r.end as usize;
-        c = match dy.rows.get(ri + 1) {
+        let next = match dy.rows.get(ri + 1) {
             Some(next) if next.key == r.key + 1 && row_level(next.key) == row_level(r.key) => {
-                sweep_self_and_next(dy, run, Some(next), c)
+                // The next strip's top edge.
+                let l = row_level(next.key);
+                let strip = (next.key & ((1 << 28) - 1)) as i64;
+                Some((next, (strip << lv.shift[l]) - (1i64 << 31)))
             }
-            _ => sweep_self_and_next(dy, run, None, c),
+            _ => None,
         };
+        c = sweep_self_and_next(dy, run, next, c, &mut scratch.reach);
     }
     let (buf, n) = c.into_parts();
     for &[i, j] in &buf[..n] {
         sink.hit(dy, i as usize, dy, j as usize);
     }
-    *cands = buf;
+    scratch.cands = buf;
     if st.rows.is_empty() {
         return;
     }
