@@ -5,7 +5,7 @@
 //! Boxes (integer corners, [`Bounds`]) are kept in *strips*: horizontal bands
 //! of height `S`, each sorted by left edge. A box goes to the finest *level*
 //! whose strip height is at least its own height (levels grow by a factor of
-//! 4 from 64 px by default, up to a single strip for the whole `i32` range),
+//! 4 from 128 px by default, up to a single strip for the whole `i32` range),
 //! so a 2 px bullet and a 4096 px platform each sit where they are cheap: a
 //! wide-but-flat platform stays on level 0 (width never matters), a tall one
 //! goes up. Two boxes of one level can only overlap if their strips are equal
@@ -137,8 +137,9 @@ fn mtv_of(a: (i32, i32, i32, i32), b: (i32, i32, i32, i32)) -> IVec2 {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BroadPhaseConfig {
     /// `log2` of the finest strip height in units (clamped to `4..=32`).
-    /// Best near the height of the common small body: the default, 14, is
-    /// 64 px.
+    /// Best at a few times the height of the common small body (only the
+    /// boxes reaching into the next strip scan it): the default, 15, is
+    /// 128 px.
     pub strip_shift: u32,
     /// `log2` of the ratio between the strip heights of consecutive levels
     /// (clamped to `1..=28`); default 2 (x4).
@@ -150,7 +151,7 @@ pub struct BroadPhaseConfig {
 impl Default for BroadPhaseConfig {
     fn default() -> Self {
         Self {
-            strip_shift: 14,
+            strip_shift: 15,
             level_shift: 2,
             batch: 1024,
         }
