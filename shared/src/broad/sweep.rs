@@ -6,9 +6,16 @@
 //! is a few 4-lane vector compares, written with `wide` so that they stay
 //! vector code whatever the optimiser decides, folded into a bit mask) and
 //! stop at the first entry that starts too far right; strips end with a
-//! sentinel that always stops a scan. The few hits are then walked bit by
-//! bit. Bodies move little, so most boxes have no or one candidate and a
-//! branchy scan would mispredict on almost every box.
+//! sentinel that always stops a scan. Bodies move little, so most boxes
+//! have no or one candidate and a branchy scan would mispredict on almost
+//! every box.
+//!
+//! Pairs of dynamic strips are not handed to the sink as they are found:
+//! each block's first hit is written into a candidate list whether or not
+//! there is one (the count then advances by `mask != 0`; only a second hit
+//! in one block branches), and the sink takes the whole list afterwards in
+//! one sequential pass. Only the boxes reaching into the next strip scan it:
+//! they are listed during the self scan, again without a branch.
 
 use super::strips::{row_level, Levels, Row, Strips, BLOCK, SENTINEL};
 use core::ops::Range;
