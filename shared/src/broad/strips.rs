@@ -28,9 +28,9 @@ use core::ops::Range;
 pub(crate) const MAX_LEVELS: usize = 16;
 /// Entries tested at once by the block kernels.
 pub(crate) const BLOCK: usize = 4;
-/// Sentinels after the last strip's sentinel, so a block read from any
-/// entry stays in bounds.
-pub(crate) const PAD: usize = BLOCK;
+/// Sentinels after the last strip's sentinel, so that two blocks read from
+/// any entry stay in bounds.
+pub(crate) const PAD: usize = 2 * BLOCK;
 /// The left edge of a sentinel.
 pub(crate) const SENTINEL: i32 = i32::MAX;
 

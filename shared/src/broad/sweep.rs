@@ -98,6 +98,26 @@ fn advance(b: &Strips, p: &mut usize, x0: i32, max_w: u32) {
     }
 }
 
+/// [`advance`] two blocks at a time, for cursors that move several entries
+/// per box (the next-strip cursor of the reaching boxes, a few of a strip):
+/// fewer loop exits to mispredict. Needs `2 * BLOCK` entries readable after
+/// the sentinel (`strips::PAD`).
+#[inline(always)]
+fn advance_far(b: &Strips, p: &mut usize, x0: i32, max_w: u32) {
+    let lo = x0 as i64 - max_w as i64;
+    if lo >= i32::MIN as i64 {
+        loop {
+            let m = lanes_le(&b.minx, *p, lo as i32)
+                | lanes_le(&b.minx, *p + BLOCK, lo as i32) << BLOCK;
+            let c = m.trailing_ones();
+            *p += c as usize;
+            if c < 2 * BLOCK as u32 {
+                break;
+            }
+        }
+    }
+}
+
 /// Every overlapping pair of a box of run `ra` of `a` with a box of run `rb`
 /// of `b` (both sorted by left edge, `rb` followed by a sentinel, no box of
 /// `rb` wider than `max_w`). For each box of `ra`, in order, a cursor in `rb`
@@ -248,7 +268,7 @@ fn sweep_self_and_next(
         for &i in &reach[..m] {
             let i = i as usize;
             let x = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
-            advance(s, &mut p, x.0, next.max_w);
+            advance_far(s, &mut p, x.0, next.max_w);
             scan_into(s, p, i, x, &mut c);
         }
     }
