@@ -152,9 +152,8 @@ pub(crate) struct Scratch {
 
 /// Candidate pairs `[i, j]` (entries of one set), written without a branch
 /// per block: the buffer is kept longer than its contents and `n` counts
-/// the pairs in it. Held by value and passed by value through the sweeps
-/// (never behind a reference), so that the count and the buffer's pointer
-/// stay in registers rather than being stored at every block.
+/// the pairs in it. Passed by value through the sweeps rather than behind
+/// a reference (measured about 1 % faster).
 pub(crate) struct Cands {
     buf: Vec<[u32; 2]>,
     n: usize,
@@ -217,10 +216,11 @@ fn scan_into(s: &Strips, mut k: usize, i: usize, x: (i32, i32, i32, i32), c: &mu
 }
 
 /// Every overlapping pair inside run `ra` of `s` (each box scans forward)
-/// and, with `next`, of `ra` against the next strip (as [`sweep_two`]), in
-/// one pass over `ra`, into a candidate list. (Skipping the boxes that end
-/// above the next strip's highest top edge was measured: the unpredictable
-/// branch costs more than the scan it saves.)
+/// and, with `next` (the next strip and its top edge), of `ra` against the
+/// next strip (as [`sweep_two`]), into a candidate list. Only the boxes
+/// reaching below the next strip's top edge can meet it: the self scan
+/// lists them without a branch (a branch per box, taken or not at random,
+/// was measured slower), then only they scan the next strip.
 #[inline]
 fn sweep_self_and_next(
     s: &Strips,
