@@ -14,7 +14,8 @@
 //! `--breakdown` (update vs pair search), `--brute-full 10000` (largest N
 //! timed in full; above it brute force is estimated from a sample of rows),
 //! `--only-fast` / `--only-par K` (quick runs of our one-thread path / of it
-//! against rayon on K threads in alternating passes).
+//! against rayon on K threads in alternating passes), `--runs 5` (five whole
+//! comparisons, then a summary per N).
 //!
 //! Each method runs in its own pass over a fresh copy of the scene (same
 //! seed, so the very same boxes every tick), so that none of them finds
@@ -76,6 +77,10 @@ struct Args {
     /// Rounds: every method runs once per round, medians over all rounds.
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..))]
     rounds: u64,
+    /// Whole comparisons in a row (each printed), then a summary per N of
+    /// every run's one-thread figures and the least rapier2d / ours.
+    #[arg(long, default_value_t = 1)]
+    runs: usize,
 }
 
 /// `--only-par K`: our one-thread path and rayon on `k` threads in
@@ -716,8 +721,47 @@ fn main() {
             )
         })
         .collect();
-    let rows: Vec<Row> = a.ns.iter().map(|&n| run(n, &a, &pools)).collect();
+    let mut all = Vec::new();
+    for r in 0..a.runs {
+        if a.runs > 1 {
+            println!("## Run {} of {}\n", r + 1, a.runs);
+        }
+        let rows: Vec<Row> = a.ns.iter().map(|&n| run(n, &a, &pools)).collect();
+        print_run(&a, &pools, &rows);
+        all.push(rows);
+    }
+    if a.runs > 1 {
+        summary(&a, &all);
+    }
+}
 
+/// `--runs K`: per N, each run's figures side by side, and the worst.
+fn summary(a: &Args, all: &[Vec<Row>]) {
+    println!(
+        "\n## Summary of {} runs (one thread, medians per run)\n",
+        all.len()
+    );
+    println!("| N | ours | rapier2d | rapier2d / ours | least | ours / floor | fastest ticks, rapier2d / ours |");
+    println!("|---:|---|---|---|---:|---|---|");
+    for (k, &n) in a.ns.iter().enumerate() {
+        let rows: Vec<&Row> = all.iter().map(|r| &r[k]).collect();
+        let list =
+            |f: &dyn Fn(&Row) -> String| rows.iter().map(|r| f(r)).collect::<Vec<_>>().join(", ");
+        let ratio = |r: &Row| r.rapier.map_or(f64::NAN, |x| x / r.fast);
+        let least = rows.iter().map(|r| ratio(r)).fold(f64::INFINITY, f64::min);
+        println!(
+            "| {n} | {} | {} | {} | {least:.1}x | {} | {} |",
+            list(&|r| fmt_ns(r.fast)),
+            list(&|r| r.rapier.map_or("—".into(), fmt_ns)),
+            list(&|r| format!("{:.1}x", ratio(r))),
+            list(&|r| format!("{:.0}x ({})", r.fast / r.copy, fmt_ns(r.copy))),
+            list(&|r| format!("{:.1}x", r.rapier_fastest.unwrap_or(f64::NAN))),
+        );
+    }
+}
+
+/// Prints the tables of one run.
+fn print_run(a: &Args, pools: &[(usize, rayon::ThreadPool)], rows: &[Row]) {
     println!(
         "Median per tick over {} rounds of {} timed ticks (each after {} warm-up ticks), \
          detection only; ratios are times of the other method divided by ours, same run.\n",
@@ -726,14 +770,14 @@ fn main() {
     let mut head =
         String::from("| N | pairs/tick | ours, AABB fast path, 1 thread | ours, general path |");
     let mut rule = String::from("|---:|---:|---:|---:|");
-    for (k, _) in &pools {
+    for (k, _) in pools {
         head += &format!(" ours, rayon {k} thr |");
         rule += "---:|";
     }
     head += " rapier2d | brute force | copy of the boxes (floor) | rapier2d / ours | brute / ours | ours / floor |";
     rule += "---:|---:|---:|---:|---:|---:|";
     println!("{head}\n{rule}");
-    for r in &rows {
+    for r in rows {
         let mut line = format!(
             "| {} | {:.0} | {} | {} ({:.2}x) |",
             r.n,
@@ -765,7 +809,7 @@ fn main() {
         println!("\nrapier2d / ours, one thread: median of each round, and fastest tick against fastest tick\n");
         println!("| N | per round | fastest ticks |");
         println!("|---:|---|---:|");
-        for r in &rows {
+        for r in rows {
             let rounds: Vec<String> = r.rapier_rounds.iter().map(|x| format!("{x:.1}x")).collect();
             println!(
                 "| {} | {} | {:.1}x |",
@@ -782,7 +826,7 @@ fn main() {
     println!("| N | ns/body/tick | vs previous N |");
     println!("|---:|---:|---:|");
     let mut prev: Option<f64> = None;
-    for r in &rows {
+    for r in rows {
         let per = r.fast / r.n as f64;
         println!(
             "| {} | {:.1} | {} |",
@@ -796,7 +840,7 @@ fn main() {
         println!("\nBreakdown, 1 thread: update_dynamic vs contacts_aabb\n");
         println!("| N | update | pair search + MTV + sort |");
         println!("|---:|---:|---:|");
-        for r in &rows {
+        for r in rows {
             println!("| {} | {} | {} |", r.n, fmt_ns(r.update), fmt_ns(r.search));
         }
     }

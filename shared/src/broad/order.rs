@@ -157,15 +157,22 @@ impl<T: Keyed> Buffers<T> {
         (&mut self.bufs[..n], self.split)
     }
 
-    /// Sorts the pairs of the prepared buffers into `out` (cleared first),
+    /// Sorts the pairs of the prepared buffers into `out` (replacing its
+    /// contents),
     /// each part on its own (on the current rayon pool with `par`, when
     /// there are enough pairs to pay for it).
     pub fn finish(&mut self, out: &mut Vec<T>, par: bool) {
-        out.clear();
         let (split, items) = (self.split, self.items);
         let bufs = &self.bufs[..items * split.parts];
         let total: usize = bufs.iter().map(Vec::len).sum();
-        out.resize(total, T::default());
+        // Every element is overwritten by the sort: whatever `out` held is
+        // kept where it fits rather than cleared and filled again (a serial
+        // write of the whole output, 370 KB at N = 100,000).
+        if out.len() > total {
+            out.truncate(total);
+        } else {
+            out.resize(total, T::default());
+        }
         let all = Whole { bufs, split };
         let par = par && total >= PAR_SORT_MIN;
         all.sort(0..split.parts, out, &mut self.starts[..split.parts], par);

@@ -23,14 +23,15 @@
 
 use super::Bounds;
 use core::ops::Range;
+use wide::{i32x4, u32x4};
 
 /// Most levels a set can have (the level is 4 bits of the key).
 pub(crate) const MAX_LEVELS: usize = 16;
 /// Entries tested at once by the block kernels.
 pub(crate) const BLOCK: usize = 4;
-/// Sentinels after the last strip's sentinel, so a block read from any
-/// entry stays in bounds.
-pub(crate) const PAD: usize = BLOCK;
+/// Sentinels after the last strip's sentinel, so that two blocks read from
+/// any entry stay in bounds.
+pub(crate) const PAD: usize = 2 * BLOCK;
 /// The left edge of a sentinel.
 pub(crate) const SENTINEL: i32 = i32::MAX;
 
@@ -359,26 +360,66 @@ fn put(out: &mut Slices<'_>, at: usize, stay: &[Kept], new: &[Entry], acc: &mut 
 }
 
 /// Writes `run` into `out` from entry `at` on, column by column; returns
-/// the next free entry.
+/// the next free entry. Four boxes at a time: their four edges are loaded
+/// as four vectors, transposed into one vector per column and stored as
+/// such; the widest box and the id range are kept in vectors too (a width
+/// as the wrapping difference, exact for a valid box).
 #[inline(always)]
 fn put_run(out: &mut Slices<'_>, at: usize, run: &[Kept], acc: &mut Acc) -> usize {
     let end = at + run.len();
-    let cols = out.minx[at..end]
-        .iter_mut()
-        .zip(&mut out.maxx[at..end])
-        .zip(&mut out.miny[at..end])
-        .zip(&mut out.maxy[at..end])
-        .zip(&mut out.id[at..end])
-        .zip(&mut out.idx[at..end]);
-    let mut a = *acc;
-    for (e, (((((minx, maxx), miny), maxy), id), idx)) in run.iter().zip(cols) {
-        (*minx, *maxx, *miny, *maxy, *id, *idx) = (e.minx, e.maxx, e.miny, e.maxy, e.id, e.idx);
+    let mut k = at;
+    let (mut wv, mut lov, mut hiv) = (
+        u32x4::splat(acc.max_w),
+        u32x4::splat(acc.id_lo),
+        u32x4::splat(acc.id_hi),
+    );
+    let mut quads = run.chunks_exact(4);
+    for q in &mut quads {
+        let edges = |e: &Kept| i32x4::new([e.minx, e.maxx, e.miny, e.maxy]);
+        let [mnx, mxx, mny, mxy] =
+            i32x4::transpose([edges(&q[0]), edges(&q[1]), edges(&q[2]), edges(&q[3])]);
+        out.minx[k..k + 4].copy_from_slice(&mnx.to_array());
+        out.maxx[k..k + 4].copy_from_slice(&mxx.to_array());
+        out.miny[k..k + 4].copy_from_slice(&mny.to_array());
+        out.maxy[k..k + 4].copy_from_slice(&mxy.to_array());
+        let ids = [q[0].id, q[1].id, q[2].id, q[3].id];
+        out.id[k..k + 4].copy_from_slice(&ids);
+        out.idx[k..k + 4].copy_from_slice(&[q[0].idx, q[1].idx, q[2].idx, q[3].idx]);
+        let w: u32x4 = as_unsigned(mxx - mnx);
+        wv = wv.max(w);
+        let idv = u32x4::new(ids);
+        lov = lov.min(idv);
+        hiv = hiv.max(idv);
+        k += 4;
+    }
+    let mut a = Acc {
+        max_w: wv.to_array().into_iter().max().unwrap_or(0),
+        id_lo: lov.to_array().into_iter().min().unwrap_or(u32::MAX),
+        id_hi: hiv.to_array().into_iter().max().unwrap_or(0),
+    };
+    for e in quads.remainder() {
+        (
+            out.minx[k],
+            out.maxx[k],
+            out.miny[k],
+            out.maxy[k],
+            out.id[k],
+            out.idx[k],
+        ) = (e.minx, e.maxx, e.miny, e.maxy, e.id, e.idx);
         a.max_w = a.max_w.max(e.width());
         a.id_lo = a.id_lo.min(e.id);
         a.id_hi = a.id_hi.max(e.id);
+        k += 1;
     }
     *acc = a;
     end
+}
+
+/// The lanes of `v` as unsigned (the wrapping difference of two edges is
+/// the width of a valid box).
+#[inline(always)]
+fn as_unsigned(v: i32x4) -> u32x4 {
+    u32x4::new(v.to_array().map(|x| x as u32))
 }
 
 /// One set of boxes (the static or the dynamic ones) in strip order.

@@ -6,9 +6,16 @@
 //! is a few 4-lane vector compares, written with `wide` so that they stay
 //! vector code whatever the optimiser decides, folded into a bit mask) and
 //! stop at the first entry that starts too far right; strips end with a
-//! sentinel that always stops a scan. The few hits are then walked bit by
-//! bit. Bodies move little, so most boxes have no or one candidate and a
-//! branchy scan would mispredict on almost every box.
+//! sentinel that always stops a scan. Bodies move little, so most boxes
+//! have no or one candidate and a branchy scan would mispredict on almost
+//! every box.
+//!
+//! Pairs of dynamic strips are not handed to the sink as they are found:
+//! each block's first hit is written into a candidate list whether or not
+//! there is one (the count then advances by `mask != 0`; only a second hit
+//! in one block branches), and the sink takes the whole list afterwards in
+//! one sequential pass. Only the boxes reaching into the next strip scan it:
+//! they are listed during the self scan, again without a branch.
 
 use super::strips::{row_level, Levels, Row, Strips, BLOCK, SENTINEL};
 use core::ops::Range;
@@ -73,16 +80,6 @@ fn scan(s: &Strips, mut k: usize, x0: i32, x1: i32, y0: i32, y1: i32, mut hit: i
     }
 }
 
-/// Every overlapping pair inside one strip (`r` is a run of `s` sorted by
-/// left edge and followed by a sentinel): each box scans forward.
-#[inline]
-pub(crate) fn sweep_self<S: Sink>(s: &Strips, r: Range<usize>, sink: &mut S) {
-    for i in r {
-        let (x0, x1, y0, y1) = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
-        scan(s, i + 1, x0, x1, y0, y1, |j| sink.hit(s, i, s, j));
-    }
-}
-
 /// Moves cursor `p` of a run of `b` (sorted by left edge, ending in a
 /// sentinel, no box wider than `max_w`) past the boxes that end before `x0`
 /// can be reached: left edge `<= x0 - max_w`.
@@ -95,6 +92,26 @@ fn advance(b: &Strips, p: &mut usize, x0: i32, max_w: u32) {
             let c = lanes_le(&b.minx, *p, lo as i32).trailing_ones();
             *p += c as usize;
             if c < BLOCK as u32 {
+                break;
+            }
+        }
+    }
+}
+
+/// [`advance`] two blocks at a time, for cursors that move several entries
+/// per box (the next-strip cursor of the reaching boxes, a few of a strip):
+/// fewer loop exits to mispredict. Needs `2 * BLOCK` entries readable after
+/// the sentinel (`strips::PAD`).
+#[inline(always)]
+fn advance_far(b: &Strips, p: &mut usize, x0: i32, max_w: u32) {
+    let lo = x0 as i64 - max_w as i64;
+    if lo >= i32::MIN as i64 {
+        loop {
+            let m = lanes_le(&b.minx, *p, lo as i32)
+                | lanes_le(&b.minx, *p + BLOCK, lo as i32) << BLOCK;
+            let c = m.trailing_ones();
+            *p += c as usize;
+            if c < 2 * BLOCK as u32 {
                 break;
             }
         }
@@ -124,38 +141,180 @@ pub(crate) fn sweep_two<S: Sink>(
     }
 }
 
-/// [`sweep_self`] of run `ra` and [`sweep_two`] of `ra` against the next
-/// strip `next` of the same set, in one pass over `ra`. (Skipping the boxes
-/// that end above the next strip's highest top edge was measured: the
-/// unpredictable branch costs more than the scan it saves.)
-#[inline]
-fn sweep_self_and_next<S: Sink>(s: &Strips, ra: Range<usize>, next: &Row, sink: &mut S) {
-    let mut p = next.start as usize;
-    for i in ra {
-        let (x0, x1, y0, y1) = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
-        scan(s, i + 1, x0, x1, y0, y1, |j| sink.hit(s, i, s, j));
-        advance(s, &mut p, x0, next.max_w);
-        scan(s, p, x0, x1, y0, y1, |j| sink.hit(s, i, s, j));
+/// Reused buffers of one work item's sweeps.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct Scratch {
+    /// Candidate pairs.
+    cands: Vec<[u32; 2]>,
+    /// Boxes of one strip reaching into the next.
+    reach: Vec<u32>,
+}
+
+/// Candidate pairs `[i, j]` (entries of one set), written without a branch
+/// per block: the buffer is kept longer than its contents and `n` counts
+/// the pairs in it. Passed by value through the sweeps rather than behind
+/// a reference (measured about 1 % faster).
+pub(crate) struct Cands {
+    buf: Vec<[u32; 2]>,
+    n: usize,
+}
+
+impl Cands {
+    /// An empty list over `buf` (whose contents are overwritten).
+    #[inline]
+    pub fn new(buf: Vec<[u32; 2]>) -> Self {
+        Self { buf, n: 0 }
     }
+
+    /// The pairs found, and the buffer to keep for the next time.
+    #[inline]
+    pub fn into_parts(self) -> (Vec<[u32; 2]>, usize) {
+        (self.buf, self.n)
+    }
+
+    /// Adds `[i, k + t]` for every bit `t` of `h`. The first is stored
+    /// whatever `h` (and kept only if `h != 0`); only a second hit in one
+    /// block (rare) takes a branch.
+    #[inline(always)]
+    fn push(&mut self, i: usize, k: usize, mut h: u32) {
+        if self.n + 2 * BLOCK > self.buf.len() {
+            self.buf = grow(core::mem::take(&mut self.buf));
+        }
+        self.buf[self.n] = [i as u32, (k as u32).wrapping_add(h.trailing_zeros())];
+        self.n += (h != 0) as usize;
+        h &= h.wrapping_sub(1);
+        while h != 0 {
+            self.buf[self.n] = [i as u32, (k as u32).wrapping_add(h.trailing_zeros())];
+            self.n += 1;
+            h &= h - 1;
+        }
+    }
+}
+
+/// A longer candidate buffer (by value: no address of the list escapes).
+#[cold]
+#[inline(never)]
+fn grow(mut buf: Vec<[u32; 2]>) -> Vec<[u32; 2]> {
+    let len = (2 * buf.len()).max(1024);
+    buf.resize(len, [0; 2]);
+    buf
+}
+
+/// [`scan`] into a candidate list: box `i` against the entries of `s` from
+/// `k` on while they start left of `x1`.
+#[inline(always)]
+fn scan_into(s: &Strips, mut k: usize, i: usize, x: (i32, i32, i32, i32), c: &mut Cands) {
+    let (x0, x1, y0, y1) = x;
+    loop {
+        let run = lanes_lt(&s.minx, k, x1).trailing_ones();
+        c.push(i, k, lanes_rest(s, k, x0, y0, y1) & low(run));
+        if run < BLOCK as u32 {
+            return;
+        }
+        k += BLOCK;
+    }
+}
+
+/// Every overlapping pair inside run `ra` of `s` (each box scans forward)
+/// and, with `next` (the next strip and its top edge), of `ra` against the
+/// next strip (as [`sweep_two`]), into a candidate list. Only the boxes
+/// reaching below the next strip's top edge can meet it: the self scan
+/// lists them without a branch (a branch per box, taken or not at random,
+/// was measured slower), then only they scan the next strip.
+#[inline]
+fn sweep_self_and_next(
+    s: &Strips,
+    ra: Range<usize>,
+    next: Option<(&Row, i64)>,
+    mut c: Cands,
+    reach: &mut Vec<u32>,
+) -> Cands {
+    // Each box with the block after it, as windows of the four columns: the
+    // self scan's first block needs no bounds check (a run ends with its
+    // sentinel and the arrays with `PAD` more entries).
+    let r = ra.start..ra.end + BLOCK;
+    let boxes = s.minx[r.clone()]
+        .windows(BLOCK + 1)
+        .zip(s.maxx[r.clone()].windows(BLOCK + 1))
+        .zip(s.miny[r.clone()].windows(BLOCK + 1))
+        .zip(s.maxy[r].windows(BLOCK + 1));
+    // The boxes reaching into the next strip (below `bottom`), listed
+    // without a branch: only they scan it.
+    if reach.len() < ra.len() {
+        reach.resize(ra.len(), 0);
+    }
+    let bottom = next.map_or(i64::MAX, |n| n.1);
+    let mut m = 0;
+    for (i, (((a, b), e), d)) in ra.clone().zip(boxes) {
+        let x = (a[0], b[0], e[0], d[0]);
+        let (x0, x1, y0, y1) = x;
+        let tail = |v: &[i32]| i32x4::new([v[1], v[2], v[3], v[4]]);
+        let run = tail(a)
+            .simd_lt(i32x4::splat(x1))
+            .to_bitmask()
+            .trailing_ones();
+        let rest = tail(b).simd_gt(i32x4::splat(x0))
+            & tail(d).simd_gt(i32x4::splat(y0))
+            & i32x4::splat(y1).simd_gt(tail(e));
+        c.push(i, i + 1, rest.to_bitmask() & low(run));
+        if run == BLOCK as u32 {
+            scan_into(s, i + 1 + BLOCK, i, x, &mut c);
+        }
+        reach[m] = i as u32;
+        m += (y1 as i64 > bottom) as usize;
+    }
+    if let Some((next, _)) = next {
+        let mut p = next.start as usize;
+        for &i in &reach[..m] {
+            let i = i as usize;
+            let x = (s.minx[i], s.maxx[i], s.miny[i], s.maxy[i]);
+            advance_far(s, &mut p, x.0, next.max_w);
+            scan_into(s, p, i, x, &mut c);
+        }
+    }
+    c
 }
 
 /// Same-level pairs for the dynamic strips `rows` (row-table indices of
 /// `dy`): inside each strip, with the next strip, and with the static strips
 /// one above, level with and one below.
-pub(crate) fn same_level<S: Sink>(dy: &Strips, st: &Strips, rows: Range<usize>, sink: &mut S) {
+pub(crate) fn same_level<S: Sink>(
+    lv: &Levels,
+    dy: &Strips,
+    st: &Strips,
+    rows: Range<usize>,
+    scratch: &mut Scratch,
+    sink: &mut S,
+) {
+    // Dynamic pairs: candidates first, then the sink in one sequential pass
+    // (the scans stay free of the output's branches and buffers).
+    let mut c = Cands::new(core::mem::take(&mut scratch.cands));
+    for ri in rows.clone() {
+        let r = dy.rows[ri];
+        let run = r.start as usize..r.end as usize;
+        let next = match dy.rows.get(ri + 1) {
+            Some(next) if next.key == r.key + 1 && row_level(next.key) == row_level(r.key) => {
+                // The next strip's top edge.
+                let l = row_level(next.key);
+                let strip = (next.key & ((1 << 28) - 1)) as i64;
+                Some((next, (strip << lv.shift[l]) - (1i64 << 31)))
+            }
+            _ => None,
+        };
+        c = sweep_self_and_next(dy, run, next, c, &mut scratch.reach);
+    }
+    let (buf, n) = c.into_parts();
+    for &[i, j] in &buf[..n] {
+        sink.hit(dy, i as usize, dy, j as usize);
+    }
+    scratch.cands = buf;
+    if st.rows.is_empty() {
+        return;
+    }
     let mut cursor = None;
     for ri in rows {
         let r = dy.rows[ri];
         let run = r.start as usize..r.end as usize;
-        match dy.rows.get(ri + 1) {
-            Some(next) if next.key == r.key + 1 && row_level(next.key) == row_level(r.key) => {
-                sweep_self_and_next(dy, run.clone(), next, sink);
-            }
-            _ => sweep_self(dy, run.clone(), sink),
-        }
-        if st.rows.is_empty() {
-            continue;
-        }
         // Static strips with keys r.key - 1 ..= r.key + 1 of the same level;
         // dynamic strips come in key order, so the cursor only moves forward.
         let lo = r.key.saturating_sub(1);
