@@ -449,10 +449,10 @@ impl SessionState {
 #[cfg(test)]
 mod tests {
 
-    #[test]
-    fn what_came_with_the_welcome_is_handled_at_once() {
-        use ledge_shared::protocol::{NetTiming, RosterEntry};
-        let welcome = Welcome {
+    /// A welcome at `tick_rate` Hz, snapshots every other tick.
+    fn welcome_at(tick_rate: u32) -> Welcome {
+        use ledge_shared::protocol::NetTiming;
+        Welcome {
             player_id: PlayerId(1),
             room: "room-1".into(),
             level_id: "level".into(),
@@ -461,12 +461,37 @@ mod tests {
             session_token: Default::default(),
             server_tick: 0,
             timing: NetTiming {
-                tick_rate: 60,
+                tick_rate,
                 snapshot_interval: 2,
-                input_redundancy: 4,
+                input_redundancy: 8,
             },
             sim_config: vec![],
+        }
+    }
+
+    /// An empty full snapshot of `tick` reporting `input_timing`, encoded.
+    fn snapshot_datagram(tick: u64, input_timing: i16) -> Vec<u8> {
+        use ledge_shared::protocol::Snapshot;
+        let mut delta = Vec::new();
+        let empty = StateSnapshot {
+            tick,
+            ..StateSnapshot::default()
         };
+        ledge_shared::protocol::encode_delta(None, &empty, &mut delta).unwrap();
+        let snapshot = Snapshot {
+            tick,
+            baseline_tick: None,
+            last_input_tick: None,
+            input_timing,
+            delta,
+        };
+        snapshot.encode().unwrap()
+    }
+
+    #[test]
+    fn what_came_with_the_welcome_is_handled_at_once() {
+        use ledge_shared::protocol::RosterEntry;
+        let welcome = welcome_at(60);
         // The roster read in the same chunk as the welcome.
         let mut bytes = Vec::new();
         write_frame(&ServerControl::Welcome(welcome.clone()), &mut bytes).unwrap();
@@ -533,22 +558,7 @@ mod tests {
             [1, 20, 30, 31, 60, 120, 144].map(input_interval),
             [1, 1, 1, 2, 2, 4, 5]
         );
-        use ledge_shared::protocol::{NetTiming, Snapshot};
-        let welcome = Welcome {
-            player_id: PlayerId(1),
-            room: "room-1".into(),
-            level_id: "level".into(),
-            level_hash: 0,
-            level: Default::default(),
-            session_token: Default::default(),
-            server_tick: 0,
-            timing: NetTiming {
-                tick_rate: 120,
-                snapshot_interval: 2,
-                input_redundancy: 8,
-            },
-            sim_config: vec![],
-        };
+        let welcome = welcome_at(120);
         let now = Instant::now();
         let mut state = SessionState::new(welcome, FrameDecoder::new(MAX_FRAME), now).unwrap();
         let sent: Vec<u64> = (10..20)
@@ -560,20 +570,7 @@ mod tests {
         assert!(state.input_datagram(12, Buttons(1)).unwrap().is_some());
         // A datagram the server saw 5 ticks early brought 3 ticks due
         // earlier: the oldest was 2 ticks early.
-        let mut delta = Vec::new();
-        let empty = StateSnapshot {
-            tick: 2,
-            ..StateSnapshot::default()
-        };
-        ledge_shared::protocol::encode_delta(None, &empty, &mut delta).unwrap();
-        let snapshot = Snapshot {
-            tick: 2,
-            baseline_tick: None,
-            last_input_tick: None,
-            input_timing: 5,
-            delta,
-        };
-        state.on_datagram(&snapshot.encode().unwrap(), now);
+        state.on_datagram(&snapshot_datagram(2, 5), now);
         match state.poll_event() {
             Some(SessionEvent::Snapshot(update)) => assert_eq!(update.input_timing, 2),
             other => panic!("{other:?}"),
@@ -582,22 +579,7 @@ mod tests {
 
     #[test]
     fn inputs_land_in_the_tick_before_a_snapshot() {
-        use ledge_shared::protocol::{NetTiming, Snapshot};
-        let welcome = Welcome {
-            player_id: PlayerId(1),
-            room: "room-1".into(),
-            level_id: "level".into(),
-            level_hash: 0,
-            level: Default::default(),
-            session_token: Default::default(),
-            server_tick: 0,
-            timing: NetTiming {
-                tick_rate: 60,
-                snapshot_interval: 2,
-                input_redundancy: 8,
-            },
-            sim_config: vec![],
-        };
+        let welcome = welcome_at(60);
         let now = Instant::now();
         let mut state = SessionState::new(welcome, FrameDecoder::new(MAX_FRAME), now).unwrap();
         let sent = |state: &mut SessionState, ticks: std::ops::Range<u64>| -> Vec<u64> {
@@ -610,20 +592,7 @@ mod tests {
         assert_eq!(sent(&mut state, 10..17), [10, 11, 13, 15]);
         // The server says inputs arrive 3 ticks early: now the even ones
         // (17 still goes: no tick waits longer than the interval).
-        let mut delta = Vec::new();
-        let empty = StateSnapshot {
-            tick: 2,
-            ..StateSnapshot::default()
-        };
-        ledge_shared::protocol::encode_delta(None, &empty, &mut delta).unwrap();
-        let snapshot = Snapshot {
-            tick: 2,
-            baseline_tick: None,
-            last_input_tick: None,
-            input_timing: 3,
-            delta,
-        };
-        state.on_datagram(&snapshot.encode().unwrap(), now);
+        state.on_datagram(&snapshot_datagram(2, 3), now);
         assert_eq!(sent(&mut state, 17..24), [17, 18, 20, 22]);
     }
 }
