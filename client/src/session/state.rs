@@ -256,12 +256,12 @@ impl SessionState {
     /// Whether a datagram whose newest tick is `tick` should reach the
     /// server in the tick before it sends snapshots, so that the server's
     /// ACK of it rides on the next snapshot instead of going alone when its
-    /// ACK timer runs out first (quinn holds an ACK for at most the larger
-    /// of the RTT and 25 ms, less than a snapshot interval at 60 Hz on a
-    /// LAN). Input for `tick` arrives while the server's next tick is
-    /// about `tick - timing`; snapshots go after a tick `k` with
-    /// `(k + 1) % every == 0`.
-    /// (Only when snapshots go every `input_every` ticks, as at 60 Hz.)
+    /// ACK timer runs out first (quinn holds an ACK at most 25 ms, its
+    /// default `max_ack_delay`, less than a 33 ms snapshot interval). Input
+    /// for `tick` arrives while the server's next tick is about
+    /// `tick - timing`; snapshots go after a tick `k` with
+    /// `(k + 1) % every == 0`. Only when snapshots go every `input_every`
+    /// ticks, as at 60 Hz.
     fn lands_before_snapshot(&self, tick: u64) -> bool {
         if u64::from(self.welcome.timing.snapshot_interval) != self.input_every {
             return false;
