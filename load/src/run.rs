@@ -486,6 +486,9 @@ fn summarise(
     let hz = procstat::clock_ticks_per_second() as f64;
     let cpu_pct = |ticks: u64| ticks as f64 / hz / window * 100.0;
     let player_ticks = clients * window * f64::from(config.tick_hz);
+    let per_client = |name: &str| delta(name) / window / clients;
+    let packets_up = per_client("ledge_wire_datagrams_in_total");
+    let packets_down = per_client("ledge_wire_datagrams_out_total");
     Ok(RunResult {
         bots: config.bots,
         client: config.client_label(),
@@ -500,18 +503,14 @@ fn summarise(
         missed_ticks: delta("ledge_missed_ticks_total") as u64,
         late_wakeups: lateness.count_above(1.0 / f64::from(config.tick_hz.max(1))),
         lateness_p99: lateness.quantile(0.99),
-        up_bytes_per_client_s: delta("ledge_bytes_in_total") / window / clients,
-        down_bytes_per_client_s: delta("ledge_bytes_out_total") / window / clients,
-        wire_up_bytes_per_client_s: (delta("ledge_wire_bytes_in_total")
-            + IP_UDP_HEADER * delta("ledge_wire_datagrams_in_total"))
-            / window
-            / clients,
-        wire_down_bytes_per_client_s: (delta("ledge_wire_bytes_out_total")
-            + IP_UDP_HEADER * delta("ledge_wire_datagrams_out_total"))
-            / window
-            / clients,
-        packets_up_per_client_s: delta("ledge_wire_datagrams_in_total") / window / clients,
-        packets_down_per_client_s: delta("ledge_wire_datagrams_out_total") / window / clients,
+        up_bytes_per_client_s: per_client("ledge_bytes_in_total"),
+        down_bytes_per_client_s: per_client("ledge_bytes_out_total"),
+        wire_up_bytes_per_client_s: per_client("ledge_wire_bytes_in_total")
+            + IP_UDP_HEADER * packets_up,
+        wire_down_bytes_per_client_s: per_client("ledge_wire_bytes_out_total")
+            + IP_UDP_HEADER * packets_down,
+        packets_up_per_client_s: packets_up,
+        packets_down_per_client_s: packets_down,
         server_cpu_pct: cpu_pct(last.server_cpu.saturating_sub(first.server_cpu)),
         server_run_queue_wait_ms_s: last.server_wait_ns.saturating_sub(first.server_wait_ns) as f64
             / 1e6

@@ -186,8 +186,8 @@ pub struct BroadPhase {
     statics: Strips,
     dynamics: Strips,
     work: Vec<Work>,
-    /// Candidate pairs, one buffer per work item (scratch).
-    cands: Vec<sweep::Scratch>,
+    /// Sweep buffers (candidate pairs), one per work item.
+    scratch: Vec<sweep::Scratch>,
     pairs: Buffers<(u32, u32)>,
     contacts: Buffers<(u32, u32, IVec2)>,
 }
@@ -222,7 +222,7 @@ impl BroadPhase {
             statics: Strips::default(),
             dynamics: Strips::default(),
             work: Vec::new(),
-            cands: Vec::new(),
+            scratch: Vec::new(),
             pairs: Buffers::default(),
             contacts: Buffers::default(),
         }
@@ -346,10 +346,10 @@ impl BroadPhase {
             id_hi = id_hi.max(st.id_hi);
         }
         let work = &self.work;
-        if self.cands.len() < n {
-            self.cands.resize_with(n, Default::default);
+        if self.scratch.len() < n {
+            self.scratch.resize_with(n, Default::default);
         }
-        let cands = &mut self.cands[..n];
+        let scratch = &mut self.scratch[..n];
         let bufs = <Self as HasBuffers<T>>::buffers(&mut self.pairs, &mut self.contacts);
         let parts = if par {
             PARTS_PER_THREAD * rayon::current_num_threads()
@@ -369,12 +369,12 @@ impl BroadPhase {
             use rayon::prelude::*;
             work.par_iter()
                 .zip(item_bufs.par_chunks_mut(split.parts))
-                .zip(cands.par_iter_mut())
+                .zip(scratch.par_iter_mut())
                 .for_each(job);
         } else {
             work.iter()
                 .zip(item_bufs.chunks_mut(split.parts))
-                .zip(cands.iter_mut())
+                .zip(scratch.iter_mut())
                 .for_each(job);
         }
         bufs.finish(out, par);

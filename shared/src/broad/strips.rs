@@ -93,6 +93,13 @@ impl Levels {
         ((((y as u32) ^ (1 << 31)) as u64) >> self.shift[l]) as u32
     }
 
+    /// The top edge of strip `strip` of level `l` (the inverse of
+    /// [`Self::strip`]).
+    #[inline]
+    pub fn strip_top(&self, l: usize, strip: u32) -> i64 {
+        ((strip as i64) << self.shift[l]) - (1i64 << 31)
+    }
+
     /// Strip height of level `l` in units.
     #[inline]
     pub fn height(&self, l: usize) -> i64 {
@@ -122,6 +129,12 @@ pub(crate) fn row_key(key: u64) -> u32 {
 #[inline]
 pub(crate) fn row_level(row_key: u32) -> usize {
     (row_key >> 28) as usize
+}
+
+/// The strip (of its level) of a row key.
+#[inline]
+pub(crate) fn row_strip(row_key: u32) -> u32 {
+    row_key & ((1 << 28) - 1)
 }
 
 /// One non-empty strip: a run of the sorted arrays.

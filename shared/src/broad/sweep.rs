@@ -17,7 +17,7 @@
 //! one sequential pass. Only the boxes reaching into the next strip scan it:
 //! they are listed during the self scan, again without a branch.
 
-use super::strips::{row_level, Levels, Row, Strips, BLOCK, SENTINEL};
+use super::strips::{row_level, row_strip, Levels, Row, Strips, BLOCK, SENTINEL};
 use core::ops::Range;
 use wide::i32x4;
 
@@ -294,10 +294,8 @@ pub(crate) fn same_level<S: Sink>(
         let run = r.start as usize..r.end as usize;
         let next = match dy.rows.get(ri + 1) {
             Some(next) if next.key == r.key + 1 && row_level(next.key) == row_level(r.key) => {
-                // The next strip's top edge.
-                let l = row_level(next.key);
-                let strip = (next.key & ((1 << 28) - 1)) as i64;
-                Some((next, (strip << lv.shift[l]) - (1i64 << 31)))
+                let top = lv.strip_top(row_level(next.key), row_strip(next.key));
+                Some((next, top))
             }
             _ => None,
         };
