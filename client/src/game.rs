@@ -274,7 +274,7 @@ impl ClientGame {
     pub fn on_snapshot(&mut self, update: &SnapshotUpdate) -> Option<Reconciled> {
         let now = update.received;
         let tick = update.state.tick;
-        self.stats.snapshot(tick, now);
+        self.stats.snapshot(tick, update.previous_tick, now);
         let jitter = self.stats.jitter_ticks();
         let loss = self.stats.loss();
         self.interp.set_jitter(jitter);
@@ -288,6 +288,9 @@ impl ClientGame {
             .filter(|e| e.kind == kind::PLAYER && e.id != self.me.0)
             .copied()
             .collect();
+        if let Some(previous) = update.previous_tick {
+            self.interp.skipped(previous, tick);
+        }
         self.interp.push(tick, remotes, now);
         if update.last_input_tick.is_some() {
             self.clock.observe(update.input_timing);
@@ -409,6 +412,7 @@ impl ClientGame {
             jitter_ms: (s.jitter_ticks() * tick_ms) as f32,
             loss: s.loss() as f32,
             snapshot_hz: s.snapshot_hz(now) as f32,
+            quiet: s.quiet(),
             bytes_in_per_s: bytes_in as f32,
             bytes_out_per_s: bytes_out as f32,
             corrections_per_s: s.corrections_per_s(now) as f32,

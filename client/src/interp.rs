@@ -9,9 +9,18 @@
 //! arrived). `delay` is one snapshot interval plus half a tick plus
 //! [`JITTER_DELAY`] times the measured arrival jitter: with regular arrivals
 //! the next snapshot is always there before it is needed; with jitter the
-//! buffer deepens. The render tick never goes backwards: when the buffer
+//! buffer deepens. The render tick never visibly goes backwards: when the buffer
 //! runs dry it holds the newest state (an *underrun*, counted), and when it
 //! falls far behind (a stall) it jumps forward.
+//!
+//! A quiet server (nothing changed for us, [`Interpolator::skipped`]) sends
+//! snapshots a few times a second instead of every interval: the state held
+//! between them, and while the newest two frames agree the render tick
+//! goes on past the newest at its pace (holding it, not an underrun). The
+//! next snapshot sets it back to the usual delay behind it, no further
+//! back than the newest it had: everything it passed looked the same, so
+//! the step back is not seen, and the first motion after a quiet stretch
+//! (or a stalled server) plays at the usual delay.
 //!
 //! Why interpolation rather than predicting remote players with their last
 //! input: the server does not send other players' inputs (only states), so
@@ -25,7 +34,7 @@ use std::collections::VecDeque;
 
 use glam::Vec2;
 use ledge_shared::fixed::UNITS_PER_PX;
-use ledge_shared::protocol::EntityState;
+use ledge_shared::protocol::{extrapolate, EntityState};
 
 use crate::view::px2;
 
@@ -166,10 +175,20 @@ impl Interpolator {
     /// Buffers the remote `entities` of the snapshot of `tick`, which
     /// arrived at `now`. Older than the newest: ignored.
     pub fn push(&mut self, tick: u64, entities: Vec<EntityState>, now: Instant) {
-        if self.frames.back().is_some_and(|f| f.tick >= tick) {
-            return;
-        }
+        let before = match self.frames.back() {
+            Some(f) if f.tick >= tick => return,
+            f => f.map(|f| f.tick as f64),
+        };
         self.frames.push_back(Frame { tick, entities });
+        if let (Some(r), Some(before)) = (self.render, before) {
+            if r > before {
+                // Past the newest while nothing moved ([`Self::still`]):
+                // every render tick from `before` on showed the same, so
+                // going back to the usual delay behind `tick` is not seen.
+                let usual = tick as f64 - self.target_delay();
+                self.render = Some(usual.min(r).max(before));
+            }
+        }
         self.newest_arrival = Some(now);
         self.stats.snapshots += 1;
         while self.frames.len() > KEPT {
@@ -179,6 +198,51 @@ impl Interpolator {
             self.render = Some((tick as f64 - self.target_delay()).max(0.0));
             self.at = Some(now);
         }
+    }
+
+    /// The server sent no snapshot between `previous` and `tick` because
+    /// nothing but time changed: when `previous` is our newest frame, it
+    /// goes on as it was (extrapolated) until one interval before `tick`,
+    /// so that motion which starts at `tick` starts there instead of being
+    /// spread over the whole gap. Call before [`Interpolator::push`] of
+    /// `tick`.
+    pub fn skipped(&mut self, previous: u64, tick: u64) {
+        let until = tick.saturating_sub(self.interval as u64);
+        let Some(last) = self.frames.back() else {
+            return;
+        };
+        if last.tick != previous || until <= previous {
+            return;
+        }
+        let held = Frame {
+            tick: until,
+            entities: last
+                .entities
+                .iter()
+                .map(|e| extrapolate(e, until - previous))
+                .collect(),
+        };
+        self.frames.push_back(held);
+        while self.frames.len() > KEPT {
+            self.frames.pop_front();
+        }
+    }
+
+    /// Whether the newest frame is the one before it with nothing but time
+    /// changed (players standing, or moving at a constant velocity): the
+    /// render tick may pass the newest, extrapolating it, without waiting.
+    fn still(&self) -> bool {
+        let n = self.frames.len();
+        if n < 2 {
+            return false;
+        }
+        let (a, b) = (&self.frames[n - 2], &self.frames[n - 1]);
+        let back = b.tick - a.tick;
+        a.entities.len() == b.entities.len()
+            && a.entities
+                .iter()
+                .zip(&b.entities)
+                .all(|(x, y)| extrapolate(x, back) == *y)
     }
 
     /// The newest tick as it would be at `now`, if snapshots kept coming.
@@ -211,7 +275,7 @@ impl Interpolator {
             self.adjust = (error * RENDER_GAIN).clamp(-MAX_RENDER_ADJUST, MAX_RENDER_ADJUST);
             r += dt * self.rate * (1.0 + self.adjust);
         }
-        if r > newest {
+        if r > newest && !self.still() {
             if render < newest || dt > 0.0 {
                 self.stats.underruns += 1;
             }
@@ -239,7 +303,15 @@ impl Interpolator {
         };
         let a = &self.frames[i];
         let Some(b) = self.frames.get(i + 1) else {
-            return hold(a);
+            let mut out = hold(a);
+            if self.still() {
+                // Past the newest: it goes on at its velocity.
+                let ahead = (r - a.tick as f64) as f32;
+                for s in &mut out {
+                    s.pos += s.vel * ahead;
+                }
+            }
+            return out;
         };
         let f = ((r - a.tick as f64) / (b.tick - a.tick) as f64).clamp(0.0, 1.0) as f32;
         let mut out = Vec::with_capacity(a.entities.len());
@@ -420,5 +492,120 @@ mod tests {
         let r2 = it.advance(ms(t0, 2001.0)).unwrap();
         assert!(r2 > 200.0 && r2 <= 220.0, "{r2}");
         assert_eq!(it.stats().resyncs, 1);
+    }
+
+    #[test]
+    fn a_quiet_stretch_holds_still_and_the_next_motion_plays_at_the_usual_delay() {
+        let t0 = Instant::now();
+        let mut it = Interpolator::new(60, 2);
+        let at_tick = |tick: u64| ms(t0, tick as f64 * 1000.0 / 60.0 + 10.0);
+        // Snapshots every 2 ticks up to 40, then quiet (one every 12 ticks,
+        // each naming the one before), then the player runs: x = 50 px
+        // until tick 98, then 4 px a tick; the first snapshot that shows
+        // it (100) names the last quiet one (88).
+        let mut sent: Vec<(u64, Option<u64>)> = (0..=20).map(|i| (2 * i, None)).collect();
+        for t in (52..=88).step_by(12).chain([100]) {
+            let before = sent.last().unwrap().0;
+            sent.push((t, Some(before)));
+        }
+        for t in (102..=160).step_by(2) {
+            sent.push((t, Some(t - 2)));
+        }
+        let x = |tick: u64| 50 + 4 * tick.saturating_sub(98) as i32;
+        let mut next = 0;
+        let mut delays = Vec::new();
+        let mut underruns = 0;
+        for f in 0..170 * 16 {
+            // Frames every ~1 ms of a 60 Hz tick's 16.7 ms.
+            let now = ms(t0, f as f64 * 1000.0 / 60.0 / 16.0);
+            while next < sent.len() && at_tick(sent[next].0) <= now {
+                let (tick, previous) = sent[next];
+                if let Some(p) = previous {
+                    it.skipped(p, tick);
+                }
+                it.push(tick, vec![player(7, x(tick))], at_tick(tick));
+                next += 1;
+            }
+            let before = it.stats().underruns;
+            let Some(r) = it.advance(now) else { continue };
+            // From the first frames' warm-up to the end of the stream.
+            if (10.0..155.0).contains(&r) {
+                underruns += it.stats().underruns - before;
+            }
+            let drawn = it.sample()[0].pos.x;
+            // Never ahead of the truth at the render tick: still until 98.
+            let truth = 50.0 + 4.0 * (r - 98.0).max(0.0) as f32;
+            assert!(
+                (drawn - truth).abs() <= 1.0 + 1e-3,
+                "render tick {r:.2}: drawn {drawn}, truth {truth}"
+            );
+            if (120.0..150.0).contains(&r) {
+                delays.push(it.delay());
+            }
+        }
+        assert_eq!(underruns, 0, "holding still is no underrun");
+        let mean = delays.iter().sum::<f64>() / delays.len() as f64;
+        assert!(
+            (mean - it.target_delay()).abs() < 1.0,
+            "walking after the quiet stretch: delay {mean:.2}, target {:.2}",
+            it.target_delay()
+        );
+    }
+
+    #[test]
+    fn after_a_stall_of_a_still_world_the_render_tick_comes_back_at_once() {
+        let t0 = Instant::now();
+        let mut it = Interpolator::new(60, 2);
+        // Snapshots every 2 ticks of a still player up to tick 40, then the
+        // server stalls for 2 s and resumes at tick 42 with the player
+        // moving 2 px a tick.
+        let arrival = |tick: u64| {
+            let stall = if tick > 40 { 2000.0 } else { 0.0 };
+            ms(t0, tick as f64 * 1000.0 / 60.0 + stall)
+        };
+        let x = |tick: u64| 50 + 2 * tick.saturating_sub(40) as i32;
+        let mut ticks = (0..=80u64).step_by(2).peekable();
+        let mut late = Vec::new();
+        for f in 0..400 {
+            let now = ms(t0, f as f64 * 1000.0 / 60.0);
+            while let Some(&t) = ticks.peek().filter(|&&t| arrival(t) <= now) {
+                it.push(t, vec![player(7, x(t))], arrival(t));
+                ticks.next();
+            }
+            it.advance(now);
+            // Half a second after it resumed.
+            if (arrival(72)..arrival(80)).contains(&now) {
+                late.push(it.delay() - it.target_delay());
+            }
+        }
+        assert!(!late.is_empty());
+        for d in late {
+            assert!(d.abs() < 1.5, "off the target delay by {d:.2} ticks");
+        }
+    }
+
+    #[test]
+    fn past_the_newest_a_steady_runner_runs_on_and_a_skip_extrapolates() {
+        let t0 = Instant::now();
+        let mut it = Interpolator::new(60, 2);
+        let runner = |tick: u64| EntityState {
+            vel: IVec2::new(3 * UNITS_PER_PX, 0),
+            ..player(7, 3 * tick as i32)
+        };
+        let at_tick = |tick: f64| ms(t0, tick * 1000.0 / 60.0);
+        it.push(0, vec![runner(0)], at_tick(0.0));
+        it.push(2, vec![runner(2)], at_tick(2.0));
+        // Ten ticks later nothing new came: it runs on, no underrun.
+        let r = it.advance(at_tick(12.0)).unwrap();
+        assert!(r > 2.0, "{r}");
+        let x = it.sample()[0].pos.x;
+        assert!((x - 3.0 * r as f32).abs() < 1e-3, "{x} at {r}");
+        assert_eq!(it.stats().underruns, 0);
+        // The server skipped 4..12 and sends 14 (it stopped at 13): the
+        // frame held at 12 is the runner carried on to 12.
+        it.skipped(2, 14);
+        let stopped = player(7, 39);
+        it.push(14, vec![stopped], at_tick(14.0));
+        assert_eq!(it.frames[it.frames.len() - 2].entities[0], runner(12));
     }
 }

@@ -45,8 +45,9 @@ impl TransportSample {
 pub struct StatsTracker {
     rate: f64,
     interval: u64,
-    /// (arrival, tick) of recent snapshots.
-    snapshots: VecDeque<(Instant, u64)>,
+    /// (arrival, tick, the tick the server sent before it) of recent
+    /// snapshots.
+    snapshots: VecDeque<(Instant, u64, Option<u64>)>,
     /// Transit time of the previous snapshot, ticks (RFC 3550).
     last_transit: Option<f64>,
     epoch: Option<Instant>,
@@ -56,6 +57,8 @@ pub struct StatsTracker {
     rtt: Option<Duration>,
     corrections: VecDeque<Instant>,
     last_correction_px: f32,
+    /// The newest snapshot came after a gap the server left on purpose.
+    quiet: bool,
 }
 
 impl StatsTracker {
@@ -72,11 +75,13 @@ impl StatsTracker {
             rtt: None,
             corrections: VecDeque::new(),
             last_correction_px: 0.0,
+            quiet: false,
         }
     }
 
-    /// A snapshot of `tick` arrived at `at`.
-    pub fn snapshot(&mut self, tick: u64, at: Instant) {
+    /// A snapshot of `tick` arrived at `at`; the server had sent
+    /// `previous` before it ([`crate::session::SnapshotUpdate::previous_tick`]).
+    pub fn snapshot(&mut self, tick: u64, previous: Option<u64>, at: Instant) {
         let epoch = *self.epoch.get_or_insert(at);
         let transit = at.saturating_duration_since(epoch).as_secs_f64() * self.rate - tick as f64;
         if let Some(last) = self.last_transit {
@@ -84,11 +89,12 @@ impl StatsTracker {
             self.jitter += (d - self.jitter) / 16.0;
         }
         self.last_transit = Some(transit);
-        self.snapshots.push_back((at, tick));
+        self.quiet = previous.is_some_and(|p| tick.saturating_sub(p) > self.interval);
+        self.snapshots.push_back((at, tick, previous));
         while self
             .snapshots
             .front()
-            .is_some_and(|&(t, _)| at.saturating_duration_since(t) > LOSS_WINDOW)
+            .is_some_and(|&(t, _, _)| at.saturating_duration_since(t) > LOSS_WINDOW)
         {
             self.snapshots.pop_front();
         }
@@ -126,6 +132,12 @@ impl StatsTracker {
         }
     }
 
+    /// Whether the newest snapshot came after snapshots the server skipped
+    /// because nothing changed for us (a quiet connection: a few a second).
+    pub fn quiet(&self) -> bool {
+        self.quiet
+    }
+
     /// Snapshot arrival jitter, ticks (RFC 3550 estimator).
     pub fn jitter_ticks(&self) -> f64 {
         self.jitter
@@ -140,20 +152,36 @@ impl StatsTracker {
     pub fn snapshot_hz(&self, now: Instant) -> f64 {
         self.snapshots
             .iter()
-            .filter(|&&(t, _)| now.saturating_duration_since(t) <= RATE_WINDOW)
+            .filter(|&&(t, _, _)| now.saturating_duration_since(t) <= RATE_WINDOW)
             .count() as f64
             / RATE_WINDOW.as_secs_f64()
     }
 
     /// Fraction of the snapshots the server sent over the last seconds that
-    /// did not arrive (or arrived too late to be used).
+    /// did not arrive (or arrived too late to be used). Each snapshot names
+    /// the one sent before it: one that never came was lost, and so were
+    /// the snapshot intervals between it and the last one received before
+    /// it (a server sending every interval). Gaps the server left on
+    /// purpose (nothing changed) are not loss.
     pub fn loss(&self) -> f64 {
-        let (Some(&(_, first)), Some(&(_, last))) = (self.snapshots.front(), self.snapshots.back())
-        else {
+        let mut ticks: Vec<u64> = self.snapshots.iter().map(|&(_, t, _)| t).collect();
+        ticks.sort_unstable();
+        ticks.dedup();
+        let Some(&first) = ticks.first() else {
             return 0.0;
         };
-        let expected = (last.saturating_sub(first) / self.interval + 1) as f64;
-        (1.0 - self.snapshots.len() as f64 / expected).clamp(0.0, 1.0)
+        let mut lost = 0;
+        for &(_, tick, previous) in &self.snapshots {
+            let Some(p) = previous.filter(|&p| p > first && p < tick) else {
+                continue;
+            };
+            if let Err(i) = ticks.binary_search(&p) {
+                // `p > first`, so a received tick lies before it.
+                lost += (p - ticks[i - 1]).div_ceil(self.interval);
+            }
+        }
+        let expected = (ticks.len() as u64 + lost) as f64;
+        (lost as f64 / expected).clamp(0.0, 1.0)
     }
 
     /// (in, out) bytes per second over the last second.
@@ -203,7 +231,7 @@ mod tests {
         // 30 Hz snapshots for 2 s, every fifth lost, arrivals regular.
         for i in 0..60u64 {
             if i % 5 != 4 {
-                s.snapshot(2 * i, at(i * 100 / 3));
+                s.snapshot(2 * i, (2 * i).checked_sub(2), at(i * 100 / 3));
             }
             s.transport(
                 TransportSample {
@@ -233,11 +261,27 @@ mod tests {
         assert_eq!(s.corrections_per_s(now + Duration::from_secs(2)), 0.0);
         assert_eq!(s.last_correction_px(), 5.0);
 
+        // Snapshots the server skipped (their successor names the one before
+        // them) are not lost; two in a row lost are two.
+        let mut q = StatsTracker::new(60, 2);
+        q.snapshot(10, Some(8), at(0));
+        q.snapshot(34, Some(10), at(400));
+        q.snapshot(58, Some(34), at(800));
+        assert_eq!(q.loss(), 0.0, "skipped, not lost");
+        assert!(q.quiet());
+        q.snapshot(64, Some(62), at(900));
+        assert!(
+            (q.loss() - 2.0 / 6.0).abs() < 1e-9,
+            "60 and 62: {}",
+            q.loss()
+        );
+        assert!(!q.quiet(), "64 came an interval after 62");
+
         // Arrivals alternating 0 and 20 ms late: |D| = 1.2 ticks each time.
         let mut j = StatsTracker::new(60, 2);
         for i in 0..200u64 {
             let late = if i % 2 == 0 { 0 } else { 20 };
-            j.snapshot(2 * i, at(i * 100 / 3 + late));
+            j.snapshot(2 * i, None, at(i * 100 / 3 + late));
         }
         assert!(
             (j.jitter_ticks() - 1.2).abs() < 0.15,

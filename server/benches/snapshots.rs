@@ -221,7 +221,8 @@ fn run(mut world: impl FnMut(u64) -> Vec<EntityState>) -> Row {
             let lag = 2 + client % 4;
             let ack = sent.len().checked_sub(lag).map(|i| sent[i]);
             let t = Instant::now();
-            let snapshot = snaps.encode_for(ack, Some(tick - 1), 2).unwrap();
+            let previous = sent.last().copied();
+            let snapshot = snaps.encode_for(ack, previous, Some(tick - 1), 2).unwrap();
             let bytes = black_box(snapshot.encode().unwrap());
             row.delta_encode += t.elapsed();
             row.delta_bytes += bytes.len();

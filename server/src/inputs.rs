@@ -6,6 +6,11 @@
 //! tick already simulated is *late* (counted if it was new), one too far
 //! ahead is *too early* (counted). Repeats of ticks already held are the
 //! normal redundancy and cost nothing.
+//!
+//! A packet with [`InputPacket::hold`] (a quiet client's) makes its newest
+//! buttons stand for every later tick the buffer has no input for, until a
+//! newer packet says otherwise: those ticks are not starved, and the
+//! client's own inputs for them arriving late are not late if they agree.
 
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{input_timing, InputPacket};
@@ -30,6 +35,9 @@ pub struct InputBuffer {
     slots: Vec<Option<(u64, Buttons)>>,
     next_tick: u64,
     newest: Option<u64>,
+    /// The newest packet's tick and buttons when it asked for them to be
+    /// held.
+    hold: Option<(u64, Buttons)>,
 }
 
 impl InputBuffer {
@@ -40,6 +48,7 @@ impl InputBuffer {
             slots: vec![None; window.max(1)],
             next_tick,
             newest: None,
+            hold: None,
         }
     }
 
@@ -65,9 +74,11 @@ impl InputBuffer {
         };
         let end = self.next_tick.saturating_add(self.slots.len() as u64);
         let seen = self.newest;
+        let held = self.hold;
         for (tick, buttons) in packet.ticks() {
             if tick < self.next_tick {
-                if seen.is_none_or(|n| tick > n) {
+                let agreed = held.is_some_and(|(t, b)| tick > t && b == buttons);
+                if seen.is_none_or(|n| tick > n) && !agreed {
                     r.late += 1;
                 }
             } else if tick >= end {
@@ -80,6 +91,12 @@ impl InputBuffer {
                 self.slots[i] = Some((tick, buttons));
             }
         }
+        if seen.is_none_or(|n| packet.newest_tick >= n) {
+            self.hold = packet
+                .hold
+                .then(|| packet.buttons.first().map(|&b| (packet.newest_tick, b)))
+                .flatten();
+        }
         if r.fresh > 0 || r.late > 0 {
             self.newest = Some(self.newest.map_or(packet.newest_tick, |n| {
                 n.max(packet.newest_tick.min(end.saturating_sub(1)))
@@ -88,13 +105,14 @@ impl InputBuffer {
         r
     }
 
-    /// The input for `tick` (the room's current tick), if it arrived; the
-    /// buffer then waits for `tick + 1`. Ticks skipped over are discarded.
+    /// The input for `tick` (the room's current tick), if it arrived or is
+    /// held ([`InputPacket::hold`]); the buffer then waits for `tick + 1`.
+    /// Ticks skipped over are discarded.
     pub fn take(&mut self, tick: u64) -> Option<Buttons> {
         let i = self.slot(tick);
         let found = match self.slots[i] {
             Some((t, b)) if t == tick => Some(b),
-            _ => None,
+            _ => self.hold.filter(|&(t, _)| t < tick).map(|(_, b)| b),
         };
         self.slots[i] = None;
         self.next_tick = tick + 1;
@@ -145,6 +163,52 @@ mod tests {
         // 110, 109 too early; 108..105 stored.
         assert_eq!((r.fresh, r.late, r.too_early), (4, 0, 2));
         assert_eq!(buf.take(105), Some(Buttons(1)));
+    }
+
+    #[test]
+    fn held_buttons_fill_the_ticks_of_a_quiet_client_until_it_speaks() {
+        let mut buf = InputBuffer::new(8, 10);
+        // Quiet from tick 10 on, holding 4.
+        buf.receive(&packet(10, &[4, 4]).holding(true));
+        assert_eq!(buf.take(10), Some(Buttons(4)));
+        assert_eq!(buf.take(11), Some(Buttons(4)), "held, not starved");
+        assert_eq!(buf.take(12), Some(Buttons(4)));
+        // Its keepalive (newest 14) repeats ticks 10..12, already taken:
+        // they agree with the hold, so they are not late; 13 and 14 are
+        // fresh.
+        let r = buf.receive(&packet(14, &[4, 4, 4, 4, 4]).holding(true));
+        assert_eq!((r.fresh, r.late), (2, 0));
+        assert_eq!(buf.take(13), Some(Buttons(4)));
+        assert_eq!(buf.take(14), Some(Buttons(4)));
+        assert_eq!(buf.take(15), Some(Buttons(4)));
+        // A change that came too late disagrees with the hold: late. It
+        // holds nothing, so the hold ends: missing ticks starve again.
+        let r = buf.receive(&packet(15, &[1, 1]));
+        assert_eq!((r.fresh, r.late), (0, 1), "tick 15 was held as 4");
+        let r = buf.receive(&packet(17, &[1]));
+        assert_eq!(r.fresh, 1);
+        assert_eq!(buf.take(16), None);
+        assert_eq!(buf.take(17), Some(Buttons(1)));
+        assert_eq!(buf.take(18), None);
+    }
+
+    #[test]
+    fn an_older_packet_arriving_late_does_not_change_the_hold() {
+        let mut buf = InputBuffer::new(8, 0);
+        buf.receive(&packet(4, &[2]).holding(true));
+        // Reordered: an older, non-holding packet.
+        buf.receive(&packet(3, &[2, 2]));
+        for t in 0..4 {
+            buf.take(t);
+        }
+        assert_eq!(buf.take(4), Some(Buttons(2)));
+        assert_eq!(buf.take(5), Some(Buttons(2)), "still held");
+        // An older holding packet does not start a hold either.
+        let mut buf = InputBuffer::new(8, 0);
+        buf.receive(&packet(4, &[2]));
+        buf.receive(&packet(3, &[2]).holding(true));
+        buf.take(4);
+        assert_eq!(buf.take(5), None);
     }
 
     #[test]

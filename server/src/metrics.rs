@@ -208,6 +208,9 @@ pub struct Metrics {
     pub wire_datagrams_out: Counter,
     /// Their UDP payload bytes.
     pub wire_bytes_out: Counter,
+    /// Snapshots not sent to a quiet client: it sent nothing since the
+    /// last one and they would have changed nothing.
+    pub snapshots_skipped: Counter,
     /// Encoded snapshot sizes in bytes.
     pub snapshot_bytes: Family<SnapshotLabel, Histogram, fn() -> Histogram>,
     /// Ticks a player's input was missing and the previous one repeated.
@@ -284,6 +287,7 @@ impl Metrics {
             wire_bytes_in: Counter::default(),
             wire_datagrams_out: Counter::default(),
             wire_bytes_out: Counter::default(),
+            snapshots_skipped: Counter::default(),
             snapshot_bytes: Family::new_with_constructor(size_histogram as fn() -> Histogram),
             input_starvation: Family::default(),
             dropped: Family::default(),
@@ -409,6 +413,11 @@ impl Metrics {
             "wire_bytes_out",
             "UDP payload bytes sent to native QUIC players, sampled each second",
             m.wire_bytes_out.clone(),
+        );
+        r.register(
+            "snapshots_skipped",
+            "Snapshots not sent to a quiet client because they would change nothing for it",
+            m.snapshots_skipped.clone(),
         );
         r.register(
             "snapshot_bytes",

@@ -13,6 +13,13 @@
 //! `snapshot_interval` ticks capture a snapshot and send each player a
 //! delta against the snapshot it acknowledged, as a datagram when it fits
 //! and on the control stream when it does not.
+//!
+//! A quiet client (one that sent nothing since its last snapshot, holding
+//! its buttons: [`InputPacket::hold`]) gets no snapshot that would change
+//! nothing for it: nothing but time changed since both the one it
+//! acknowledged and the last one it was sent (`StateSnapshot::extrapolates_to`). It gets one again when it speaks, when anything
+//! changes, or after [`QUIET_MAX`]. An idle room then costs a few packets a
+//! second per player instead of 30 snapshots and their ACKs.
 
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -46,6 +53,12 @@ use crate::tls::DATAGRAM_SEND_BUFFER;
 /// How long the room waits for a client to acknowledge a snapshot sent on
 /// the control stream before it sends another one there.
 const STREAM_SNAPSHOT_RESEND: Duration = Duration::from_millis(1000);
+
+/// Longest a client goes without a snapshot while nothing changes (should
+/// its own quiet inputs, 5 a second, be lost): its clock and loss figure
+/// keep a sample, its acknowledged baseline stays in the room's history,
+/// and the client, which calls a server silent for 1 s stalled, never does.
+pub const QUIET_MAX: Duration = Duration::from_millis(500);
 
 /// Something for a client's control-stream writer.
 #[derive(Debug)]
@@ -391,6 +404,10 @@ struct Member {
     heard_at: u64,
     /// Its inbox's packet count when last seen.
     packets_seen: u64,
+    /// Its inbox's packet count when it was last sent a snapshot.
+    packets_at_snapshot: u64,
+    /// The tick of the last snapshot sent to it.
+    last_snapshot: Option<u64>,
     /// A connection holds it (false: lost, kept for a resume).
     attached: bool,
     /// Its connection's UDP totals at the last sample.
@@ -495,6 +512,8 @@ impl Room {
                         m.buttons = Buttons::NONE;
                         m.inbox = Arc::new(Mutex::new(PlayerInbox::new(window, tick)));
                         m.packets_seen = 0;
+                        m.packets_at_snapshot = 0;
+                        m.last_snapshot = None;
                     }
                 }
             }
@@ -569,6 +588,8 @@ impl Room {
                 attached: true,
                 heard_at: tick,
                 packets_seen: 0,
+                packets_at_snapshot: 0,
+                last_snapshot: None,
                 wire: Wire::default(),
             },
         );
@@ -601,6 +622,8 @@ impl Room {
         m.attached = true;
         m.heard_at = tick;
         m.packets_seen = 0;
+        m.packets_at_snapshot = 0;
+        m.last_snapshot = None;
         let generation = m.generation;
         info!(room = %self.config.name, %player_id, generation, tick, "player resumed");
         // The room as it is now: who joined and left meanwhile.
@@ -760,9 +783,21 @@ impl Room {
             return;
         }
         let now = Instant::now();
+        let quiet_max = (QUIET_MAX.as_secs_f64() * f64::from(self.config.tick_rate)) as u64;
         for m in self.members.values_mut().filter(|m| m.attached) {
             let (ack, timing) = {
                 let mut inbox = lock(&m.inbox);
+                let quiet = inbox.packets == m.packets_at_snapshot
+                    && m.stream_pending.is_none()
+                    && m.last_snapshot.is_some_and(|p| {
+                        tick.saturating_sub(p) < quiet_max && self.snapshots.unchanged_since(p)
+                    })
+                    && inbox.ack.is_some_and(|a| self.snapshots.unchanged_since(a));
+                if quiet {
+                    self.metrics.snapshots_skipped.inc();
+                    continue;
+                }
+                m.packets_at_snapshot = inbox.packets;
                 (inbox.ack, inbox.take_timing())
             };
             if let Some((pending, _)) = m.stream_pending {
@@ -770,7 +805,10 @@ impl Room {
                     m.stream_pending = None;
                 }
             }
-            let snapshot = match self.snapshots.encode_for(ack, m.last_applied, timing) {
+            let encoded = self
+                .snapshots
+                .encode_for(ack, m.last_snapshot, m.last_applied, timing);
+            let snapshot = match encoded {
                 Ok(s) => s,
                 Err(e) => {
                     error!(tick, "cannot encode a snapshot: {e}");
@@ -799,6 +837,7 @@ impl Room {
                     let len = bytes.len();
                     match m.link.link.send_datagram(bytes.into()) {
                         Ok(()) => {
+                            m.last_snapshot = Some(tick);
                             record_snapshot(&self.metrics, &m.link.bytes, kind, len);
                         }
                         Err(DatagramError::Lost) => {}
@@ -818,6 +857,7 @@ impl Room {
                     let len = frame.len();
                     match m.link.control.try_send(Outbound::Frame(frame)) {
                         Ok(()) => {
+                            m.last_snapshot = Some(tick);
                             m.stream_pending = Some((tick, now));
                             // Bytes are counted by the writer when written.
                             self.metrics

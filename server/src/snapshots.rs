@@ -53,12 +53,25 @@ impl RoomSnapshots {
         self.history.latest()
     }
 
+    /// Whether nothing but time changed from the snapshot of `tick` to the
+    /// newest ([`StateSnapshot::extrapolates_to`]; false when that one is
+    /// no longer kept, or none was taken): a client holding it would learn
+    /// nothing from the newest.
+    pub fn unchanged_since(&self, tick: u64) -> bool {
+        match (self.history.latest(), self.history.get(tick)) {
+            (Some(now), Some(then)) => then.extrapolates_to(now),
+            _ => false,
+        }
+    }
+
     /// The newest snapshot encoded for a client that acknowledged `ack`:
     /// a delta against it when it is still in the history (and not newer
-    /// than the snapshot), else a full snapshot.
+    /// than the snapshot), else a full snapshot. `previous` is the tick of
+    /// the last snapshot sent to that client ([`Snapshot::since_previous`]).
     pub fn encode_for(
         &mut self,
         ack: Option<u64>,
+        previous: Option<u64>,
         last_input_tick: Option<u64>,
         input_timing: i16,
     ) -> Result<Snapshot, ProtocolError> {
@@ -84,6 +97,9 @@ impl RoomSnapshots {
             baseline_tick,
             last_input_tick,
             input_timing,
+            since_previous: previous
+                .filter(|&p| p < current.tick)
+                .map_or(0, |p| u32::try_from(current.tick - p).unwrap_or(u32::MAX)),
             delta,
         })
     }
@@ -112,36 +128,68 @@ mod tests {
     fn deltas_against_acks_and_full_without() {
         let mut s = RoomSnapshots::new(4);
         s.capture(2, entities(2)).unwrap();
-        let full = s.encode_for(None, None, 0).unwrap();
+        let full = s.encode_for(None, None, None, 0).unwrap();
         assert_eq!(full.baseline_tick, None);
         let state = full.decode_state(None).unwrap();
         assert_eq!(state.entities.len(), 9, "client-simulated entity left out");
 
         s.capture(4, entities(4)).unwrap();
-        let delta = s.encode_for(Some(2), Some(3), -1).unwrap();
+        let delta = s.encode_for(Some(2), Some(2), Some(3), -1).unwrap();
         assert_eq!(delta.baseline_tick, Some(2));
         assert_eq!((delta.last_input_tick, delta.input_timing), (Some(3), -1));
+        assert_eq!((delta.since_previous, delta.previous_tick()), (2, Some(2)));
         assert_eq!(
             delta.decode_state(Some(&state)).unwrap(),
             *s.latest().unwrap()
         );
         assert!(delta.delta.len() < full.delta.len());
         // A shared baseline is encoded once, the envelope is per client.
-        let again = s.encode_for(Some(2), None, 5).unwrap();
+        let again = s.encode_for(Some(2), None, None, 5).unwrap();
         assert_eq!(again.delta, delta.delta);
 
         // Unknown or future acks: full.
-        assert_eq!(s.encode_for(Some(3), None, 0).unwrap().baseline_tick, None);
-        assert_eq!(s.encode_for(Some(99), None, 0).unwrap().baseline_tick, None);
+        assert_eq!(
+            s.encode_for(Some(3), None, None, 0).unwrap().baseline_tick,
+            None
+        );
+        assert_eq!(
+            s.encode_for(Some(99), None, None, 0).unwrap().baseline_tick,
+            None
+        );
         // Acks older than the history: full.
         for t in [6, 8, 10, 12] {
             s.capture(t, entities(t)).unwrap();
         }
-        assert_eq!(s.encode_for(Some(2), None, 0).unwrap().baseline_tick, None);
         assert_eq!(
-            s.encode_for(Some(6), None, 0).unwrap().baseline_tick,
+            s.encode_for(Some(2), None, None, 0).unwrap().baseline_tick,
+            None
+        );
+        assert_eq!(
+            s.encode_for(Some(6), None, None, 0).unwrap().baseline_tick,
             Some(6)
         );
         assert!(s.capture(12, entities(12)).is_err(), "same tick twice");
+    }
+
+    #[test]
+    fn unchanged_compares_the_entities_of_a_kept_snapshot() {
+        let mut s = RoomSnapshots::new(3);
+        assert!(!s.unchanged_since(0), "nothing captured");
+        s.capture(1, entities(0)).unwrap();
+        s.capture(2, entities(0)).unwrap();
+        assert!(s.unchanged_since(1));
+        assert!(s.unchanged_since(2), "itself");
+        s.capture(3, entities(3)).unwrap();
+        assert!(!s.unchanged_since(2), "entities moved");
+        s.capture(4, entities(3)).unwrap();
+        assert!(s.unchanged_since(3));
+        let mut runner = entities(0);
+        runner[1].vel.x = 5;
+        s.capture(5, runner.clone()).unwrap();
+        runner[1].pos.x += 10;
+        s.capture(7, runner).unwrap();
+        assert!(s.unchanged_since(5), "moved on at its velocity");
+        assert!(!s.unchanged_since(1), "no longer kept");
+        assert!(!s.unchanged_since(9), "never taken");
     }
 }

@@ -272,8 +272,9 @@ fn input_packet() -> impl Strategy<Value = InputPacket> {
         any_tick(),
         proptest::collection::vec(buttons(), 1..=MAX_INPUT_HISTORY),
         proptest::option::of(any_tick()),
+        any::<bool>(),
     )
-        .prop_map(|(tick, b, ack)| InputPacket::new(tick, &b, ack))
+        .prop_map(|(tick, b, ack, hold)| InputPacket::new(tick, &b, ack).holding(hold))
 }
 
 /// One edit of a valid encoding.
@@ -863,12 +864,14 @@ fn input_packet_validation() {
         newest_tick: 5,
         buttons: vec![],
         ack_snapshot: None,
+        hold: false,
     };
     assert!(empty.encode().is_err());
     let before_zero = InputPacket {
         newest_tick: 1,
         buttons: vec![Buttons(0); 3],
         ack_snapshot: None,
+        hold: false,
     };
     assert!(before_zero.encode().is_err());
     let raw = bincode::serde::encode_to_vec(&before_zero, bincode::config::standard()).unwrap();
@@ -1034,7 +1037,7 @@ fn idle_and_typical_deltas_are_small() {
     let input = InputPacket::new(t0 + 5, &ticks, Some(t0 + 2))
         .encode()
         .unwrap();
-    assert!(input.len() <= 12, "input datagram: {} bytes", input.len());
+    assert!(input.len() <= 13, "input datagram: {} bytes", input.len());
     eprintln!(
         "sizes: idle delta (200 entities) {idle_len} B, idle snapshot datagram {} B; \
          8 moving players delta {} B, datagram {} B; full state of 200 entities {} B; \
@@ -1103,7 +1106,11 @@ fn documented_example_bytes() {
     let input = InputPacket::new(300, &[Buttons(Buttons::JUMP), Buttons(0)], Some(297));
     assert_eq!(
         input.encode().unwrap(),
-        [0xFB, 0x2C, 0x01, 0x04, 0x00, 0x10, 0x00, 0x00, 0x01, 0x05]
+        [0xFB, 0x2C, 0x01, 0x04, 0x00, 0x10, 0x00, 0x00, 0x01, 0x05, 0x00]
+    );
+    assert_eq!(
+        input.holding(true).encode().unwrap(),
+        [0xFB, 0x2C, 0x01, 0x04, 0x00, 0x10, 0x00, 0x00, 0x01, 0x05, 0x01]
     );
 }
 

@@ -240,9 +240,11 @@ async fn a_lost_input_burst_is_corrected_with_blending_and_prediction_converges(
         corrections.iter().all(|(tick, ..)| *tick <= burst.end + 20),
         "not converged: {corrections:?}"
     );
-    let tail: Vec<_> = c.log.iter().rev().take(30).collect();
+    // (Standing still, the client is quiet: a few snapshots a second.)
+    let newest = c.log.iter().map(|r| r.tick).max().unwrap();
+    let tail: Vec<_> = c.log.iter().filter(|r| r.tick + 60 > newest).collect();
     assert!(
-        tail.iter().all(|r| r.compared && !r.mispredicted),
+        tail.len() >= 4 && tail.iter().all(|r| r.compared && !r.mispredicted),
         "{tail:?}"
     );
     assert!(stats.mispredictions >= 1 && stats.corrections >= 1);

@@ -112,7 +112,7 @@ fn run(delay_ms: f64, jitter_ms: f64, loss: f64, seed: u64) -> (Figures, Figures
         let now = (f as f64 + 0.5) / RATE;
         while next < arrivals.len() && arrivals[next].0 <= now {
             let (when, tick) = arrivals[next];
-            stats.snapshot(tick, at(when));
+            stats.snapshot(tick, tick.checked_sub(2), at(when));
             interp.set_jitter(stats.jitter_ticks());
             interp.set_loss(stats.loss());
             interp.push(tick, snapshots[tick as usize].entities.clone(), at(when));

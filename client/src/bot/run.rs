@@ -15,7 +15,7 @@ use crate::bundle::{fetch_level, FetchOptions, Fetched, LevelCache};
 use crate::game::ClientGame;
 use crate::levels::level_for;
 use crate::netstats::TransportSample;
-use crate::session::{JoinOptions, Session, SessionEvent};
+use crate::session::{JoinOptions, Session, SessionEvent, SnapshotUpdate};
 use crate::trust::{connect_trusted, Trust};
 use crate::view::NetStats;
 
@@ -74,6 +74,13 @@ pub struct BotReport {
     pub ticks: u64,
     /// Snapshots received.
     pub snapshots: u64,
+    /// Server ticks the snapshots received account for: each one's distance
+    /// from the one the server sent before it, when that one arrived too (a
+    /// lost snapshot's ticks are not covered). A quiet server sends a few
+    /// snapshots a second but covers every tick.
+    pub covered_ticks: u64,
+    /// The newest snapshot's tick.
+    pub(crate) last_snapshot: Option<u64>,
     /// Snapshots where our state differed from the prediction.
     pub mispredictions: u64,
     /// Corrections of our predicted position.
@@ -99,6 +106,21 @@ pub struct BotReport {
     pub level: Option<Fetched>,
 }
 
+impl BotReport {
+    /// Counts a snapshot received ([`BotReport::snapshots`],
+    /// [`BotReport::covered_ticks`]).
+    pub fn snapshot(&mut self, update: &SnapshotUpdate) {
+        self.snapshots += 1;
+        let tick = update.state.tick;
+        if let (Some(previous), Some(last)) = (update.previous_tick, self.last_snapshot) {
+            if previous == last {
+                self.covered_ticks += tick - previous;
+            }
+        }
+        self.last_snapshot = Some(tick);
+    }
+}
+
 impl fmt::Display for BotReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let id = self
@@ -107,7 +129,7 @@ impl fmt::Display for BotReport {
         write!(
             f,
             "{:<10} {:<7} player {:>4}  ticks {:>5}  snapshots {:>4}  corrections {:>3} \
-             (max {:>5.1} px, mispredicted {:>3})  rtt {:>6.2} ms  jitter {:>5.2} ms  \
+             (max {:>5.1} px, mispredicted {:>3})  covered {:>5} ticks  rtt {:>6.2} ms  jitter {:>5.2} ms  \
              loss {:>4.1}%  goal {}",
             self.name,
             self.brain,
@@ -117,6 +139,7 @@ impl fmt::Display for BotReport {
             self.corrections,
             self.max_correction_px,
             self.mispredictions,
+            self.covered_ticks,
             self.net.rtt_ms,
             self.net.jitter_ms,
             self.net.loss * 100.0,
@@ -250,7 +273,7 @@ pub async fn run_bot(
         };
         match event {
             Ok(SessionEvent::Snapshot(update)) => {
-                report.snapshots += 1;
+                report.snapshot(&update);
                 if let Some(mine) = update.state.get(me.0) {
                     if mine.flags & player_flags::WON != 0 && !report.won {
                         report.won = true;

@@ -93,7 +93,7 @@ pub async fn run_thin_with(
         };
         match event {
             Ok(SessionEvent::Snapshot(update)) => {
-                report.snapshots += 1;
+                report.snapshot(&update);
                 clock.observe(update.input_timing);
             }
             Ok(SessionEvent::Notice(NoticeKind::Kick { reason })) => {

@@ -95,6 +95,10 @@ pub struct SnapshotUpdate {
     pub state: StateSnapshot,
     /// The snapshot it was a delta against (`None`: it came in full).
     pub baseline_tick: Option<u64>,
+    /// The snapshot the server sent us before it (`None`: the first); more
+    /// than an interval back, the server skipped those between because
+    /// nothing changed ([`ledge_shared::protocol::Snapshot::since_previous`]).
+    pub previous_tick: Option<u64>,
     /// Newest tick of our input the server had applied (`None` before the
     /// first): inputs after it are not in `state` yet.
     pub last_input_tick: Option<u64>,

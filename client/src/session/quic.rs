@@ -232,6 +232,11 @@ impl Session {
         self.state.stats()
     }
 
+    /// Whether we are quiet ([`SessionState::is_quiet`]).
+    pub fn is_quiet(&self) -> bool {
+        self.state.is_quiet()
+    }
+
     /// Records our buttons for `tick` and, when one is due, sends an input
     /// datagram carrying it and the ticks before it (as many as the server
     /// asked for in `Welcome`), plus the acknowledgement of the newest

@@ -56,6 +56,19 @@ impl InputHistory {
         }
     }
 
+    /// How many ticks (newest last, at most the history) the newest
+    /// buttons have been held.
+    fn steady(&self) -> usize {
+        let Some(&(_, newest)) = self.ticks.back() else {
+            return 0;
+        };
+        self.ticks
+            .iter()
+            .rev()
+            .take_while(|&&(_, b)| b == newest)
+            .count()
+    }
+
     /// A packet of the newest `n` ticks.
     fn packet(&self, n: usize, ack: Option<u64>) -> Option<InputPacket> {
         let &(newest, _) = self.ticks.back()?;
@@ -136,6 +149,22 @@ pub fn input_interval(tick_rate: u32) -> u64 {
     u64::from(tick_rate.div_ceil(INPUT_SEND_HZ).max(1))
 }
 
+/// Input datagrams a second while quiet: our buttons held for
+/// [`QUIET_AFTER`], our player standing still, and the world still (the
+/// newest snapshot the one before it with nothing but time changed: players
+/// standing or running steadily, run timers counting, walkers walking on).
+/// A player on the move is never quiet: its inputs and snapshots keep the
+/// full rate.
+/// Each says its buttons hold ([`InputPacket::hold`]), so the server
+/// applies them meanwhile; and since it sends a quiet client snapshots only
+/// when something changes or it hears from it, an idle player costs a few
+/// small packets a second each way instead of ~30. A button pressed ends it
+/// at once.
+pub const QUIET_SEND_HZ: u32 = 5;
+
+/// How long our buttons must stay the same before we go quiet.
+pub const QUIET_AFTER: std::time::Duration = std::time::Duration::from_millis(250);
+
 /// A welcomed session's protocol state: the roster, the snapshot history,
 /// our recent inputs, pings in flight, and the events not yet taken.
 #[derive(Debug)]
@@ -146,6 +175,15 @@ pub struct SessionState {
     redundancy: usize,
     /// Ticks between input datagrams ([`input_interval`]).
     input_every: u64,
+    /// Ticks between input datagrams while quiet ([`QUIET_SEND_HZ`]).
+    quiet_every: u64,
+    /// Ticks of steady buttons before going quiet ([`QUIET_AFTER`]).
+    quiet_after: usize,
+    /// Whether the last input datagram held its buttons (we are quiet).
+    quiet: bool,
+    /// Whether in the newest snapshot our player stood still and nothing
+    /// but time changed from the one before ([`StateSnapshot::extrapolates_to`]).
+    world_still: bool,
     /// Newest tick sent in an input datagram.
     input_sent: Option<u64>,
     /// The server's last `input_timing` (for a datagram's newest tick).
@@ -172,6 +210,12 @@ impl SessionState {
             inputs: InputHistory::default(),
             redundancy: usize::from(welcome.timing.input_redundancy).clamp(1, MAX_INPUT_HISTORY),
             input_every: input_interval(welcome.timing.tick_rate),
+            quiet_every: u64::from(welcome.timing.tick_rate.div_ceil(QUIET_SEND_HZ).max(1)),
+            quiet_after: ((QUIET_AFTER.as_secs_f64() * f64::from(welcome.timing.tick_rate))
+                as usize)
+                .clamp(1, MAX_INPUT_HISTORY),
+            quiet: false,
+            world_still: false,
             input_sent: None,
             server_timing: 0,
             welcome,
@@ -221,23 +265,39 @@ impl SessionState {
         self.stats
     }
 
+    /// Whether we are quiet: the last input datagram held its buttons
+    /// ([`QUIET_SEND_HZ`]).
+    pub fn is_quiet(&self) -> bool {
+        self.quiet
+    }
+
     /// Records our buttons for `tick` and, when one is due (every
-    /// [`input_interval`] ticks), returns the input datagram to send: this
-    /// tick and the ticks before it (as many as the server asked for in
-    /// `Welcome`, so those between datagrams go too), plus the
-    /// acknowledgement of the newest snapshot.
+    /// [`input_interval`] ticks, or [`QUIET_SEND_HZ`] times a second while
+    /// quiet), returns the input datagram to send: this tick and the ticks
+    /// before it (as many as the server asked for in `Welcome`, so those
+    /// between datagrams go too), plus the acknowledgement of the newest
+    /// snapshot.
     pub fn input_datagram(
         &mut self,
         tick: u64,
         buttons: Buttons,
     ) -> Result<Option<Vec<u8>>, ClientError> {
         self.inputs.record(tick, buttons);
+        let quiet = self.world_still && self.inputs.steady() >= self.quiet_after;
         let due = match self.input_sent {
             None => true,
             Some(sent) if tick < sent => true,
             Some(sent) => {
-                tick >= sent.saturating_add(self.input_every)
-                    || (tick > sent && self.lands_before_snapshot(tick))
+                // Quiet only once quiet was said: the datagram that says
+                // it goes at the usual time.
+                let every = if quiet && self.quiet {
+                    self.quiet_every
+                } else {
+                    self.input_every
+                };
+                let due_at = sent.saturating_add(every);
+                tick >= due_at
+                    || (tick + self.input_every > due_at && self.lands_before_snapshot(tick))
             }
         };
         if !due {
@@ -246,8 +306,10 @@ impl SessionState {
         let packet = self
             .inputs
             .packet(self.redundancy, self.ack())
-            .expect("just recorded");
+            .expect("just recorded")
+            .holding(quiet);
         let bytes = packet.encode()?;
+        self.quiet = quiet;
         self.input_sent = Some(tick);
         self.stats.inputs_sent += 1;
         Ok(Some(bytes))
@@ -421,10 +483,17 @@ impl SessionState {
                 return;
             }
         };
+        let me = self.welcome.player_id.0;
+        let still = self
+            .history
+            .latest()
+            .is_some_and(|l| l.tick < state.tick && l.extrapolates_to(&state))
+            && state.get(me).is_none_or(|e| e.vel == glam::IVec2::ZERO);
         if !self.history.insert(state.clone()) {
             self.stats.stale_snapshots += 1;
             return;
         }
+        self.world_still = still;
         self.stats.snapshots += 1;
         self.server_timing = snapshot.input_timing;
         if snapshot.baseline_tick.is_none() {
@@ -433,6 +502,7 @@ impl SessionState {
         self.push(SessionEvent::Snapshot(SnapshotUpdate {
             state,
             baseline_tick: snapshot.baseline_tick,
+            previous_tick: snapshot.previous_tick(),
             last_input_tick: snapshot.last_input_tick,
             // The server times a datagram by its newest tick; the oldest
             // tick it brings first is `input_every - 1` ticks less early.
@@ -483,6 +553,7 @@ mod tests {
             baseline_tick: None,
             last_input_tick: None,
             input_timing,
+            since_previous: 0,
             delta,
         };
         snapshot.encode().unwrap()
@@ -594,5 +665,91 @@ mod tests {
         // (17 still goes: no tick waits longer than the interval).
         state.on_datagram(&snapshot_datagram(2, 3), now);
         assert_eq!(sent(&mut state, 17..24), [17, 18, 20, 22]);
+    }
+
+    #[test]
+    fn a_still_player_in_a_still_world_goes_quiet_and_a_press_ends_it_at_once() {
+        use ledge_shared::protocol::{EntityState, Message};
+        let welcome = welcome_at(60);
+        let now = Instant::now();
+        let mut state = SessionState::new(welcome, FrameDecoder::new(MAX_FRAME), now).unwrap();
+        let sent = |state: &mut SessionState, ticks: std::ops::Range<u64>, b: u8| {
+            ticks
+                .filter_map(|t| {
+                    let bytes = state.input_datagram(t, Buttons(b)).unwrap()?;
+                    Some((t, InputPacket::decode(&bytes).unwrap().hold))
+                })
+                .collect::<Vec<_>>()
+        };
+        // The world not known still yet: 30 a second, never holding.
+        assert_eq!(
+            sent(&mut state, 10..16, 0),
+            [10, 11, 13, 15].map(|t| (t, false))
+        );
+        state.on_datagram(&snapshot_datagram(2, 0), now);
+        state.on_datagram(&snapshot_datagram(4, 0), now);
+        // Still for 15 ticks (250 ms) from tick 10: the regular datagram
+        // after that holds, then one every 12 ticks (odd ones, which land
+        // in the tick before a snapshot).
+        let quiet = sent(&mut state, 16..60, 0);
+        assert_eq!(
+            quiet[..4],
+            [(17, false), (19, false), (21, false), (23, false)]
+        );
+        assert_eq!(quiet[4..], [(25, true), (37, true), (49, true)]);
+        assert!(state.is_quiet());
+        // A press goes at once, not holding.
+        assert_eq!(sent(&mut state, 60..62, 16), [(60, false), (61, false)]);
+        assert!(!state.is_quiet());
+
+        // Quiet again, then the world moves: back to 30 a second at once.
+        let quiet = sent(&mut state, 62..100, 0);
+        assert!(quiet.last().unwrap().1, "{quiet:?}");
+        let mut moved = Vec::new();
+        let one = StateSnapshot {
+            tick: 6,
+            entities: vec![EntityState::zero(7)],
+        };
+        ledge_shared::protocol::encode_delta(None, &one, &mut moved).unwrap();
+        let moved = Snapshot {
+            tick: 6,
+            baseline_tick: None,
+            last_input_tick: None,
+            input_timing: 0,
+            since_previous: 2,
+            delta: moved,
+        };
+        state.on_datagram(&moved.encode().unwrap(), now);
+        assert_eq!(sent(&mut state, 100..102, 0), [(100, false), (101, false)]);
+
+        // Our own player running steadily (the world only extrapolates):
+        // on the move, never quiet.
+        let running = |tick: u64| {
+            let me = EntityState {
+                pos: glam::IVec2::new(100 * tick as i32, 0),
+                vel: glam::IVec2::new(100, 0),
+                ..EntityState::zero(1)
+            };
+            let state = StateSnapshot {
+                tick,
+                entities: vec![me],
+            };
+            let mut delta = Vec::new();
+            ledge_shared::protocol::encode_delta(None, &state, &mut delta).unwrap();
+            let snapshot = Snapshot {
+                tick,
+                delta,
+                ..moved.clone()
+            };
+            snapshot.encode().unwrap()
+        };
+        state.on_datagram(&running(8), now);
+        state.on_datagram(&running(10), now);
+        let on_the_move = sent(&mut state, 102..140, 0);
+        assert!(
+            on_the_move.iter().all(|&(_, hold)| !hold),
+            "{on_the_move:?}"
+        );
+        assert_eq!(on_the_move.len(), 19, "{on_the_move:?}");
     }
 }

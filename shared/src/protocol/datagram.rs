@@ -23,6 +23,7 @@ struct InputWire {
     runs: Vec<u8>,
     /// `ack_snapshot - newest_tick`, wrapping (any `u64` round-trips).
     ack: Option<i64>,
+    hold: bool,
 }
 
 impl From<InputPacket> for InputWire {
@@ -38,6 +39,7 @@ impl From<InputPacket> for InputWire {
             newest_tick: p.newest_tick,
             runs,
             ack: p.ack_snapshot.map(|a| a.wrapping_sub(p.newest_tick) as i64),
+            hold: p.hold,
         }
     }
 }
@@ -64,13 +66,18 @@ impl TryFrom<InputWire> for InputPacket {
             newest_tick: w.newest_tick,
             buttons,
             ack_snapshot: w.ack.map(|d| w.newest_tick.wrapping_add(d as u64)),
+            hold: w.hold,
         })
     }
 }
 
-/// A client's input datagram, sent every tick: the buttons of the newest
-/// tick and of the ticks before it, so one lost datagram (or several in a
-/// row, up to the redundancy) costs nothing.
+/// A client's input datagram, sent every tick or two: the buttons of the
+/// newest tick and of the ticks before it, so one lost datagram (or several
+/// in a row, up to the redundancy) costs nothing.
+///
+/// A client whose buttons and world are still goes *quiet*: it sends a
+/// packet with `hold` set and then only a few a second until its buttons
+/// change, and the server applies the held buttons to the ticks in between.
 ///
 /// On the wire (`InputWire`) the buttons go as runs of equal ticks and the
 /// acknowledgement as an offset from `newest_tick`: 16 ticks of one held
@@ -86,6 +93,10 @@ pub struct InputPacket {
     /// Tick of the newest snapshot the client has decoded (its delta
     /// baseline), `None` before the first.
     pub ack_snapshot: Option<u64>,
+    /// The buttons of `newest_tick` stay pressed after it until the next
+    /// packet: the server applies them to the ticks it gets no input for
+    /// (not counted as starved) instead of waiting for them.
+    pub hold: bool,
 }
 
 impl InputPacket {
@@ -100,7 +111,14 @@ impl InputPacket {
             newest_tick,
             buttons: newest_first[..n].to_vec(),
             ack_snapshot,
+            hold: false,
         }
+    }
+
+    /// The same packet saying whether its newest buttons are held after it
+    /// ([`InputPacket::hold`]).
+    pub fn holding(self, hold: bool) -> Self {
+        InputPacket { hold, ..self }
     }
 
     /// Oldest tick carried.
@@ -175,6 +193,13 @@ pub struct Snapshot {
     /// How early (+) or late (-), in ticks, this client's inputs arrive
     /// (see [`input_timing`]).
     pub input_timing: i16,
+    /// Ticks since the previous snapshot the server sent this client (0:
+    /// this is the first). More than the snapshot interval: the snapshots
+    /// between were not sent because nothing changed, so the state of the
+    /// previous one held until `tick` less one interval. Lets the client
+    /// tell a skipped snapshot from a lost one (its loss figure) and hold
+    /// remote players still where they were still.
+    pub since_previous: u32,
     /// The state, encoded by [`encode_delta`] (at most [`MAX_DELTA_LEN`]).
     #[serde(with = "bytes")]
     pub delta: Vec<u8>,
@@ -202,8 +227,18 @@ impl Snapshot {
             baseline_tick: baseline.map(|b| b.tick),
             last_input_tick,
             input_timing,
+            since_previous: 0,
             delta,
         })
+    }
+
+    /// The tick of the previous snapshot sent to this client
+    /// ([`Snapshot::since_previous`]), `None` for the first.
+    pub fn previous_tick(&self) -> Option<u64> {
+        match self.since_previous {
+            0 => None,
+            gap => self.tick.checked_sub(u64::from(gap)),
+        }
     }
 
     /// Decodes the state against `baseline`, which must be the snapshot of

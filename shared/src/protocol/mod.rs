@@ -63,7 +63,11 @@ pub use snapshot::{
 /// 7: input datagrams carry their buttons as runs of equal ticks and the
 /// acknowledgement as an offset from the newest tick (`InputPacket`'s wire
 /// form); clients send one every other tick at 60 Hz.
-pub const PROTOCOL_VERSION: u32 = 7;
+/// 8: idle clients and rooms go quiet: `InputPacket::hold` (the server
+/// applies held buttons to the ticks a quiet client sends none for) and
+/// `Snapshot::since_previous` (the server sends no snapshot that would
+/// change nothing for a client that sent nothing).
+pub const PROTOCOL_VERSION: u32 = 8;
 
 /// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
 /// an unrelated QUIC peer. It names the application, not the version:

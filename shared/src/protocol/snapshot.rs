@@ -126,6 +126,23 @@ pub struct StateSnapshot {
 }
 
 impl StateSnapshot {
+    /// Whether `later` is this state with nothing changed but time: the
+    /// same entities, each exactly [`extrapolate`]d by the ticks between
+    /// (a still world, run timers counting, anything moving at a constant
+    /// velocity). A delta from this state to `later` is empty, and a client
+    /// holding this state can rebuild every tick up to `later` from it.
+    pub fn extrapolates_to(&self, later: &StateSnapshot) -> bool {
+        let Some(back) = later.tick.checked_sub(self.tick) else {
+            return false;
+        };
+        self.entities.len() == later.entities.len()
+            && self
+                .entities
+                .iter()
+                .zip(&later.entities)
+                .all(|(a, b)| extrapolate(a, back) == *b)
+    }
+
     /// A snapshot of the entities `keep` accepts (for example
     /// [`is_replicated`]), in any order; sorts them by id.
     ///
@@ -614,5 +631,38 @@ mod tests {
         encode_delta(Some(&far), &fast, &mut bytes).unwrap();
         assert_eq!(decode_delta(Some(&far), &bytes).unwrap(), fast);
         assert_eq!(extrapolate(&walker(1, 10, 3), 0), walker(1, 10, 3));
+    }
+
+    #[test]
+    fn a_state_extrapolates_to_a_later_one_exactly_when_the_delta_is_empty() {
+        let base = StateSnapshot {
+            tick: 100,
+            entities: vec![walker(1, 1000, 128), walker(2, 5000, 0)],
+        };
+        let later = |tick: u64, entities| StateSnapshot { tick, entities };
+        let empty_delta = |cur: &StateSnapshot| {
+            let mut bytes = Vec::new();
+            encode_delta(Some(&base), cur, &mut bytes).unwrap();
+            bytes.len() == 4
+        };
+        let moved_on = later(
+            106,
+            vec![walker(1, 1000 + 6 * 128, 128), walker(2, 5000, 0)],
+        );
+        assert!(base.extrapolates_to(&moved_on) && empty_delta(&moved_on));
+        assert!(base.extrapolates_to(&base), "itself");
+        let turned = later(
+            106,
+            vec![walker(1, 1000 + 6 * 128, -128), walker(2, 5000, 0)],
+        );
+        assert!(!base.extrapolates_to(&turned) && !empty_delta(&turned));
+        let gone = later(106, vec![walker(1, 1000 + 6 * 128, 128)]);
+        assert!(!base.extrapolates_to(&gone));
+        let renamed = later(
+            106,
+            vec![walker(1, 1000 + 6 * 128, 128), walker(3, 5000, 0)],
+        );
+        assert!(!base.extrapolates_to(&renamed));
+        assert!(!moved_on.extrapolates_to(&base), "not backwards in time");
     }
 }

@@ -247,10 +247,15 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
                 ));
                 net.push((
                     format!(
-                        "down {:.1} kB/s   up {:.1} kB/s   {:.0} snapshots/s",
+                        "down {:.1} kB/s   up {:.1} kB/s   {:.0} snapshots/s{}",
                         n.bytes_in_per_s / 1000.0,
                         n.bytes_out_per_s / 1000.0,
-                        n.snapshot_hz
+                        n.snapshot_hz,
+                        if n.quiet {
+                            " (quiet: nothing moves)"
+                        } else {
+                            ""
+                        }
                     ),
                     DIM,
                     FONT,
