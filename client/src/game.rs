@@ -412,7 +412,7 @@ impl ClientGame {
             jitter_ms: (s.jitter_ticks() * tick_ms) as f32,
             loss: s.loss() as f32,
             snapshot_hz: s.snapshot_hz(now) as f32,
-            quiet: s.quiet(),
+            quiet: s.quiet(now),
             bytes_in_per_s: bytes_in as f32,
             bytes_out_per_s: bytes_out as f32,
             corrections_per_s: s.corrections_per_s(now) as f32,

@@ -57,8 +57,6 @@ pub struct StatsTracker {
     rtt: Option<Duration>,
     corrections: VecDeque<Instant>,
     last_correction_px: f32,
-    /// The newest snapshot came after a gap the server left on purpose.
-    quiet: bool,
 }
 
 impl StatsTracker {
@@ -75,7 +73,6 @@ impl StatsTracker {
             rtt: None,
             corrections: VecDeque::new(),
             last_correction_px: 0.0,
-            quiet: false,
         }
     }
 
@@ -89,7 +86,6 @@ impl StatsTracker {
             self.jitter += (d - self.jitter) / 16.0;
         }
         self.last_transit = Some(transit);
-        self.quiet = previous.is_some_and(|p| tick.saturating_sub(p) > self.interval);
         self.snapshots.push_back((at, tick, previous));
         while self
             .snapshots
@@ -132,10 +128,14 @@ impl StatsTracker {
         }
     }
 
-    /// Whether the newest snapshot came after snapshots the server skipped
-    /// because nothing changed for us (a quiet connection: a few a second).
-    pub fn quiet(&self) -> bool {
-        self.quiet
+    /// Whether a snapshot of the last second came after snapshots the
+    /// server skipped because nothing changed for us (a quiet connection:
+    /// a few a second).
+    pub fn quiet(&self, now: Instant) -> bool {
+        self.snapshots.iter().any(|&(at, tick, previous)| {
+            now.saturating_duration_since(at) <= RATE_WINDOW
+                && previous.is_some_and(|p| tick.saturating_sub(p) > self.interval)
+        })
     }
 
     /// Snapshot arrival jitter, ticks (RFC 3550 estimator).
@@ -268,14 +268,16 @@ mod tests {
         q.snapshot(34, Some(10), at(400));
         q.snapshot(58, Some(34), at(800));
         assert_eq!(q.loss(), 0.0, "skipped, not lost");
-        assert!(q.quiet());
+        assert!(q.quiet(at(800)));
+        assert!(!q.quiet(at(2000)), "only the last second counts");
         q.snapshot(64, Some(62), at(900));
         assert!(
             (q.loss() - 2.0 / 6.0).abs() < 1e-9,
             "60 and 62: {}",
             q.loss()
         );
-        assert!(!q.quiet(), "64 came an interval after 62");
+        assert!(q.quiet(at(900)), "58 came after a gap");
+        assert!(!q.quiet(at(1900)), "64 came an interval after 62");
 
         // Arrivals alternating 0 and 20 ms late: |D| = 1.2 ticks each time.
         let mut j = StatsTracker::new(60, 2);

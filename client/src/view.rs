@@ -164,8 +164,8 @@ pub struct NetStats {
     pub loss: f32,
     /// Snapshots received per second.
     pub snapshot_hz: f32,
-    /// The server is quiet with us: nothing changed, so it sends snapshots
-    /// a few times a second instead of every interval.
+    /// The server was quiet with us in the last second: nothing changed,
+    /// so it sent snapshots a few times a second instead of every interval.
     pub quiet: bool,
     /// Bytes received per second (UDP payload, all channels).
     pub bytes_in_per_s: f32,
