@@ -17,9 +17,10 @@
 //! A quiet client (one that sent nothing since its last snapshot, holding
 //! its buttons: [`InputPacket::hold`]) gets no snapshot that would change
 //! nothing for it: nothing but time changed since both the one it
-//! acknowledged and the last one it was sent (`StateSnapshot::extrapolates_to`). It gets one again when it speaks, when anything
-//! changes, or after [`QUIET_MAX`]. An idle room then costs a few packets a
-//! second per player instead of 30 snapshots and their ACKs.
+//! acknowledged and the last one it was sent
+//! (`StateSnapshot::extrapolates_to`). It gets one again when it speaks,
+//! when anything changes, or after [`QUIET_MAX`]. An idle room then costs a
+//! few packets a second per player instead of 30 snapshots and their ACKs.
 
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicUsize, Ordering};

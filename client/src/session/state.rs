@@ -153,13 +153,12 @@ pub fn input_interval(tick_rate: u32) -> u64 {
 /// [`QUIET_AFTER`], our player standing still, and the world still (the
 /// newest snapshot the one before it with nothing but time changed: players
 /// standing or running steadily, run timers counting, walkers walking on).
-/// A player on the move is never quiet: its inputs and snapshots keep the
-/// full rate.
 /// Each says its buttons hold ([`InputPacket::hold`]), so the server
 /// applies them meanwhile; and since it sends a quiet client snapshots only
 /// when something changes or it hears from it, an idle player costs a few
 /// small packets a second each way instead of ~30. A button pressed ends it
-/// at once.
+/// at once; a player on the move is never quiet (its inputs and snapshots
+/// keep the full rate).
 pub const QUIET_SEND_HZ: u32 = 5;
 
 /// How long our buttons must stay the same before we go quiet.
@@ -297,7 +296,8 @@ impl SessionState {
                 };
                 let due_at = sent.saturating_add(every);
                 tick >= due_at
-                    || (tick + self.input_every > due_at && self.lands_before_snapshot(tick))
+                    || (tick.saturating_add(self.input_every) > due_at
+                        && self.lands_before_snapshot(tick))
             }
         };
         if !due {
