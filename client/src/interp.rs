@@ -9,18 +9,19 @@
 //! arrived). `delay` is one snapshot interval plus half a tick plus
 //! [`JITTER_DELAY`] times the measured arrival jitter: with regular arrivals
 //! the next snapshot is always there before it is needed; with jitter the
-//! buffer deepens. The render tick never visibly goes backwards: when the buffer
-//! runs dry it holds the newest state (an *underrun*, counted), and when it
-//! falls far behind (a stall) it jumps forward.
+//! buffer deepens. The render tick does not go backwards (but see below):
+//! when the buffer runs dry it holds the newest state (an *underrun*,
+//! counted), and when it falls far behind (a stall) it jumps forward.
 //!
 //! A quiet server (nothing changed for us, [`Interpolator::skipped`]) sends
 //! snapshots a few times a second instead of every interval: the state held
 //! between them, and while the newest two frames agree the render tick
-//! goes on past the newest at its pace (holding it, not an underrun). The
-//! next snapshot sets it back to the usual delay behind it, no further
-//! back than the newest it had: everything it passed looked the same, so
-//! the step back is not seen, and the first motion after a quiet stretch
-//! (or a stalled server) plays at the usual delay.
+//! goes on past the newest at its pace (extrapolating it, not an
+//! underrun), so the first motion after a quiet stretch plays at the usual
+//! delay. Should it run past the next snapshot too (the server stalled), it
+//! goes back to the usual delay behind that one, no further back than the
+//! newest it had (a standing player does not move; one extrapolated steps
+//! back to where the server says it was).
 //!
 //! Why interpolation rather than predicting remote players with their last
 //! input: the server does not send other players' inputs (only states), so
@@ -181,10 +182,11 @@ impl Interpolator {
         };
         self.frames.push_back(Frame { tick, entities });
         if let (Some(r), Some(before)) = (self.render, before) {
-            if r > before {
-                // Past the newest while nothing moved ([`Self::still`]):
-                // every render tick from `before` on showed the same, so
-                // going back to the usual delay behind `tick` is not seen.
+            if r > tick as f64 {
+                // Extrapolated ([`Self::still`]) past even this snapshot (a
+                // stalled server): back to the usual delay behind it, but
+                // not before `before`, whose state it showed meanwhile.
+                // Short of `tick`, the blend towards it carries on.
                 let usual = tick as f64 - self.target_delay();
                 self.render = Some(usual.min(r).max(before));
             }
@@ -607,5 +609,32 @@ mod tests {
         let stopped = player(7, 39);
         it.push(14, vec![stopped], at_tick(14.0));
         assert_eq!(it.frames[it.frames.len() - 2].entities[0], runner(12));
+    }
+
+    #[test]
+    fn a_late_snapshot_of_a_steady_runner_does_not_step_it_back() {
+        let t0 = Instant::now();
+        let mut it = Interpolator::new(60, 2);
+        let runner = |tick: u64| EntityState {
+            vel: IVec2::new(3 * UNITS_PER_PX, 0),
+            ..player(7, 3 * tick as i32)
+        };
+        let at_tick = |tick: f64| ms(t0, tick * 1000.0 / 60.0);
+        // On time up to 20, every quarter tick drawn; snapshot 22 is late.
+        for q in 0..=(23 * 4 + 1) {
+            let now = q as f64 / 4.0;
+            if q % 8 == 0 && q <= 80 {
+                let tick = q as u64 / 4;
+                it.push(tick, vec![runner(tick)], at_tick(now));
+            }
+            it.advance(at_tick(now));
+        }
+        let r = it.render_tick().unwrap();
+        assert!(r > 20.0 && r < 22.0, "extrapolating past 20: {r}");
+        let x = it.sample()[0].pos.x;
+        it.push(22, vec![runner(22)], at_tick(23.3));
+        it.advance(at_tick(23.35));
+        let after = it.sample()[0].pos.x;
+        assert!(after >= x, "stepped back from {x} to {after} px");
     }
 }
