@@ -381,6 +381,14 @@ mod tests {
         }
     }
 
+    /// Player 7 running right at 3 px a tick, at tick `tick`.
+    fn runner(tick: u64) -> EntityState {
+        EntityState {
+            vel: IVec2::new(3 * UNITS_PER_PX, 0),
+            ..player(7, 3 * tick as i32)
+        }
+    }
+
     fn ms(t0: Instant, ms: f64) -> Instant {
         t0 + Duration::from_secs_f64(ms / 1000.0)
     }
@@ -590,10 +598,6 @@ mod tests {
     fn past_the_newest_a_steady_runner_runs_on_and_a_skip_extrapolates() {
         let t0 = Instant::now();
         let mut it = Interpolator::new(60, 2);
-        let runner = |tick: u64| EntityState {
-            vel: IVec2::new(3 * UNITS_PER_PX, 0),
-            ..player(7, 3 * tick as i32)
-        };
         let at_tick = |tick: f64| ms(t0, tick * 1000.0 / 60.0);
         it.push(0, vec![runner(0)], at_tick(0.0));
         it.push(2, vec![runner(2)], at_tick(2.0));
@@ -615,10 +619,6 @@ mod tests {
     fn a_late_snapshot_of_a_steady_runner_does_not_step_it_back() {
         let t0 = Instant::now();
         let mut it = Interpolator::new(60, 2);
-        let runner = |tick: u64| EntityState {
-            vel: IVec2::new(3 * UNITS_PER_PX, 0),
-            ..player(7, 3 * tick as i32)
-        };
         let at_tick = |tick: f64| ms(t0, tick * 1000.0 / 60.0);
         // On time up to 20, every quarter tick drawn; snapshot 22 is late.
         for q in 0..=(23 * 4 + 1) {
