@@ -35,7 +35,7 @@ use std::collections::VecDeque;
 
 use glam::Vec2;
 use ledge_shared::fixed::UNITS_PER_PX;
-use ledge_shared::protocol::{extrapolate, EntityState};
+use ledge_shared::protocol::{extrapolate, extrapolates_to, EntityState};
 
 use crate::view::px2;
 
@@ -239,12 +239,7 @@ impl Interpolator {
             return false;
         }
         let (a, b) = (&self.frames[n - 2], &self.frames[n - 1]);
-        let back = b.tick - a.tick;
-        a.entities.len() == b.entities.len()
-            && a.entities
-                .iter()
-                .zip(&b.entities)
-                .all(|(x, y)| extrapolate(x, back) == *y)
+        extrapolates_to(&a.entities, &b.entities, b.tick - a.tick)
     }
 
     /// The newest tick as it would be at `now`, if snapshots kept coming.

@@ -41,8 +41,8 @@ pub use error::ProtocolError;
 pub use fingerprint::{Fingerprint, ParseFingerprintError};
 pub use frame::{write_frame, FrameDecoder, FRAME_HEADER};
 pub use snapshot::{
-    decode_delta, encode_delta, extrapolate, is_replicated, EntityState, SnapshotHistory,
-    StateSnapshot,
+    decode_delta, encode_delta, extrapolate, extrapolates_to, is_replicated, EntityState,
+    SnapshotHistory, StateSnapshot,
 };
 
 /// Version of this protocol, sent in [`ClientControl::Hello`]; the server

@@ -132,15 +132,10 @@ impl StateSnapshot {
     /// velocity). A delta from this state to `later` is empty, and a client
     /// holding this state can rebuild every tick up to `later` from it.
     pub fn extrapolates_to(&self, later: &StateSnapshot) -> bool {
-        let Some(back) = later.tick.checked_sub(self.tick) else {
-            return false;
-        };
-        self.entities.len() == later.entities.len()
-            && self
-                .entities
-                .iter()
-                .zip(&later.entities)
-                .all(|(a, b)| extrapolate(a, back) == *b)
+        later
+            .tick
+            .checked_sub(self.tick)
+            .is_some_and(|back| extrapolates_to(&self.entities, &later.entities, back))
     }
 
     /// A snapshot of the entities `keep` accepts (for example
@@ -289,6 +284,17 @@ pub fn extrapolate(base: &EntityState, back: u64) -> EntityState {
         ),
         ..*base
     }
+}
+
+/// Whether `later` is `earlier` [`extrapolate`]d by `back` ticks, entity
+/// by entity (the same entities in the same order, each where its velocity
+/// carried it): [`StateSnapshot::extrapolates_to`] for bare entity lists.
+pub fn extrapolates_to(earlier: &[EntityState], later: &[EntityState], back: u64) -> bool {
+    earlier.len() == later.len()
+        && earlier
+            .iter()
+            .zip(later)
+            .all(|(a, b)| extrapolate(a, back) == *b)
 }
 
 /// One step of the merge of baseline and current ids.
