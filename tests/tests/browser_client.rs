@@ -187,15 +187,25 @@ fn play(web: SocketAddr, name: &str, webtransport: bool, seen: &Seen) {
     );
     let x0 = s["me"]["x"].as_f64().expect("our position");
 
-    // Real keys: hold Right for 1.5 s, jumping over the crate on the way
-    // (Space held a few frames: the game reads held buttons each tick).
+    // Real keys: hold Right, jumping on the way (Space held a few frames:
+    // the game reads held buttons each tick), until the page has us
+    // `WALK` px right of the start. A distance, not a time: on a loaded
+    // machine a key held "1.5 s" walked far enough to put bob (standing
+    // at the start) off the screen the camera keeps centred on us.
+    const WALK: f64 = 150.0;
     page.key_down(Key::ArrowRight).unwrap();
     std::thread::sleep(Duration::from_millis(350));
     page.key_down(Key::Space).unwrap();
     std::thread::sleep(Duration::from_millis(250));
     page.key_up(Key::Space).unwrap();
-    std::thread::sleep(Duration::from_millis(900));
+    let walked = page.wait_until(
+        &format!("ledgeState.me.x > {}", x0 + WALK),
+        Duration::from_secs(10),
+    );
     page.key_up(Key::ArrowRight).unwrap();
+    if let Err(e) = walked {
+        panic!("{transport}: holding Right did not move us {WALK} px right: {e}");
+    }
     std::thread::sleep(Duration::from_millis(300));
 
     let s = state(&mut page);
