@@ -142,6 +142,10 @@ struct LoadArgs {
     /// Players per room; the server gets enough rooms for every bot.
     #[arg(long, default_value_t = 16)]
     max_players: usize,
+    /// The server's runtime threads (ledge-server --threads; default: one
+    /// per core).
+    #[arg(long, value_name = "N")]
+    server_threads: Option<usize>,
     /// Most bots per ledge-bot process (more bots: more processes).
     #[arg(long, default_value_t = 256)]
     bots_per_process: usize,
@@ -347,11 +351,16 @@ fn load(cli: LoadArgs) -> anyhow::Result<bool> {
 
     print_machine();
     println!(
-        "server: {} Hz ticks, {} Hz snapshots, {} players per room; bots: {}; \
+        "server: {} Hz ticks, {} Hz snapshots, {} players per room, {}; bots: {}; \
          window {} s after {} s of warm-up; binaries in {}",
         cli.tick_hz,
         cli.snapshot_hz,
         cli.max_players,
+        match cli.server_threads {
+            Some(1) => "one thread".to_owned(),
+            Some(n) => format!("{n} threads"),
+            None => "a thread per core".to_owned(),
+        },
         match cli.client {
             Client::Bot => format!("ledge-bot --brain {}", cli.brain),
             Client::Thin => "ledge-bot --brain thin".to_owned(),
@@ -372,6 +381,7 @@ fn load(cli: LoadArgs) -> anyhow::Result<bool> {
             max_players: cli.max_players.max(1),
             tick_hz: cli.tick_hz,
             snapshot_hz: cli.snapshot_hz,
+            server_threads: cli.server_threads,
             brain: cli.brain.clone(),
             warmup: Duration::from_secs_f64(cli.warmup),
             duration: Duration::from_secs_f64(cli.duration),

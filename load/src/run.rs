@@ -70,6 +70,8 @@ pub struct RunConfig {
     pub tick_hz: u32,
     /// Server snapshot rate, Hz.
     pub snapshot_hz: u32,
+    /// The server's runtime threads (`--threads`); `None`: its default.
+    pub server_threads: Option<usize>,
     /// Brain of the bots (`ledge-bot --brain`).
     pub brain: String,
     /// Time between the last join and the start of the window.
@@ -217,6 +219,9 @@ fn start_server(config: &RunConfig, cert_dir: &Path, stop: &Stop) -> anyhow::Res
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(log_file(&log)?);
+    if let Some(n) = config.server_threads {
+        command.args(["--threads", &n.to_string()]);
+    }
     let mut child = Guarded::spawn("ledge-server", &mut command)?;
     let lines = Lines::spawn(child.take_stdout().context("server stdout")?, &out)?;
     let wait = |prefix: &str| -> anyhow::Result<String> {
@@ -538,6 +543,7 @@ mod tests {
             max_players: 16,
             tick_hz: 60,
             snapshot_hz: 30,
+            server_threads: None,
             brain: "runner".into(),
             warmup: Duration::from_secs(1),
             duration: Duration::from_secs(1),

@@ -50,6 +50,8 @@ pub const DEFAULT_MAX_LEVEL_MIB: u64 = 32;
 pub const DEFAULT_MAX_CONNECTIONS: usize = 256;
 /// Default bound on ticks run back to back after a stall (0.25 s at 60 Hz).
 pub const DEFAULT_MAX_CATCH_UP: u32 = 15;
+/// Most runtime threads (`--threads`).
+pub const MAX_THREADS: usize = 1024;
 /// Default QUIC idle timeout: a connection with no traffic for this long is
 /// dropped (clients send keep-alives every [`DEFAULT_IDLE_TIMEOUT`] / 3).
 pub const DEFAULT_IDLE_TIMEOUT: Duration = Duration::from_secs(10);
@@ -141,6 +143,12 @@ pub struct ServerConfig {
     pub metrics_bind: Option<SocketAddr>,
     /// Most ticks run back to back after a stall; older ones are skipped.
     pub max_catch_up: u32,
+    /// Threads of the runtime `ledge-server` builds for the rooms and the
+    /// connections; `None`: one per core. One thread runs everything on
+    /// one (the least CPU per player: no hand-offs between threads; run a
+    /// server per core to use more). [`crate::Server::bind`] itself runs
+    /// on whatever runtime calls it.
+    pub threads: Option<usize>,
     /// QUIC idle timeout: silent connections are dropped after it.
     pub idle_timeout: Duration,
     /// A joined player that sends no input for this long is removed (half
@@ -215,6 +223,7 @@ impl Default for ServerConfig {
             max_level_mib: DEFAULT_MAX_LEVEL_MIB,
             metrics_bind: None,
             max_catch_up: DEFAULT_MAX_CATCH_UP,
+            threads: None,
             idle_timeout: DEFAULT_IDLE_TIMEOUT,
             reconnect_grace: DEFAULT_RECONNECT_GRACE,
             idle_kick: DEFAULT_IDLE_KICK,
@@ -276,6 +285,14 @@ impl ServerConfig {
         }
         if self.max_connections == 0 {
             return bad("max_connections must be at least 1");
+        }
+        if self
+            .threads
+            .is_some_and(|n| !(1..=MAX_THREADS).contains(&n))
+        {
+            return Err(ConfigError::Invalid(format!(
+                "threads must be 1..={MAX_THREADS}"
+            )));
         }
         if self.record_ticks == Some(0) {
             return bad("record_ticks must be at least 1 when set");
@@ -406,6 +423,12 @@ pub struct Cli {
     /// Most joined connections (players, room listings) [default: 256].
     #[arg(long, value_name = "N")]
     pub max_connections: Option<usize>,
+    /// Threads running the rooms and the connections. 1 runs everything on
+    /// one thread: the least CPU per player (no hand-offs between
+    /// threads); run one server per core to use more [default: one per
+    /// core].
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
     /// Most connections from one address (an IPv4 address or an IPv6 /64);
     /// raise it for many players behind one NAT, or bots on one machine
     /// [default: 4].
@@ -493,6 +516,7 @@ struct FileConfig {
     cert_dir: Option<PathBuf>,
     metrics_bind: Option<SocketAddr>,
     max_catch_up: Option<u32>,
+    threads: Option<usize>,
     /// Seconds.
     idle_timeout: Option<f64>,
     /// Seconds.
@@ -584,6 +608,7 @@ impl Cli {
         set(&mut c.cert_dir, file.cert_dir.map(relative));
         set(&mut c.metrics_bind, file.metrics_bind.map(Some));
         set(&mut c.max_catch_up, file.max_catch_up);
+        set(&mut c.threads, file.threads.map(Some));
         if let Some(secs) = file.idle_timeout {
             c.idle_timeout = seconds(secs, "idle_timeout")?;
         }
@@ -627,6 +652,7 @@ impl Cli {
             c.max_rooms = c.max_rooms.max(c.rooms);
         }
         set(&mut c.max_connections, self.max_connections);
+        set(&mut c.threads, self.threads.map(Some));
         set(&mut c.max_level_mib, self.max_level_mib);
         set(&mut c.cert_dir, self.cert_dir.clone());
         set(&mut c.metrics_bind, self.metrics_bind.map(Some));
@@ -749,6 +775,7 @@ mod tests {
         assert_eq!(c.snapshot_interval(), 2);
         assert_eq!(c.level, None);
         assert_eq!(c.metrics_bind, None);
+        assert_eq!(c.threads, None, "one thread per core unless told");
     }
 
     #[test]
@@ -767,6 +794,7 @@ cert_dir = "my-certs"
 level = "levels/one.json"
 metrics_bind = "127.0.0.1:9100"
 idle_timeout = 2.5
+threads = 1
 
 [limits]
 datagrams_per_second = 500.0
@@ -783,6 +811,7 @@ datagrams_per_second = 500.0
         assert_eq!(c.level, Some(dir.path().join("levels/one.json")));
         assert_eq!(c.metrics_bind, Some("127.0.0.1:9100".parse().unwrap()));
         assert_eq!(c.idle_timeout, Duration::from_millis(2500));
+        assert_eq!(c.threads, Some(1));
         assert_eq!(c.limits.datagrams_per_second, 500.0);
         // Keys missing from [limits] keep their defaults.
         assert_eq!(c.limits.control_burst, Limits::default().control_burst);
@@ -800,9 +829,12 @@ datagrams_per_second = 500.0
             "2",
             "--cert-dir",
             "/tmp/c",
+            "--threads",
+            "3",
         ])
         .resolve()
         .unwrap();
+        assert_eq!(c.threads, Some(3));
         assert_eq!(c.bind, "127.0.0.1:6000".parse().unwrap());
         assert_eq!((c.tick_rate, c.snapshot_rate), (30, 30));
         assert_eq!(c.snapshot_interval(), 1);
@@ -843,6 +875,8 @@ datagrams_per_second = 500.0
             &["--max-rooms", "257"],
             &["--max-level-mib", "0"],
             &["--max-level-mib", "97"],
+            &["--threads", "0"],
+            &["--threads", "1025"],
         ] {
             let err = cli(args).resolve().unwrap_err();
             assert!(matches!(err, ConfigError::Invalid(_)), "{args:?}: {err}");

@@ -29,15 +29,48 @@ const EXIT_CODES: &str = "Exit codes:
      or failed while running
   2  a command-line error";
 
-#[tokio::main]
-async fn main() -> ExitCode {
-    match run().await {
+fn main() -> ExitCode {
+    match start() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             let _ = writeln!(std::io::stderr().lock(), "ledge-server: {}", told(&e));
             ExitCode::FAILURE
         }
     }
+}
+
+/// Reads the command line and the configuration, then runs the server on
+/// a runtime of `threads` threads (one: a current-thread runtime, every
+/// task on the main thread).
+fn start() -> anyhow::Result<()> {
+    let matches = Cli::command().after_help(EXIT_CODES).get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    // Logs on stderr, coloured only on a terminal; stdout carries the
+    // join instructions. A log line that cannot be written (stderr closed:
+    // `ledge-server 2>&1 | head -1`) is dropped: reporting it would
+    // `eprintln!` to the same closed stderr, which panics, and a panicking
+    // signal task would leave the server deaf to Ctrl-C and SIGTERM.
+    tracing_subscriber::fmt()
+        .with_env_filter(EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()))
+        .with_writer(std::io::stderr)
+        .with_ansi(std::io::stderr().is_terminal())
+        .log_internal_errors(false)
+        .init();
+    let config = cli.resolve().context("reading the configuration")?;
+    let runtime = match config.threads {
+        Some(1) => tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build(),
+        Some(n) => tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(n)
+            .enable_all()
+            .build(),
+        None => tokio::runtime::Builder::new_multi_thread()
+            .enable_all()
+            .build(),
+    }
+    .context("starting the async runtime")?;
+    runtime.block_on(run(config))
 }
 
 /// An error and its causes on one line, each cause once: most of our
@@ -58,22 +91,7 @@ fn told(error: &anyhow::Error) -> String {
     text
 }
 
-async fn run() -> anyhow::Result<()> {
-    let matches = Cli::command().after_help(EXIT_CODES).get_matches();
-    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
-    // Logs on stderr, coloured only on a terminal; stdout carries the
-    // join instructions. A log line that cannot be written (stderr closed:
-    // `ledge-server 2>&1 | head -1`) is dropped: reporting it would
-    // `eprintln!` to the same closed stderr, which panics, and a panicking
-    // signal task would leave the server deaf to Ctrl-C and SIGTERM.
-    tracing_subscriber::fmt()
-        .with_env_filter(EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()))
-        .with_writer(std::io::stderr)
-        .with_ansi(std::io::stderr().is_terminal())
-        .log_internal_errors(false)
-        .init();
-    let config = cli.resolve().context("reading the configuration")?;
-
+async fn run(config: ledge_server::config::ServerConfig) -> anyhow::Result<()> {
     let server = Server::bind(config.clone()).with_context(|| {
         format!(
             "starting the server on {} with certificates in {}",

@@ -220,3 +220,82 @@ fn sigint_stops_it_after_its_readers_went_away() {
         started.elapsed()
     );
 }
+
+/// `GET /metrics` from `addr`: the body.
+fn scrape(addr: &str) -> String {
+    use std::io::Write;
+    let mut stream = std::net::TcpStream::connect(addr).expect("metrics endpoint");
+    write!(
+        stream,
+        "GET /metrics HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    let mut text = String::new();
+    stream.read_to_string(&mut text).unwrap();
+    text
+}
+
+/// The value of the metric line starting `name ` in a scrape.
+fn metric(text: &str, name: &str) -> f64 {
+    text.lines()
+        .find_map(|l| l.strip_prefix(name)?.strip_prefix(' '))
+        .unwrap_or_else(|| panic!("no {name} in:\n{text}"))
+        .trim()
+        .parse()
+        .unwrap()
+}
+
+#[test]
+fn one_thread_runs_the_whole_server() {
+    let certs = tempfile::tempdir().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ledge-server"))
+        .args(["--bind", "127.0.0.1:0", "--metrics-bind", "127.0.0.1:0"])
+        .args(["--threads", "1", "--cert-dir"])
+        .arg(certs.path())
+        .env("RUST_LOG", "info")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("ledge-server starts");
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    let metrics = loop {
+        line.clear();
+        assert!(stdout.read_line(&mut line).unwrap() > 0, "no metrics line");
+        if let Some(url) = line.trim().strip_prefix("metrics at http://") {
+            break url.trim_end_matches("/metrics").to_owned();
+        }
+    };
+    // The process is one thread: the runtime's, which is main's.
+    let status = std::fs::read_to_string(format!("/proc/{}/status", child.id())).unwrap();
+    let threads = status
+        .lines()
+        .find_map(|l| l.strip_prefix("Threads:"))
+        .unwrap()
+        .trim();
+    assert_eq!(threads, "1", "{status}");
+    // Its room ticks on it: 60 a second.
+    let ticks = |text: &str| metric(text, "ledge_tick_duration_seconds_count{room=\"room-1\"}");
+    let before = ticks(&scrape(&metrics));
+    std::thread::sleep(Duration::from_millis(500));
+    let after = ticks(&scrape(&metrics));
+    assert!(after - before >= 10.0, "{before} -> {after} ticks in 0.5 s");
+    interrupt(&child);
+    let status = exits_within(&mut child, Duration::from_secs(5)).expect("stopped on SIGINT");
+    assert!(status.success(), "{status}: {}", stderr_of(&mut child));
+
+    // Zero threads is refused, saying the range.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ledge-server"))
+        .args(["--bind", "127.0.0.1:0", "--threads", "0", "--cert-dir"])
+        .arg(certs.path())
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("ledge-server starts");
+    let status = exits_within(&mut child, Duration::from_secs(30)).expect("exits");
+    let err = stderr_of(&mut child);
+    assert_eq!(status.code(), Some(1), "{err}");
+    assert!(err.contains("threads must be 1..=1024"), "{err}");
+}
