@@ -602,6 +602,21 @@ fn the_gameserver_declares_what_the_server_reports_on_the_port_it_listens_on() {
         .agones
         .expect("the image runs the server with --agones");
 
+    // It runs no more threads than the cores the container asks for (the
+    // runtime's default is one per core of the node).
+    let cpu = container["resources"]["requests"]["cpu"]
+        .as_str()
+        .expect("a CPU request");
+    let millicores: u64 = match cpu.strip_suffix('m') {
+        Some(m) => m.parse().unwrap(),
+        None => cpu.parse::<u64>().unwrap() * 1000,
+    };
+    let threads = config.threads.expect("--threads set") as u64;
+    assert!(
+        threads <= millicores.div_ceil(1000),
+        "--threads {threads} for a CPU request of {cpu}"
+    );
+
     // It listens on the port the image exposes and the GameServer opens.
     assert_eq!(config.bind.port(), image.udp_port, "--bind and EXPOSE");
     let ports = spec["ports"].as_array().expect("spec.ports");
