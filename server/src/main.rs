@@ -57,19 +57,17 @@ fn start() -> anyhow::Result<()> {
         .log_internal_errors(false)
         .init();
     let config = cli.resolve().context("reading the configuration")?;
-    let runtime = match config.threads {
-        Some(1) => tokio::runtime::Builder::new_current_thread()
-            .enable_all()
-            .build(),
-        Some(n) => tokio::runtime::Builder::new_multi_thread()
-            .worker_threads(n)
-            .enable_all()
-            .build(),
-        None => tokio::runtime::Builder::new_multi_thread()
-            .enable_all()
-            .build(),
+    let mut builder = match config.threads {
+        Some(1) => tokio::runtime::Builder::new_current_thread(),
+        _ => tokio::runtime::Builder::new_multi_thread(),
+    };
+    if let Some(n) = config.threads.filter(|&n| n > 1) {
+        builder.worker_threads(n);
     }
-    .context("starting the async runtime")?;
+    let runtime = builder
+        .enable_all()
+        .build()
+        .context("starting the async runtime")?;
     runtime.block_on(run(config))
 }
 

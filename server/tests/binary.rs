@@ -14,8 +14,14 @@ fn start(cert_dir: &std::path::Path) -> Child {
 }
 
 fn start_on(bind: &str, cert_dir: &std::path::Path) -> Child {
+    start_with(&["--bind", bind], cert_dir)
+}
+
+/// The server with `args`, its certificates in `cert_dir`.
+fn start_with(args: &[&str], cert_dir: &std::path::Path) -> Child {
     Command::new(env!("CARGO_BIN_EXE_ledge-server"))
-        .args(["--bind", bind, "--cert-dir"])
+        .args(args)
+        .arg("--cert-dir")
         .arg(cert_dir)
         .env("RUST_LOG", "info")
         .stdin(Stdio::null())
@@ -248,16 +254,17 @@ fn metric(text: &str, name: &str) -> f64 {
 #[test]
 fn one_thread_runs_the_whole_server() {
     let certs = tempfile::tempdir().unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_ledge-server"))
-        .args(["--bind", "127.0.0.1:0", "--metrics-bind", "127.0.0.1:0"])
-        .args(["--threads", "1", "--cert-dir"])
-        .arg(certs.path())
-        .env("RUST_LOG", "info")
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("ledge-server starts");
+    let mut child = start_with(
+        &[
+            "--bind",
+            "127.0.0.1:0",
+            "--metrics-bind",
+            "127.0.0.1:0",
+            "--threads",
+            "1",
+        ],
+        certs.path(),
+    );
     let mut stdout = BufReader::new(child.stdout.take().unwrap());
     let mut line = String::new();
     let metrics = loop {
@@ -286,14 +293,7 @@ fn one_thread_runs_the_whole_server() {
     assert!(status.success(), "{status}: {}", stderr_of(&mut child));
 
     // Zero threads is refused, saying the range.
-    let mut child = Command::new(env!("CARGO_BIN_EXE_ledge-server"))
-        .args(["--bind", "127.0.0.1:0", "--threads", "0", "--cert-dir"])
-        .arg(certs.path())
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("ledge-server starts");
+    let mut child = start_with(&["--bind", "127.0.0.1:0", "--threads", "0"], certs.path());
     let status = exits_within(&mut child, Duration::from_secs(30)).expect("exits");
     let err = stderr_of(&mut child);
     assert_eq!(status.code(), Some(1), "{err}");
