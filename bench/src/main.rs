@@ -81,6 +81,33 @@ struct Args {
     /// every run's one-thread figures and the least rapier2d / ours.
     #[arg(long, default_value_t = 1)]
     runs: usize,
+    /// Pin worker `i` of every rayon pool (and calibration thread `i`) to
+    /// core `i`. Unpinned, Linux sometimes stacks both workers of a
+    /// two-thread pool on one core for tens of milliseconds (seen on this
+    /// 2-vCPU VM: whole rounds at 1.0x); pinned, every round shows the
+    /// parallel path itself.
+    #[arg(long)]
+    pin: bool,
+}
+
+/// Pins the calling thread to core `i` (modulo the cores this process may
+/// use) when `pin` is set; silently a no-op where the OS refuses.
+fn pin_to(i: usize, pin: bool) {
+    if !pin {
+        return;
+    }
+    if let Some(cores) = core_affinity::get_core_ids().filter(|c| !c.is_empty()) {
+        core_affinity::set_for_current(cores[i % cores.len()]);
+    }
+}
+
+/// A rayon pool of `k` workers, pinned one per core with `pin`.
+fn new_pool(k: usize, pin: bool) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(k)
+        .start_handler(move |i| pin_to(i, pin))
+        .build()
+        .expect("a thread pool")
 }
 
 /// `--only-par K`: our one-thread path and rayon on `k` threads in
@@ -91,14 +118,8 @@ struct Args {
 /// lasting longer than a tick cannot favour either way. `reference` is a
 /// one-thread trace whose output every pass must match.
 fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Trace) {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(k)
-        .build()
-        .expect("a thread pool");
-    let pool1 = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("a thread pool");
+    let pool = new_pool(k, a.pin);
+    let pool1 = new_pool(1, a.pin);
     // Per timed tick: (update, search) of each side.
     let (mut one, mut many) = (Vec::new(), Vec::new());
     let (mut rounds, mut both) = (Vec::new(), Vec::new());
@@ -124,7 +145,14 @@ fn only_par(n: usize, a: &Args, cfg: BroadPhaseConfig, k: usize, reference: &Tra
             .ns
         };
         std::thread::scope(|sc| {
-            let hs: Vec<_> = (0..k).map(|t| sc.spawn(move || serial(t))).collect();
+            let hs: Vec<_> = (0..k)
+                .map(|t| {
+                    sc.spawn(move || {
+                        pin_to(t, a.pin);
+                        serial(t)
+                    })
+                })
+                .collect();
             for h in hs {
                 both.extend(h.join().expect("a calibration thread"));
             }
@@ -708,19 +736,8 @@ fn run(n: usize, a: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Row {
 
 fn main() {
     let a = Args::parse();
-    let pools: Vec<(usize, rayon::ThreadPool)> = a
-        .threads
-        .iter()
-        .map(|&k| {
-            (
-                k,
-                rayon::ThreadPoolBuilder::new()
-                    .num_threads(k)
-                    .build()
-                    .expect("a thread pool"),
-            )
-        })
-        .collect();
+    let pools: Vec<(usize, rayon::ThreadPool)> =
+        a.threads.iter().map(|&k| (k, new_pool(k, a.pin))).collect();
     let mut all = Vec::new();
     for r in 0..a.runs {
         if a.runs > 1 {

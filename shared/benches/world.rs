@@ -292,6 +292,44 @@ fn sim(broad_phase: BroadPhaseKind, pipeline: Pipeline, threads: u32) -> SimConf
 
 const STRIPS: BroadPhaseKind = BroadPhaseKind::DEFAULT;
 
+/// A pool of `k` workers, worker `i` pinned to the `i`-th core this process
+/// may use (modulo their number), as a host attaches with
+/// `World::set_thread_pool`. Linux only; elsewhere the workers stay unpinned.
+fn pinned_pool(k: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(k)
+        .thread_name(|i| format!("pinned-{i}"))
+        .start_handler(pin_to_core)
+        .build()
+        .expect("a thread pool")
+}
+
+/// Pins the calling thread to the `i`-th core of its affinity mask.
+#[cfg(target_os = "linux")]
+fn pin_to_core(i: usize) {
+    // SAFETY: `cpu_set_t` is plain data (all zeroes is the empty set), the
+    // calls get its exact size and a valid pointer, and pid 0 is this thread.
+    unsafe {
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        let size = std::mem::size_of::<libc::cpu_set_t>();
+        if libc::sched_getaffinity(0, size, &mut set) != 0 {
+            return;
+        }
+        let cores: Vec<usize> = (0..libc::CPU_SETSIZE as usize)
+            .filter(|&c| libc::CPU_ISSET(c, &set))
+            .collect();
+        if cores.is_empty() {
+            return;
+        }
+        let mut one: libc::cpu_set_t = std::mem::zeroed();
+        libc::CPU_SET(cores[i % cores.len()], &mut one);
+        libc::sched_setaffinity(0, size, &one);
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn pin_to_core(_: usize) {}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let run = Run {
@@ -422,21 +460,34 @@ fn main() {
         subjects,
     );
 
-    // Threads on larger scenes (the parallel part is detection only).
+    // Threads on larger scenes (the parallel part is detection only): the
+    // world's own pool, and an attached pool whose workers are pinned one
+    // per core (Linux can stack two unpinned workers on one core).
     let par = [
-        ("specialised, 1 thread", special),
+        ("specialised, 1 thread", special, false),
         (
             "specialised, 2 threads",
             sim(STRIPS, Pipeline::Specialised, 2),
+            false,
+        ),
+        (
+            "specialised, 2 pinned threads",
+            sim(STRIPS, Pipeline::Specialised, 2),
+            true,
         ),
     ];
+    let pinned = std::sync::Arc::new(pinned_pool(2));
+    let attach = |mut w: World, pin: bool| {
+        if pin {
+            w.set_thread_pool(Some(pinned.clone()));
+        }
+        w
+    };
     let subjects = par
         .into_iter()
-        .map(|(name, c)| {
-            (
-                name.to_string(),
-                scenes::boxes(50_000, 1, c).expect("scene"),
-            )
+        .map(|(name, c, pin)| {
+            let w = scenes::boxes(50_000, 1, c).expect("scene");
+            (name.to_string(), attach(w, pin))
         })
         .collect();
     scenario(
@@ -449,11 +500,9 @@ fn main() {
     );
     let subjects = par
         .into_iter()
-        .map(|(name, c)| {
-            (
-                name.to_string(),
-                scenes::mixed(20_000, 1, c).expect("scene"),
-            )
+        .map(|(name, c, pin)| {
+            let w = scenes::mixed(20_000, 1, c).expect("scene");
+            (name.to_string(), attach(w, pin))
         })
         .collect();
     scenario(

@@ -233,6 +233,14 @@ impl World {
     /// builds the world's own pool at the next step, and `threads == 0` uses
     /// the pool `step` is called from). The server shares one pool among
     /// its rooms this way. Results never depend on the pool.
+    ///
+    /// The world's own pool is not pinned to cores (a library pinning its
+    /// pools would pile every pool of a process onto the same cores). Linux
+    /// can leave two unpinned workers on one core for tens of milliseconds,
+    /// which made whole stretches of two-thread ticks no faster than one
+    /// (docs/PERFORMANCE.md, "Issue 19, fourth round"); a host that wants
+    /// the steady speed-up builds a pool whose workers pin themselves
+    /// (rayon's `ThreadPoolBuilder::start_handler`) and attaches it here.
     pub fn set_thread_pool(&mut self, pool: Option<Arc<rayon::ThreadPool>>) {
         self.pool_attached = pool.is_some();
         self.pool = pool;
