@@ -351,6 +351,8 @@ impl Cx<'_> {
             }
             self.add_cells(field, w as u64 * h as u64)?;
             out.reserve(w as usize * h as usize);
+            // Short rows: (row, entries), said in one warning per array.
+            let mut short = Vec::new();
             for (r, row) in a.iter().enumerate() {
                 let rf = format!("{field}[{r}]");
                 let row = self.arr(row, &rf)?;
@@ -358,15 +360,16 @@ impl Cx<'_> {
                     return Err(self.len_err(&rf, w as u64, row.len()));
                 }
                 if row.len() < w as usize {
-                    self.warnings.borrow_mut().push(format!(
-                        "{}: {rf}: {} of {w} entries, the rest read as empty",
-                        self.file,
-                        row.len()
-                    ));
+                    short.push((r, row.len()));
                 }
                 for c in 0..w as usize {
                     out.push(f(row.get(c).unwrap_or(empty), &format!("{rf}[{c}]"))?);
                 }
+            }
+            if let Some(said) = short_rows(field, w, &short) {
+                self.warnings
+                    .borrow_mut()
+                    .push(format!("{}: {said}, the rest read as empty", self.file));
             }
         } else {
             let n = w as u64 * h as u64;
@@ -380,6 +383,47 @@ impl Cx<'_> {
             }
         }
         Ok(out)
+    }
+}
+
+/// What the short rows `(row, entries)` of 2D array `field` (rows of `w`
+/// entries) are, in one phrase: the row itself when there is one, else the
+/// rows as runs (`rows 20-29 of field: 37 of 40 entries`). `None` when no row
+/// is short.
+fn short_rows(field: &str, w: u32, short: &[(usize, usize)]) -> Option<String> {
+    match short {
+        [] => None,
+        [(r, n)] => Some(format!("{field}[{r}]: {n} of {w} entries")),
+        _ => {
+            let mut runs: Vec<(usize, usize)> = Vec::new();
+            for &(r, _) in short {
+                match runs.last_mut() {
+                    Some(run) if run.1 + 1 == r => run.1 = r,
+                    _ => runs.push((r, r)),
+                }
+            }
+            let rows: Vec<String> = runs
+                .iter()
+                .map(|&(a, b)| {
+                    if a == b {
+                        a.to_string()
+                    } else {
+                        format!("{a}-{b}")
+                    }
+                })
+                .collect();
+            let lo = short.iter().map(|s| s.1).min().unwrap_or(0);
+            let hi = short.iter().map(|s| s.1).max().unwrap_or(0);
+            let n = if lo == hi {
+                lo.to_string()
+            } else {
+                format!("{lo} to {hi}")
+            };
+            Some(format!(
+                "rows {} of {field}: {n} of {w} entries",
+                rows.join(", ")
+            ))
+        }
     }
 }
 

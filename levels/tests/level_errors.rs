@@ -196,6 +196,16 @@ fn inconsistent_data_lengths() {
         l.warnings,
         ["levels/test.json: layers[0].data2D[1]: 3 of 4 entries, the rest read as empty"]
     );
+    // Several short rows: one warning, the rows as runs.
+    let tiles = r#""data2D": [[1, 1], [1, 1, 1, 1], [1], [1, 1], [1, 1, 1]]"#;
+    let five_rows = level(tiles, SPAWN)
+        .replace(r#""height": 32"#, r#""height": 80"#)
+        .replace(r#""gridCellsY": 2"#, r#""gridCellsY": 5"#);
+    let l = load(&five_rows).unwrap();
+    assert_eq!(
+        l.warnings,
+        ["levels/test.json: rows 0, 2-4 of layers[0].data2D: 1 to 3 of 4 entries, the rest read as empty"]
+    );
     let tiles = r#""data2D": [[1, 1, 1, 1]]"#;
     check(
         load(&level(tiles, SPAWN)),
