@@ -29,9 +29,9 @@ use wide::{i32x4, u32x4};
 pub(crate) const MAX_LEVELS: usize = 16;
 /// Entries tested at once by the block kernels.
 pub(crate) const BLOCK: usize = 4;
-/// Sentinels after the last strip's sentinel, so that two blocks read from
+/// Sentinels after the last strip's sentinel, so that four blocks read from
 /// any entry stay in bounds.
-pub(crate) const PAD: usize = 2 * BLOCK;
+pub(crate) const PAD: usize = 4 * BLOCK;
 /// The left edge of a sentinel.
 pub(crate) const SENTINEL: i32 = i32::MAX;
 
