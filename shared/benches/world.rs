@@ -134,6 +134,15 @@ struct Run {
     config: Option<String>,
 }
 
+impl Run {
+    /// Whether the scenario titled `title` runs (`--only`).
+    fn wants(&self, title: &str) -> bool {
+        self.only
+            .as_ref()
+            .is_none_or(|o| title.contains(o.as_str()))
+    }
+}
+
 /// Times `subjects` (label, subject) in turn; prints one table.
 fn scenario<S: Subject>(
     run: &Run,
@@ -143,11 +152,7 @@ fn scenario<S: Subject>(
     batch: u64,
     mut subjects: Vec<(String, S)>,
 ) -> Vec<f64> {
-    if run
-        .only
-        .as_ref()
-        .is_some_and(|o| !title.contains(o.as_str()))
-    {
+    if !run.wants(title) {
         return Vec::new();
     }
     if let Some(c) = &run.config {
@@ -462,57 +467,50 @@ fn main() {
 
     // Threads on larger scenes (the parallel part is detection only): the
     // world's own pool, and an attached pool whose workers are pinned one
-    // per core (Linux can stack two unpinned workers on one core).
-    let par = [
-        ("specialised, 1 thread", special, false),
-        (
-            "specialised, 2 threads",
-            sim(STRIPS, Pipeline::Specialised, 2),
-            false,
-        ),
-        (
-            "specialised, 2 pinned threads",
-            sim(STRIPS, Pipeline::Specialised, 2),
-            true,
-        ),
-    ];
-    let pinned = std::sync::Arc::new(pinned_pool(2));
-    let attach = |mut w: World, pin: bool| {
-        if pin {
-            w.set_thread_pool(Some(pinned.clone()));
-        }
-        w
-    };
-    let subjects = par
-        .into_iter()
-        .map(|(name, c, pin)| {
-            let w = scenes::boxes(50_000, 1, c).expect("scene");
-            (name.to_string(), attach(w, pin))
-        })
-        .collect();
-    scenario(
-        &run,
+    // per core (Linux can stack two unpinned workers on one core). Scenes
+    // and the pinned pool are built only when these scenarios run.
+    let (boxes_f, mixed_f) = (
         "(f) threads: 50,000 moving boxes",
-        false,
-        30,
-        1,
-        subjects,
-    );
-    let subjects = par
-        .into_iter()
-        .map(|(name, c, pin)| {
-            let w = scenes::mixed(20_000, 1, c).expect("scene");
-            (name.to_string(), attach(w, pin))
-        })
-        .collect();
-    scenario(
-        &run,
         "(f) threads: 20,000 mixed bodies",
-        false,
-        30,
-        1,
-        subjects,
     );
+    if run.wants(boxes_f) || run.wants(mixed_f) {
+        let par = [
+            ("specialised, 1 thread", special, false),
+            (
+                "specialised, 2 threads",
+                sim(STRIPS, Pipeline::Specialised, 2),
+                false,
+            ),
+            (
+                "specialised, 2 pinned threads",
+                sim(STRIPS, Pipeline::Specialised, 2),
+                true,
+            ),
+        ];
+        let pinned = std::sync::Arc::new(pinned_pool(2));
+        let attach = |mut w: World, pin: bool| {
+            if pin {
+                w.set_thread_pool(Some(pinned.clone()));
+            }
+            w
+        };
+        let subjects = par
+            .into_iter()
+            .map(|(name, c, pin)| {
+                let w = scenes::boxes(50_000, 1, c).expect("scene");
+                (name.to_string(), attach(w, pin))
+            })
+            .collect();
+        scenario(&run, boxes_f, false, 30, 1, subjects);
+        let subjects = par
+            .into_iter()
+            .map(|(name, c, pin)| {
+                let w = scenes::mixed(20_000, 1, c).expect("scene");
+                (name.to_string(), attach(w, pin))
+            })
+            .collect();
+        scenario(&run, mixed_f, false, 30, 1, subjects);
+    }
 
     if tune {
         let strips = |s: u32, l: u32| {
