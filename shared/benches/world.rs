@@ -488,28 +488,22 @@ fn main() {
             ),
         ];
         let pinned = std::sync::Arc::new(pinned_pool(2));
-        let attach = |mut w: World, pin: bool| {
-            if pin {
-                w.set_thread_pool(Some(pinned.clone()));
-            }
-            w
+        // One world per configuration, the pinned pool attached where asked.
+        let subjects = |scene: &dyn Fn(SimConfig) -> World| -> Vec<(String, World)> {
+            par.into_iter()
+                .map(|(name, c, pin)| {
+                    let mut w = scene(c);
+                    if pin {
+                        w.set_thread_pool(Some(pinned.clone()));
+                    }
+                    (name.to_string(), w)
+                })
+                .collect()
         };
-        let subjects = par
-            .into_iter()
-            .map(|(name, c, pin)| {
-                let w = scenes::boxes(50_000, 1, c).expect("scene");
-                (name.to_string(), attach(w, pin))
-            })
-            .collect();
-        scenario(&run, boxes_f, false, 30, 1, subjects);
-        let subjects = par
-            .into_iter()
-            .map(|(name, c, pin)| {
-                let w = scenes::mixed(20_000, 1, c).expect("scene");
-                (name.to_string(), attach(w, pin))
-            })
-            .collect();
-        scenario(&run, mixed_f, false, 30, 1, subjects);
+        let boxes = subjects(&|c| scenes::boxes(50_000, 1, c).expect("scene"));
+        scenario(&run, boxes_f, false, 30, 1, boxes);
+        let mixed = subjects(&|c| scenes::mixed(20_000, 1, c).expect("scene"));
+        scenario(&run, mixed_f, false, 30, 1, mixed);
     }
 
     if tune {
