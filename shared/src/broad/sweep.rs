@@ -100,10 +100,10 @@ fn advance(b: &Strips, p: &mut usize, x0: i32, max_w: u32) {
 
 /// [`advance`] four blocks at a time, for cursors that move several entries
 /// per box (the next-strip cursor of the reaching boxes, about six entries
-/// between two of them on the standard scene): the loop exit, mispredicted
-/// whenever one step does not suffice, is rarely taken twice (two blocks a
-/// step: 4 % slower at N = 10,000). Needs `4 * BLOCK` entries readable
-/// after the sentinel (`strips::PAD`).
+/// between two of them on the standard scene): a second step, and the
+/// mispredicted loop exit it costs, is rare (two blocks a step fell short
+/// about one time in four: 4 % slower at N = 10,000). Needs `4 * BLOCK`
+/// entries readable after the sentinel (`strips::PAD`).
 #[inline(always)]
 fn advance_far(b: &Strips, p: &mut usize, x0: i32, max_w: u32) {
     let lo = x0 as i64 - max_w as i64;
