@@ -98,7 +98,8 @@ impl InputClock {
 pub const BASE_MARGIN: f64 = 1.0;
 /// Ticks of margin added per tick of measured jitter.
 pub const JITTER_MARGIN: f64 = 2.0;
-/// Most extra margin for loss, ticks.
+/// Most extra input datagrams of margin for loss (each worth the ticks
+/// between two datagrams, [`input_interval`]).
 pub const MAX_LOSS_MARGIN: f64 = 4.0;
 /// Largest target margin, ticks.
 pub const MAX_MARGIN: f64 = 12.0;
@@ -138,6 +139,8 @@ pub struct SyncClock {
     base: f64,
     /// Extra margin for loss, ticks.
     loss_margin: f64,
+    /// Ticks between two input datagrams ([`input_interval`]).
+    datagram_ticks: f64,
     target: f64,
     /// After a catch-up jump: no other jump before this position (reports
     /// in flight still describe inputs sent before the jump).
@@ -156,6 +159,7 @@ impl SyncClock {
             jitter: 0.0,
             base: BASE_MARGIN,
             loss_margin: 0.0,
+            datagram_ticks: input_interval(tick_rate.max(1)) as f64,
             target: BASE_MARGIN,
             holdoff: f64::MIN,
         }
@@ -237,19 +241,24 @@ impl SyncClock {
         self.retarget();
     }
 
-    /// Sets the measured loss (fraction). Each input packet repeats the
-    /// previous ticks, so a lost one is recovered by the next, a tick
-    /// later: with loss `p`, the margin grows by the ticks `k` such that
-    /// `k + 1` packets in a row are lost with probability under 0.1%
-    /// (1% loss: 1 tick, 10%: 2, 30%: 4), at most [`MAX_LOSS_MARGIN`].
+    /// Sets the measured loss (fraction). Each input datagram repeats the
+    /// previous ticks, so a lost one is recovered by the next, one
+    /// datagram interval later ([`input_interval`]: 2 ticks at 60 Hz): with
+    /// loss `p`, the margin grows by `k` intervals such that `k + 1`
+    /// datagrams in a row are lost with probability under 0.1% (1% loss:
+    /// one interval, 10%: 2, 30%: 4), at most [`MAX_LOSS_MARGIN`]
+    /// intervals. (Counted in ticks, as when every tick had its datagram,
+    /// the margin at 60 Hz covered one lost datagram fewer than it meant
+    /// to: at 10% loss about one tick in 200 arrived late.)
     pub fn set_loss(&mut self, loss: f64) {
-        self.loss_margin = if loss <= 0.001 {
+        let datagrams = if loss <= 0.001 {
             0.0
         } else if loss >= 0.5 {
             MAX_LOSS_MARGIN
         } else {
             ((0.001f64.ln() / loss.ln()).ceil() - 1.0).clamp(0.0, MAX_LOSS_MARGIN)
         };
+        self.loss_margin = datagrams * self.datagram_ticks;
         self.retarget();
     }
 
@@ -479,12 +488,17 @@ mod tests {
         let starved = late.iter().filter(|&&r| r < 0).count();
         assert_eq!(starved, 0, "inputs late under jitter: {late:?}");
 
-        let mut c = SyncClock::new(100.0, 60, t0);
-        for (loss, extra) in [(0.0, 0.0), (0.01, 1.0), (0.1, 2.0), (0.3, 4.0), (0.9, 4.0)] {
-            c.set_loss(loss);
-            assert_eq!(c.target_margin(), BASE_MARGIN + extra, "loss {loss}");
+        // The margin for loss is counted in input datagrams: at 60 Hz one
+        // goes every 2 ticks, at 30 Hz every tick.
+        for (rate, every) in [(60, 2.0), (30, 1.0)] {
+            let mut c = SyncClock::new(100.0, rate, t0);
+            for (loss, datagrams) in [(0.0, 0.0), (0.01, 1.0), (0.1, 2.0), (0.3, 4.0), (0.9, 4.0)] {
+                c.set_loss(loss);
+                let want = BASE_MARGIN + datagrams * every;
+                assert_eq!(c.target_margin(), want, "{rate} Hz, loss {loss}");
+            }
         }
-        c.set_loss(0.0);
+        let mut c = SyncClock::new(100.0, 60, t0);
         assert_eq!(c.observe(-40), 40.0 + BASE_MARGIN);
         assert_eq!(c.position(), 141.0);
         assert_eq!(c.observe(-38), 0.0, "a report from before the jump");
