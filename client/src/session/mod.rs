@@ -168,7 +168,8 @@ pub struct SessionStats {
     pub missing_baselines: u64,
     /// Datagrams or snapshots that failed to decode, dropped.
     pub malformed: u64,
-    /// Roster entries ignored because [`MAX_ROSTER`] names were known.
+    /// Roster entries ignored because
+    /// [`MAX_ROSTER`](ledge_shared::protocol::MAX_ROSTER) names were known.
     pub roster_overflow: u64,
     /// Input packets sent.
     pub inputs_sent: u64,
