@@ -324,7 +324,7 @@ impl Animator {
     /// Advances every player in `players` by `dt` seconds (the frame's
     /// duration; a long stall counts as a quarter second) and returns
     /// their poses in the same order. Players missing from
-    /// two updates in a row are forgotten (a player seen
+    /// `FORGET_AFTER` updates in a row are forgotten (a player seen
     /// again later starts afresh).
     pub fn update<'a>(
         &mut self,

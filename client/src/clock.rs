@@ -139,8 +139,6 @@ pub struct SyncClock {
     base: f64,
     /// Extra margin for loss, ticks.
     loss_margin: f64,
-    /// Ticks between two input datagrams ([`input_interval`]).
-    datagram_ticks: f64,
     target: f64,
     /// After a catch-up jump: no other jump before this position (reports
     /// in flight still describe inputs sent before the jump).
@@ -159,7 +157,6 @@ impl SyncClock {
             jitter: 0.0,
             base: BASE_MARGIN,
             loss_margin: 0.0,
-            datagram_ticks: input_interval(tick_rate.max(1)) as f64,
             target: BASE_MARGIN,
             holdoff: f64::MIN,
         }
@@ -259,7 +256,8 @@ impl SyncClock {
         } else {
             ((0.001f64.ln() / loss.ln()).ceil() - 1.0).clamp(0.0, MAX_LOSS_MARGIN)
         };
-        self.loss_margin = datagrams * self.datagram_ticks;
+        // `rate` is a whole number of ticks a second.
+        self.loss_margin = datagrams * input_interval(self.rate as u32) as f64;
         self.retarget();
     }
 
