@@ -24,7 +24,7 @@
 use std::collections::BTreeMap;
 use std::net::IpAddr;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use prometheus_client::encoding::EncodeLabelValue;
 use tokio::sync::Notify;
@@ -43,6 +43,13 @@ pub const DEFAULT_HELLO_TIMEOUT: Duration = Duration::from_secs(2);
 /// Default pending connections above which unvalidated sources get a
 /// Retry.
 pub const DEFAULT_RETRY_ABOVE: usize = 8;
+/// How long a connection may say nothing after its handshake before a full
+/// pool counts it silent. A client sends its hello with the handshake's
+/// last flight, so the server reads it within moments; until then a
+/// connection that just finished its handshake is ranked like one still in
+/// it (by age), not ahead of them: under a flood of handshakes an honest
+/// newcomer would otherwise be the one silent connection, and go first.
+pub const SILENT_AFTER: Duration = Duration::from_millis(250);
 
 /// The admission limits (the configuration file's `[admission]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -140,8 +147,17 @@ struct Counts {
 struct Pending {
     key: AddressKey,
     evict: Arc<Notify>,
-    /// Its QUIC handshake is done: only its hello is missing.
-    silent: bool,
+    /// When its QUIC handshake finished (then only its hello is missing).
+    handshaken: Option<Instant>,
+}
+
+impl Pending {
+    /// Its handshake finished at least [`SILENT_AFTER`] before `now` and
+    /// it has still said nothing.
+    fn silent(&self, now: Instant) -> bool {
+        self.handshaken
+            .is_some_and(|at| now.saturating_duration_since(at) >= SILENT_AFTER)
+    }
 }
 
 #[derive(Debug, Default)]
@@ -170,16 +186,17 @@ impl State {
         }
     }
 
-    /// The pending connection to close for a newcomer: of the addresses
-    /// holding the most pending ones, the oldest connection that finished
-    /// its handshake but says nothing (a client sends its hello at once),
-    /// else the oldest one still in its handshake.
-    fn eviction_candidate(&self) -> Option<(u64, AddressKey, usize)> {
+    /// The pending connection to close for a newcomer at `now`: of the
+    /// addresses holding the most pending ones, the oldest connection that
+    /// finished its handshake and has said nothing since (for
+    /// [`SILENT_AFTER`]; a client sends its hello at once), else the oldest
+    /// one.
+    fn eviction_candidate(&self, now: Instant) -> Option<(u64, AddressKey, usize)> {
         let most = self.addresses.values().map(|c| c.pending).max()?;
         self.pending
             .iter()
             .filter(|(_, p)| self.addresses.get(&p.key).map(|c| c.pending) == Some(most))
-            .min_by_key(|(&seq, p)| (!p.silent, seq))
+            .min_by_key(|(&seq, p)| (!p.silent(now), seq))
             .map(|(&seq, p)| (seq, p.key, most))
     }
 }
@@ -214,10 +231,16 @@ impl Admission {
         self.state.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
-    /// Decides on a new connection from `ip`. `validated`: quinn knows the
-    /// source receives packets (it answered a Retry, or showed a token);
-    /// `may_retry`: a Retry can still be sent.
-    pub fn consider(self: &Arc<Self>, ip: IpAddr, validated: bool, may_retry: bool) -> Verdict {
+    /// Decides on a new connection from `ip`, arriving at `now`.
+    /// `validated`: quinn knows the source receives packets (it answered a
+    /// Retry, or showed a token); `may_retry`: a Retry can still be sent.
+    pub fn consider(
+        self: &Arc<Self>,
+        ip: IpAddr,
+        validated: bool,
+        may_retry: bool,
+        now: Instant,
+    ) -> Verdict {
         let key = AddressKey::of(ip);
         let c = &self.config;
         let mut s = self.lock();
@@ -236,7 +259,7 @@ impl Admission {
         }
         let mut evicted = false;
         if s.pending.len() >= c.pending {
-            match s.eviction_candidate() {
+            match s.eviction_candidate(now) {
                 Some((seq, victim, most)) if here.pending < most => {
                     let gone = s.pending.remove(&seq).expect("candidate is pending");
                     s.counts(victim).pending -= 1;
@@ -254,7 +277,7 @@ impl Admission {
             Pending {
                 key,
                 evict: evict.clone(),
-                silent: false,
+                handshaken: None,
             },
         );
         let counts = s.counts(key);
@@ -309,12 +332,12 @@ impl Ticket {
         self.evict.notified().await;
     }
 
-    /// Its QUIC handshake is done: from now on only its hello is missing,
-    /// and a full pool evicts such connections before those still in their
-    /// handshake.
-    pub fn handshaken(&self) {
+    /// Its QUIC handshake finished at `now`: from then on only its hello
+    /// is missing, and once it has been silent for [`SILENT_AFTER`] a full
+    /// pool evicts it before those still in their handshake.
+    pub fn handshaken(&self, now: Instant) {
         if let Some(p) = self.admission.lock().pending.get_mut(&self.seq) {
-            p.silent = true;
+            p.handshaken = Some(now);
         }
     }
 
@@ -371,7 +394,12 @@ mod tests {
 
     #[track_caller]
     fn admit(a: &Arc<Admission>, ip: IpAddr) -> (Ticket, bool) {
-        match a.consider(ip, true, false) {
+        admit_at(a, ip, Instant::now())
+    }
+
+    #[track_caller]
+    fn admit_at(a: &Arc<Admission>, ip: IpAddr, now: Instant) -> (Ticket, bool) {
+        match a.consider(ip, true, false, now) {
             Verdict::Admit { ticket, evicted } => (ticket, evicted),
             other => panic!("{ip} admitted, not {other:?}"),
         }
@@ -379,7 +407,7 @@ mod tests {
 
     #[track_caller]
     fn refused(a: &Arc<Admission>, ip: IpAddr) -> Refusal {
-        match a.consider(ip, true, false) {
+        match a.consider(ip, true, false, Instant::now()) {
             Verdict::Refuse(why) => why,
             other => panic!("{ip} refused, not {other:?}"),
         }
@@ -459,15 +487,37 @@ mod tests {
     #[test]
     fn a_silent_connection_goes_before_one_still_in_its_handshake() {
         let a = Admission::new(config(), 100);
-        let (mut handshaking, _) = admit(&a, v4(1));
-        let (mut silent, _) = admit(&a, v4(2));
-        silent.handshaken();
-        let (_c, _) = admit(&a, v4(3));
-        let (_d, _) = admit(&a, v4(4));
-        let (_e, evicted) = admit(&a, v4(5));
+        let t0 = Instant::now();
+        let (mut handshaking, _) = admit_at(&a, v4(1), t0);
+        let (mut silent, _) = admit_at(&a, v4(2), t0);
+        silent.handshaken(t0);
+        let (_c, _) = admit_at(&a, v4(3), t0);
+        let (_d, _) = admit_at(&a, v4(4), t0);
+        let (_e, evicted) = admit_at(&a, v4(5), t0 + SILENT_AFTER);
         assert!(evicted);
         assert!(!silent.join(), "the younger but silent one went");
         assert!(handshaking.join());
+    }
+
+    /// The order of events under a flood from many addresses: every
+    /// address holds one pending connection, the flood's still in their
+    /// handshakes (each is evicted soon after it is admitted), and an
+    /// honest client has just finished its handshake, its hello in flight.
+    /// A newcomer evicts the oldest flood connection, not the honest one.
+    #[test]
+    fn a_connection_just_past_its_handshake_is_not_yet_silent() {
+        let a = Admission::new(config(), 100);
+        let t0 = Instant::now();
+        let (mut oldest, _) = admit_at(&a, v4(1), t0);
+        let (_b, _) = admit_at(&a, v4(2), t0);
+        let (_c, _) = admit_at(&a, v4(3), t0);
+        let (mut honest, _) = admit_at(&a, v4(4), t0);
+        let hello_in_flight = t0 + Duration::from_millis(5);
+        honest.handshaken(hello_in_flight);
+        let (_e, evicted) = admit_at(&a, v4(5), hello_in_flight + SILENT_AFTER / 2);
+        assert!(evicted);
+        assert!(!oldest.join(), "the oldest in its handshake went");
+        assert!(honest.join(), "the one whose hello is in flight stays");
     }
 
     #[tokio::test]
@@ -496,14 +546,17 @@ mod tests {
             },
             100,
         );
-        let retry = |ip| matches!(a.consider(ip, false, true), Verdict::Retry);
+        let retry = |ip| matches!(a.consider(ip, false, true, Instant::now()), Verdict::Retry);
         let _t1 = admit(&a, v4(1));
         assert!(retry(v4(1)), "an address with a handshake pending");
         assert!(!retry(v4(2)), "below the threshold");
         let _t2 = admit(&a, v4(2));
         assert!(retry(v4(3)), "at the threshold");
         assert!(
-            matches!(a.consider(v4(3), false, false), Verdict::Admit { .. }),
+            matches!(
+                a.consider(v4(3), false, false, Instant::now()),
+                Verdict::Admit { .. }
+            ),
             "a source that already answered a Retry is not sent another"
         );
     }

@@ -140,7 +140,7 @@ pub async fn serve(incoming: Incoming, mut ticket: Ticket, shared: Arc<Shared>) 
                 return;
             }
         };
-        ticket.handshaken();
+        ticket.handshaken(Instant::now());
         debug!("connected");
         match session(&link, acceptor, &shared, &mut ticket, deadline).await {
             Ok(()) => link.close(CloseCode::Normal, "bye"),

@@ -141,7 +141,9 @@ fn admit(
         }
         Incoming::WebSocket(_) => (true, false),
     };
-    let verdict = shared.admission.consider(remote.ip(), validated, may_retry);
+    let verdict = shared
+        .admission
+        .consider(remote.ip(), validated, may_retry, Instant::now());
     let metrics = &shared.metrics;
     match verdict {
         Verdict::Retry => {

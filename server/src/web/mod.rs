@@ -18,7 +18,7 @@ pub mod webtransport;
 
 use std::net::SocketAddr;
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use axum::extract::ws::WebSocketUpgrade;
 use axum::extract::{ConnectInfo, Request, State};
@@ -195,7 +195,10 @@ async fn websocket(
         );
     }
     let metrics = &shared.metrics;
-    let (ticket, evicted) = match shared.admission.consider(peer.ip(), true, false) {
+    let (ticket, evicted) = match shared
+        .admission
+        .consider(peer.ip(), true, false, Instant::now())
+    {
         Verdict::Admit { ticket, evicted } => (ticket, evicted),
         Verdict::Refuse(reason) => {
             metrics.refused_on(Transport::WebSocket, reason);
