@@ -198,7 +198,7 @@ impl<T: Keyed> Whole<'_, T> {
         par: bool,
     ) {
         if parts.len() == 1 {
-            return self.sort_part(parts.start, out, &mut starts[0]);
+            return sort_part(self, parts.start, out, &mut starts[0]);
         }
         let mid = parts.start + parts.len() / 2;
         let left: usize = (parts.start..mid)
@@ -221,6 +221,7 @@ impl<T: Keyed> Whole<'_, T> {
     /// Sorts part `p` into `out`: one histogram over its buffers, a scatter
     /// straight into `out` (no intermediate copy), then one bounded
     /// insertion sort.
+    #[inline(always)]
     fn sort_part(&self, p: usize, out: &mut [T], starts: &mut Vec<u32>) {
         if out.is_empty() {
             return;
@@ -263,16 +264,26 @@ impl<T: Keyed> Whole<'_, T> {
     }
 }
 
+multiversioned! {
+    /// [`Whole::sort_part`], compiled for each target.
+    fn sort_part<T: Keyed>(w: &Whole<'_, T>, p: usize, out: &mut [T], starts: &mut Vec<u32>) {
+        w.sort_part(p, out, starts)
+    }
+}
+
 /// Sorts `v` by ids, fast when every element is near its place: an
 /// insertion sort, abandoned for a comparison sort once it has shifted
 /// more than a few elements per element (a crowded bucket).
+#[inline(always)]
 fn sort_nearly_sorted<T: Keyed>(v: &mut [T]) {
     sort_nearly_sorted_by_key(v, 4, Keyed::key);
 }
 
 /// Sorts `v` by `key` with an insertion sort, linear when every element is
 /// near its place, falling back to a comparison sort past `shifts` shifts
-/// per element.
+/// per element. Inlined, so that it is part of each target's version of
+/// its callers.
+#[inline(always)]
 pub(crate) fn sort_nearly_sorted_by_key<T: Copy, K: Ord>(
     v: &mut [T],
     shifts: usize,

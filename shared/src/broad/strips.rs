@@ -239,6 +239,7 @@ struct Chunk {
 impl Chunk {
     /// Reads this chunk's boxes in their old order, re-keys them and splits
     /// them into kept (re-sorted by insertion as they come) and movers.
+    #[inline(always)]
     fn split(&mut self, lv: &Levels, rows: &[Row], idx: &[u32], items: &[(u32, Bounds)]) {
         self.stay.clear();
         self.stay_rows.clear();
@@ -294,6 +295,7 @@ impl Chunk {
 
     /// Merges the kept boxes and this chunk's movers into `out`, strip by
     /// strip, one sentinel after each.
+    #[inline(always)]
     fn layout(&mut self, movers: &[Entry], mut out: Slices<'_>) {
         self.out_rows.clear();
         let (st, mv) = (&self.stay, &movers[self.mv.clone()]);
@@ -331,6 +333,26 @@ impl Chunk {
         debug_assert_eq!(at, self.size);
         self.id_lo = acc.id_lo;
         self.id_hi = acc.id_hi;
+    }
+}
+
+multiversioned! {
+    /// [`Chunk::split`], compiled for each target.
+    fn split_chunk(
+        c: &mut Chunk,
+        lv: &Levels,
+        rows: &[Row],
+        idx: &[u32],
+        items: &[(u32, Bounds)],
+    ) {
+        c.split(lv, rows, idx, items)
+    }
+}
+
+multiversioned! {
+    /// [`Chunk::layout`], compiled for each target.
+    fn layout_chunk(c: &mut Chunk, movers: &[Entry], out: Slices<'_>) {
+        c.layout(movers, out)
     }
 }
 
@@ -511,7 +533,7 @@ impl Strips {
             self.plan_chunks(if par { chunk.max(1) } else { usize::MAX });
             let nc = self.chunks.len();
             let (rows, idx) = (&self.rows, &self.idx);
-            let job = |c: &mut Chunk| c.split(lv, rows, idx, items);
+            let job = |c: &mut Chunk| split_chunk(c, lv, rows, idx, items);
             if par {
                 use rayon::prelude::*;
                 self.chunks[..nc].par_iter_mut().for_each(job);
@@ -749,7 +771,7 @@ fn lay_chunks(chunks: &mut [Chunk], movers: &[Entry], out: Slices<'_>, par: bool
         let mut out = out;
         for c in chunks {
             let (mine, rest) = out.split_at(c.size);
-            c.layout(movers, mine);
+            layout_chunk(c, movers, mine);
             out = rest;
         }
         return;

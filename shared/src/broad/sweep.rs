@@ -128,7 +128,7 @@ fn advance_far(b: &Strips, p: &mut usize, x0: i32, max_w: u32) {
 /// skips the boxes that end before it can start (left edge
 /// `<= a.min.x - max_w`, a bound that only grows), then a forward scan tests
 /// the boxes that start before it ends.
-#[inline]
+#[inline(always)]
 pub(crate) fn sweep_two<S: Sink>(
     a: &Strips,
     ra: Range<usize>,
@@ -225,7 +225,7 @@ fn scan_into(s: &Strips, mut k: usize, i: usize, x: (i32, i32, i32, i32), c: &mu
 /// reaching below the next strip's top edge can meet it: the self scan
 /// lists them without a branch (a branch per box, taken or not at random,
 /// was measured slower), then only they scan the next strip.
-#[inline]
+#[inline(always)]
 fn sweep_self_and_next(
     s: &Strips,
     ra: Range<usize>,
@@ -286,10 +286,25 @@ fn sweep_self_and_next(
     c
 }
 
-/// Same-level pairs for the dynamic strips `rows` (row-table indices of
-/// `dy`): inside each strip, with the next strip, and with the static strips
-/// one above, level with and one below.
-pub(crate) fn same_level<S: Sink>(
+multiversioned! {
+    /// Same-level pairs for the dynamic strips `rows` (row-table indices of
+    /// `dy`): inside each strip, with the next strip, and with the static
+    /// strips one above, level with and one below.
+    pub(crate) fn same_level<S: Sink>(
+        lv: &Levels,
+        dy: &Strips,
+        st: &Strips,
+        rows: Range<usize>,
+        scratch: &mut Scratch,
+        sink: &mut S,
+    ) {
+        same_level_in(lv, dy, st, rows, scratch, sink)
+    }
+}
+
+/// The body of [`same_level`].
+#[inline(always)]
+fn same_level_in<S: Sink>(
     lv: &Levels,
     dy: &Strips,
     st: &Strips,
@@ -343,17 +358,25 @@ pub(crate) fn same_level<S: Sink>(
     }
 }
 
-/// Pairs of entries `xs` of `x` (all on levels above 0) with the boxes of
-/// `y` on lower levels. For each box of `x` and each lower level of `y`: the
-/// strips it can reach, and in each a binary search on the left edge bounded
-/// by the strip's widest box, then a scan.
-pub(crate) fn cross_level<S: Sink>(
-    lv: &Levels,
-    x: &Strips,
-    xs: Range<usize>,
-    y: &Strips,
-    sink: &mut S,
-) {
+multiversioned! {
+    /// Pairs of entries `xs` of `x` (all on levels above 0) with the boxes
+    /// of `y` on lower levels. For each box of `x` and each lower level of
+    /// `y`: the strips it can reach, and in each a binary search on the left
+    /// edge bounded by the strip's widest box, then a scan.
+    pub(crate) fn cross_level<S: Sink>(
+        lv: &Levels,
+        x: &Strips,
+        xs: Range<usize>,
+        y: &Strips,
+        sink: &mut S,
+    ) {
+        cross_level_in(lv, x, xs, y, sink)
+    }
+}
+
+/// The body of [`cross_level`].
+#[inline(always)]
+fn cross_level_in<S: Sink>(lv: &Levels, x: &Strips, xs: Range<usize>, y: &Strips, sink: &mut S) {
     for e in xs {
         if x.minx[e] == SENTINEL {
             continue;

@@ -171,7 +171,8 @@ fn even_px(rng: &mut SplitMix64, lo: i32, hi: i32) -> i32 {
     px(rng.range(lo / 2, hi / 2) * 2)
 }
 
-/// The feature-poor level: [`room_tiles`] (solid tiles only), one static
+/// The feature-poor level: a room of tiles (solid tiles only: about
+/// `4000 n` px^2, solid border, pillars and shelves), one static
 /// block (16..48 px) per 50 boxes on one static body, and `n` dynamic boxes
 /// of 8..24 px with movers, placed on empty tiles.
 pub fn tile_room(n: usize, seed: u64, config: SimConfig) -> Result<World, BuildError> {
@@ -197,9 +198,9 @@ pub fn tile_room(n: usize, seed: u64, config: SimConfig) -> Result<World, BuildE
     Ok(w)
 }
 
-/// Everything at once, `n` moving bodies: [`room_tiles`] with slopes,
-/// one-way shelves and hazards; static blocks, segments, polygons, a one-way
-/// box and trigger pads; kinematic platforms (one in 20 bodies, some
+/// Everything at once, `n` moving bodies: the room of [`tile_room`] with
+/// slopes, one-way shelves and hazards; static blocks, segments, polygons,
+/// a one-way box and trigger pads; kinematic platforms (one in 20 bodies, some
 /// one-way) and dynamic bodies of every shape kind, all driven by movers;
 /// dynamic boxes are riders, one body in ten carries a trigger sensor, and
 /// one in seven is on a layer that ignores itself.
