@@ -39,20 +39,19 @@
 //!   methods never touch rayon. They use the *current* rayon pool, so a
 //!   caller picks the thread count with
 //!   `rayon::ThreadPoolBuilder::new().num_threads(n).build()?.install(..)`.
+//! * **Compiled twice**: the hot loops are compiled for the x86-64 baseline
+//!   and for x86-64-v3 (AVX2, BMI1/2, ...), and each call takes the best
+//!   version the CPU has (the `multiversion` crate; the check is one atomic
+//!   load). The vector code is written for 4 lanes either way; the newer
+//!   instructions (blends, 32-bit lane min/max, inserts and extracts,
+//!   three-operand forms) make it about 7 % faster at N = 10,000
+//!   (`docs/PERFORMANCE.md`). Integer code only: both versions give the
+//!   same results bit for bit.
 //!
 //! Pairs are reported only when the interiors overlap (`a.min < b.max` and
 //! `b.min < a.max` on both axes): boxes that share an edge are not a pair.
 //! Static-static pairs are never reported. Ids are the caller's and should be
 //! distinct across the static and dynamic sets.
-//!
-//! * **Compiled twice**: the hot loops are compiled for the x86-64 baseline
-//!   and for x86-64-v3 (AVX2, BMI1/2, ...), and each call takes the best
-//!   version the CPU has (the `multiversion` crate; the check is one atomic
-//!   load). The vector code is written for 4 lanes either way; the newer
-//!   instructions (blends, 32-bit lane min/max and inserts, three-operand
-//!   forms, `tzcnt`) make it about 7 % faster at N = 10,000
-//!   (`docs/PERFORMANCE.md`). Integer code only: both versions give the
-//!   same results bit for bit.
 //!
 //! [`standard`] is the benchmark scene of `docs/PERFORMANCE.md`.
 
