@@ -29,15 +29,15 @@ use crate::error::ClientError;
 use crate::net::Network;
 pub use crate::net::{NetEvent, NetStatus};
 use crate::netstats::TransportSample;
-use crate::session::{JoinOptions, Session, SessionEvent};
-use crate::trust::{connect_trusted, Trust};
+use crate::session::{handshake, JoinOptions, Session, SessionEvent};
+use crate::trust::{dial_trusted, Trust};
 
 /// How often the background thread pings the server.
 const PING_INTERVAL: Duration = Duration::from_secs(1);
 /// How long a client keeps trying to reconnect after losing a joined
 /// session (the server's default reconnect grace).
 pub const RECONNECT_FOR: Duration = Duration::from_secs(30);
-/// Longest one reconnect attempt may take.
+/// Longest the QUIC handshake of one reconnect attempt may take.
 const RECONNECT_ATTEMPT: Duration = Duration::from_secs(3);
 /// First wait between reconnect attempts (doubling up to the max).
 const RECONNECT_BACKOFF: Duration = Duration::from_millis(250);
@@ -272,16 +272,25 @@ async fn run(
     let mut joined_once = false;
     loop {
         let connecting = async {
-            let attempt = connect_trusted(&request.server, &trust, &join);
-            if joined_once {
+            let hello = join.hello();
+            ledge_shared::protocol::Message::validate(&hello)?;
+            let dial = dial_trusted(&request.server, &trust);
+            let (dialed, trusted) = if joined_once {
                 // A reconnect attempt through a dead link must not hang for
-                // the whole QUIC idle timeout.
-                tokio::time::timeout(RECONNECT_ATTEMPT, attempt)
+                // the whole QUIC idle timeout, but only the QUIC handshake
+                // is cut short: once our hello is out, the server may have
+                // given our player to this connection, and dropping it
+                // then closes it without a `Leave`, which the server takes
+                // as leaving (the player gone, the next attempt a new
+                // player). Past the handshake the link works, and the idle
+                // timeout bounds the rest.
+                tokio::time::timeout(RECONNECT_ATTEMPT, dial)
                     .await
-                    .unwrap_or(Err(ClientError::Timeout))
+                    .unwrap_or(Err(ClientError::Timeout))?
             } else {
-                attempt.await
-            }
+                dial.await?
+            };
+            Ok::<_, ClientError>((handshake(dialed, hello).await?, trusted))
         };
         let result = tokio::select! {
             _ = &mut quit => return,
