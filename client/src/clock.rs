@@ -246,7 +246,7 @@ impl SyncClock {
     /// one interval, 10%: 2, 30%: 4), at most [`MAX_LOSS_MARGIN`]
     /// intervals. (Counted in ticks, as when every tick had its datagram,
     /// the margin at 60 Hz covered one lost datagram fewer than it meant
-    /// to: through `tests/impaired.rs`'s relay, 10% loss each way, 11 of
+    /// to: through `tests/e2e/impaired.rs`'s relay, 10% loss each way, 11 of
     /// 7,200 ticks arrived late.)
     pub fn set_loss(&mut self, loss: f64) {
         let datagrams = if loss <= 0.001 {

@@ -12,7 +12,7 @@
 //! which would let each end ask the other for fewer ACK-only packets. With
 //! it, a second client joining through a link of 150 ms RTT, 25 ms jitter
 //! and 5 % loss saw its hello time out on the server in each of three runs
-//! (`tests/conditioned.rs`), and it is not needed: clients time their input
+//! (`tests/e2e/conditioned.rs`), and it is not needed: clients time their input
 //! datagrams so that ACKs ride on the game's own packets
 //! (`ledge_client::session::state`).
 

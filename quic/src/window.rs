@@ -10,7 +10,7 @@
 //! same blocked packet), so an end answers the other's probes only when its
 //! own probe timer fires: after an exponentially backed-off delay that
 //! reached 3-5 s after a 5 s blackout in our end-to-end test
-//! (`tests/tests/conditioned.rs`). With a window that never drops below
+//! (`tests/tests/e2e/conditioned.rs`). With a window that never drops below
 //! [`WINDOW_FLOOR`], both ends resume within one round trip (measured:
 //! 40-60 ms after the link returned).
 //!

@@ -136,7 +136,7 @@ impl TestServer {
             bind: SocketAddr::from(([127, 0, 0, 1], 0)),
             cert_dir: cert_dir.path().to_owned(),
             // Tests stand for many machines on one loopback address; the
-            // admission tests (tests/admission.rs) restore the defaults.
+            // admission tests (tests/e2e/admission.rs) restore the defaults.
             admission: AdmissionConfig {
                 per_address: 4096,
                 pending_per_address: 256,

@@ -1,7 +1,7 @@
 //! `OnlineGame` against a real server in-process on loopback: the calls a
 //! fixed-step front end makes (`wait`, `update_ticks`) and what it reads.
 
-mod common;
+use crate::common;
 
 use std::time::{Duration, Instant};
 

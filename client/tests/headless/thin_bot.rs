@@ -3,7 +3,7 @@
 //! sends an input per tick, receives snapshots, leaves cleanly, and prints
 //! the report line `ledge-load` reads.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 use std::time::Duration;

@@ -12,8 +12,8 @@
 //! there a missing corpus is fetched (the script is idempotent) and a
 //! missing `xvfb-run` fails the test.
 
+use crate::common;
 use std::path::{Path, PathBuf};
-mod common;
 
 use std::process::Command;
 use std::time::Duration;

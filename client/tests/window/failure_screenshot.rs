@@ -7,9 +7,8 @@
 //!
 //! The window tests run under `xvfb-run` (skipped with a loud notice when
 //! it is missing, failing when `CI=true`).
-#![cfg(feature = "gui")]
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::{Command, Output};

@@ -1,9 +1,8 @@
 //! The real `ledge-client` binary lists a server's rooms without joining
 //! (`--list-rooms`, no window): a room a friend opened by name shows with
 //! its level and players.
-#![cfg(feature = "gui")]
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 use std::time::Duration;

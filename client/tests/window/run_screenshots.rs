@@ -10,7 +10,7 @@
 //!
 //! Needs `xvfb-run` (see `common::xvfb_or_skip`).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::time::Duration;

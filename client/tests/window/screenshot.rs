@@ -7,8 +7,8 @@
 //! it). Without it the test fails when `CI=true` and otherwise prints a
 //! loud notice and passes without checking anything.
 
+use crate::common;
 use std::net::SocketAddr;
-mod common;
 
 use std::time::{Duration, Instant};
 

@@ -6,9 +6,8 @@
 //! The refusal needs no display. The first-use test opens a window, so it
 //! runs under `xvfb-run` like the screenshot test (skipped with a notice
 //! when it is missing, failing when `CI=true`).
-#![cfg(feature = "gui")]
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -9,10 +9,7 @@ use std::path::Path;
 use ledge_levels::{ogmo, tmx, LoadOptions};
 use proptest::prelude::*;
 
-mod peak;
-
-#[global_allocator]
-static ALLOC: peak::Counting = peak::Counting;
+use crate::peak;
 
 use peak::{measured, serial};
 

@@ -12,10 +12,7 @@ use std::time::Instant;
 use ledge_levels::limits::*;
 use ledge_levels::{ogmo, tmx, LevelError, LoadOptions};
 
-mod peak;
-
-#[global_allocator]
-static ALLOC: peak::Counting = peak::Counting;
+use crate::peak;
 
 use peak::{measured, serial, CURRENT, PEAK};
 

@@ -338,7 +338,7 @@ fn ogmo_layers_are_drawn_last_to_first() {
          "gridCellsX": 4, "gridCellsY": 2, "tileset": "ledge", "data": [2, -1, -1, -1, -1, -1, -1, -1]},
         {"name": "entities", "entities": [{"name": "player", "x": 8, "y": 8, "width": 8, "height": 8}]}
       ]}"#;
-    let project = include_str!("../default/ledge.ogmo");
+    let project = include_str!("../../default/ledge.ogmo");
     let options = LoadOptions {
         collision_layers: Some(vec!["front".into()]),
         ..LoadOptions::default()

@@ -393,7 +393,7 @@ fn sticker_knight_collides_where_its_static_bodies_are() {
 /// repository; real files from two other projects, licences there) load
 /// with no settings file and say what they did not use or guessed: the
 /// echo slopes level (one tile layer of a foreign tileset, no grid layer,
-/// no entities) collides every tile, said (`levels/tests/level_ogmo.rs`
+/// no entities) collides every tile, said (`levels/tests/import/level_ogmo.rs`
 /// loads it with its tile table, slopes and all).
 #[test]
 fn ogmo_files_load_with_no_settings_and_say_what_they_skipped() {

@@ -14,8 +14,8 @@ const UNO: &str = concat!(
     "/../../shared/testdata/levels/ogmo3-sample/levels/uno.json"
 );
 const TILED_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/levels/tiled");
-const DEFAULT_JSON: &str = include_str!("../default/default.json");
-const DEFAULT_PROJECT: &str = include_str!("../default/ledge.ogmo");
+const DEFAULT_JSON: &str = include_str!("../../default/default.json");
+const DEFAULT_PROJECT: &str = include_str!("../../default/ledge.ogmo");
 
 /// A one-layer OGMO level: a 4 x 2 tile layer (`tiles_json` is its data
 /// field), and an entity layer with `entities_json`.

@@ -4,8 +4,7 @@
 //! naming the file and the field; a player stands on and walks along a
 //! polygon ramp.
 
-#[path = "../../shared/tests/platformer_kit/mod.rs"]
-mod platformer_kit;
+use crate::platformer_kit;
 
 use glam::IVec2;
 use ledge_levels::{
@@ -19,7 +18,7 @@ use ledge_shared::world::AnyShape;
 use platformer_kit::{Sim, LEFT, NONE, RIGHT};
 
 const TILED_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/levels/tiled");
-const RAMP_TMX: &str = include_str!("fixtures/levels/tiled/ramp.tmx");
+const RAMP_TMX: &str = include_str!("../fixtures/levels/tiled/ramp.tmx");
 /// The ramp's points in `ramp.tmx`, which tests replace.
 const RAMP_POINTS: &str = r#"<polygon points="0,0 64,-16 64,0"/>"#;
 

@@ -3,7 +3,7 @@
 //! loopback: they join, send inputs, receive snapshots and leave, their
 //! report lines are the ones `ledge-load` counts, and the server's metrics,
 //! scraped over HTTP as `ledge-load` does, show their traffic and the fine
-//! tick histogram. (`client/tests/thin_bot.rs` runs the binary itself.)
+//! tick histogram. (`client/tests/headless/thin_bot.rs` runs the binary itself.)
 
 use std::net::SocketAddr;
 use std::time::Duration;

@@ -59,13 +59,13 @@
 /// time (see the module docs). Kept to thin wrappers around
 /// `#[inline(always)]` bodies, so that everything the body calls is part of
 /// each version and rustfmt formats the bodies. Built with
-/// `--cfg ledge_baseline_only`, only the baseline version exists: CI runs
+/// the `baseline-only` feature, only the baseline version exists: CI runs
 /// the broad-phase tests so too, since a machine with AVX2 never runs it
 /// otherwise.
 macro_rules! multiversioned {
     ($(#[$attr:meta])* $vis:vis fn $($rest:tt)*) => {
         $(#[$attr])*
-        #[cfg_attr(not(ledge_baseline_only), multiversion::multiversion(targets(
+        #[cfg_attr(not(feature = "baseline-only"), multiversion::multiversion(targets(
             "x86_64+avx2+avx+bmi1+bmi2+fma+lzcnt+popcnt+movbe+f16c"
         )))]
         $vis fn $($rest)*

@@ -3,11 +3,11 @@
 //! `substeps` and `restitution_iterations` change results (and are part of
 //! [`super::World::state_hash`]). `sweep` changes results only for bodies
 //! it sweeps (a scene with none gives the same states whatever its value,
-//! `tests/world_sweep.rs`), so it is not hashed either: its effect is in
+//! `tests/simulation/world_sweep.rs`), so it is not hashed either: its effect is in
 //! the bodies' states. The other three only change how the work is done:
 //! every combination of `broad_phase`, `pipeline` and `threads` gives the
 //! same contacts in the same order and bit-identical states
-//! (`tests/world_threads.rs`), so they are not hashed.
+//! (`tests/simulation/world_threads.rs`), so they are not hashed.
 
 use serde::{Deserialize, Serialize};
 

@@ -8,11 +8,8 @@
 use ledge_shared::scene::{run_scripted, scripted_inputs, warmup_room};
 use ledge_shared::world::Event;
 
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::allocations;
-
-#[global_allocator]
-static GLOBAL: counting_alloc::Counting = counting_alloc::Counting;
 
 #[test]
 fn the_counter_counts() {

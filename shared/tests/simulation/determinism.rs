@@ -1,7 +1,7 @@
 //! Determinism: a scripted 100,000-tick run of the warm-up room gives the
 //! same state hash on repeated runs, from a cloned mid-run state, and in a
-//! release build (the `determinism` example, run through cargo) as in this
-//! (debug) build.
+//! release build (the `ledge-determinism` binary, run through cargo) as in
+//! this (debug) build.
 
 use std::path::Path;
 use std::process::Command;
@@ -45,8 +45,8 @@ fn debug_and_release_builds_agree() {
             "--release",
             "-p",
             "ledge-shared",
-            "--example",
-            "determinism",
+            "--bin",
+            "ledge-determinism",
             "--",
         ])
         .arg(TICKS.to_string())

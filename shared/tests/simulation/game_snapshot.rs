@@ -2,7 +2,7 @@
 //! every future tick; long multi-player runs are deterministic; players join
 //! and leave; bad snapshots are refused without changing anything.
 
-mod platformer_kit;
+use crate::platformer_kit;
 
 use glam::IVec2;
 use ledge_shared::game::{kind, Game, GameError, GameEvent, ENTITY_ID_BASE};

@@ -28,7 +28,7 @@
 //! * the moved (touching or just-apart) configuration is classified
 //!   correctly too.
 
-mod common;
+use crate::common;
 
 use common::*;
 use core::fmt::Debug;

@@ -2,7 +2,7 @@
 //! variable height), walls and ceilings, dropping through one-way tiles,
 //! running over slopes without leaving the ground.
 
-mod platformer_kit;
+use crate::platformer_kit;
 
 use glam::IVec2;
 use ledge_shared::game::{GameConfig, GameEvent, PlayerConfig};

@@ -1,7 +1,7 @@
 //! Walkers (stomp, hurt, turning), springboards, coins, checkpoints, the
 //! goal, hazard tiles and volumes.
 
-mod platformer_kit;
+use crate::platformer_kit;
 
 use glam::IVec2;
 use ledge_shared::game::{EntityType, GameEvent, HurtCause, ENTITY_ID_BASE, FALL_MARGIN};

@@ -2,7 +2,7 @@
 //! moves (solid and one-way), platforms crush what they push into solids,
 //! and leaving a platform keeps its velocity per `CarryMode`.
 
-mod platformer_kit;
+use crate::platformer_kit;
 
 use glam::IVec2;
 use ledge_shared::game::{CarryMode, GameConfig, GameEvent, HurtCause, PlayerConfig};

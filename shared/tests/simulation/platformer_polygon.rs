@@ -3,7 +3,7 @@
 //! running up works), a steeper face is a wall they slide off. Every test
 //! runs on a ramp rising right and on its mirror image.
 
-mod platformer_kit;
+use crate::platformer_kit;
 
 use glam::IVec2;
 use ledge_shared::game::{GameConfig, PlayerConfig, PlayerShape, PlayerView, FOOT_INSET};

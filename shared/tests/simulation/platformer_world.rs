@@ -2,7 +2,7 @@
 //! restitution path, riders carried by kinematic boxes, drop-through, body
 //! removal and suspension.
 
-mod platformer_kit;
+use crate::platformer_kit;
 
 use glam::IVec2;
 use ledge_shared::shape::Aabb;

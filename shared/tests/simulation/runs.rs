@@ -2,7 +2,7 @@
 //! restarts; all of it in the state hash, the snapshot (full and delta) and
 //! a restored game.
 
-mod platformer_kit;
+use crate::platformer_kit;
 
 use glam::IVec2;
 use ledge_shared::game::state::{player_flags, run_flags};

@@ -2,7 +2,7 @@
 //! near the spawn, free of solids and on the spawn's floor; a player
 //! without a checkpoint respawns on the same spot, in any game of the level.
 
-mod platformer_kit;
+use crate::platformer_kit;
 
 use glam::IVec2;
 use ledge_shared::game::{spawn, Game, GameEvent, HurtCause};

@@ -21,11 +21,9 @@
 //! * a long run (10^6 ticks) of a busy room is periodic (no drift) and
 //!   allocates nothing after warm-up.
 //!
-//! A counting global allocator (this test binary only) measures the long
-//! run's memory.
+//! The test binary's counting allocator (`counting_alloc`) measures the
+//! long run's memory.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::time::Instant;
 
 use glam::IVec2;
@@ -43,76 +41,7 @@ use proptest::prelude::*;
 
 // ------------------------------------------------------------ allocator
 
-/// Forwards to the system allocator; counts, per thread, what the thread
-/// asks for while its counter is on (the harness runs other tests, which
-/// allocate, on other threads at the same time).
-struct Counting;
-
-/// One thread's allocation counter.
-struct Counter {
-    on: Cell<bool>,
-    calls: Cell<u64>,
-    bytes_in: Cell<u64>,
-    bytes_out: Cell<u64>,
-}
-
-thread_local! {
-    static COUNTER: Counter = const {
-        Counter {
-            on: Cell::new(false),
-            calls: Cell::new(0),
-            bytes_in: Cell::new(0),
-            bytes_out: Cell::new(0),
-        }
-    };
-}
-
-/// Records an allocation call of `bytes_in` bytes that frees `bytes_out`.
-fn note(calls: u64, bytes_in: usize, bytes_out: usize) {
-    let _ = COUNTER.try_with(|c| {
-        if c.on.get() {
-            c.calls.set(c.calls.get() + calls);
-            c.bytes_in.set(c.bytes_in.get() + bytes_in as u64);
-            c.bytes_out.set(c.bytes_out.get() + bytes_out as u64);
-        }
-    });
-}
-
-// SAFETY: every call is forwarded unchanged to the system allocator.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        note(1, layout.size(), 0);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        note(1, layout.size(), 0);
-        unsafe { System.alloc_zeroed(layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        note(1, new_size, layout.size());
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        note(0, 0, layout.size());
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
-
-/// What the current thread allocated while running `f`: allocation calls
-/// (including reallocations) and the change in live bytes.
-fn allocations<R>(f: impl FnOnce() -> R) -> (R, u64, i64) {
-    let read = || COUNTER.with(|c| (c.calls.get(), c.bytes_in.get(), c.bytes_out.get()));
-    let (calls, bytes_in, bytes_out) = read();
-    COUNTER.with(|c| c.on.set(true));
-    let r = f();
-    COUNTER.with(|c| c.on.set(false));
-    let (calls2, bytes_in2, bytes_out2) = read();
-    let net = (bytes_in2 - bytes_in) as i64 - (bytes_out2 - bytes_out) as i64;
-    (r, calls2 - calls, net)
-}
+use crate::counting_alloc::calls_and_bytes as allocations;
 
 #[test]
 fn the_allocation_counter_counts() {

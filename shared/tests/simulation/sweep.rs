@@ -27,7 +27,7 @@ use ledge_shared::tilemap::{ContactFlags, Slope, Tile, TileContact, Tilemap};
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseResult;
 
-mod platformer_kit;
+use crate::platformer_kit;
 use platformer_kit::map_at;
 
 // ------------------------------------------------------------------ helpers

@@ -12,7 +12,7 @@ use ledge_shared::fixed::{px, MAX_COORD};
 use ledge_shared::tilemap::{ContactFlags, Slope, Tile, TileContact, Tilemap, TilemapError};
 use std::cmp::Reverse;
 
-mod platformer_kit;
+use crate::platformer_kit;
 use platformer_kit::map_at;
 
 /// 16 px tiles.

@@ -14,7 +14,7 @@ use ledge_shared::world::{
 };
 use proptest::prelude::*;
 
-mod platformer_kit;
+use crate::platformer_kit;
 use platformer_kit::{map, T};
 
 /// Gravity per tick, in units per tick.

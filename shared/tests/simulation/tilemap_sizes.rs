@@ -20,7 +20,7 @@
 //!   row of tiles and up and down 45 and 22.5 degree hills staying
 //!   grounded, and drops through one-way tiles.
 
-mod platformer_kit;
+use crate::platformer_kit;
 
 use glam::{I64Vec2, IVec2};
 use ledge_shared::fixed::{px, MAX_COORD, MAX_EXTENT, MAX_SPEED};

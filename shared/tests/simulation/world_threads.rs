@@ -528,14 +528,11 @@ fn detection_of_random_placements_is_the_same_in_every_mode() {
 
 // ------------------------------------------------------------ allocations
 
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::allocations;
 
-#[global_allocator]
-static GLOBAL: counting_alloc::Counting = counting_alloc::Counting;
-
 /// The warm-up room and the game (tiny scenes) are covered by
-/// `tests/alloc.rs`; these scenes go through the broad phase, incremental
+/// `tests/simulation/alloc.rs`; these scenes go through the broad phase, incremental
 /// re-detection, tiles and the sorted rider search.
 #[test]
 fn large_scenes_allocate_nothing_per_tick_in_steady_state() {

@@ -115,6 +115,26 @@ fn state(page: &mut Page) -> Value {
         .expect("read the page's state")
 }
 
+/// The page's state and a screenshot of the frame it describes: the
+/// players' drawn rectangles read before and after the screenshot agree
+/// (else the camera or a player was still moving: a loaded machine may
+/// draw a frame between the two reads, so it tries again).
+fn still_screenshot(page: &mut Page, transport: &str) -> (Value, Vec<u8>) {
+    let drawn = |s: &Value| s["players"].clone();
+    let mut last = Value::Null;
+    for _ in 0..30 {
+        let before = state(page);
+        let png = page.screenshot_png().expect("a screenshot");
+        let after = state(page);
+        if drawn(&before) == drawn(&after) {
+            return (before, png);
+        }
+        last = after;
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    panic!("{transport}: the page never held still for a screenshot in 3 s: {last}");
+}
+
 /// Pixels of `png` (RGBA) within `tolerance` of `rgb` inside `rect`
 /// (x, y, w, h), and how many pixels the rect held.
 fn count(png: &[u8], rect: [f64; 4], rgb: [u8; 3], tolerance: i32) -> (u32, u32) {
@@ -208,7 +228,7 @@ fn play(web: SocketAddr, name: &str, webtransport: bool, seen: &Seen) {
     }
     std::thread::sleep(Duration::from_millis(300));
 
-    let s = state(&mut page);
+    let (s, png) = still_screenshot(&mut page, transport);
     let x1 = s["me"]["x"].as_f64().expect("our position");
     assert!(
         x1 > x0 + 60.0,
@@ -228,7 +248,6 @@ fn play(web: SocketAddr, name: &str, webtransport: bool, seen: &Seen) {
     );
 
     // The screenshot: the level, us, bob.
-    let png = page.screenshot_png().expect("a screenshot");
     std::fs::write(
         std::env::temp_dir().join(format!("ledge-browser-{transport}.png")),
         &png,

@@ -4,7 +4,7 @@
 //! the local player is barely corrected and remote players never freeze;
 //! after a 5 s blackout a client is back in sync within 2 s.
 //!
-//! `cargo test -p ledge-tests --test conditioned -- --nocapture` prints the
+//! `cargo test -p ledge-tests --test e2e conditioned:: -- --nocapture` prints the
 //! measured figures.
 //!
 //! The blackout figure depends on QUIC recovering quickly once the link

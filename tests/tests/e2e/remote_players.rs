@@ -7,7 +7,7 @@
 //! and the visible snaps (frames where the drawn motion changes abruptly,
 //! by more than 4 px and more than twice any real change nearby plus 2 px:
 //! corrections, not delayed jumps or landings). `cargo test -p ledge-tests --test
-//! remote_players -- --nocapture` prints the table (docs/CLIENT.md).
+//! e2e remote_players:: -- --nocapture` prints the table (docs/CLIENT.md).
 
 use std::time::{Duration, Instant};
 

@@ -232,7 +232,7 @@ async fn a_chat_flood_is_rate_limited() {
 #[tokio::test]
 async fn a_silent_client_times_out_and_its_body_is_removed() {
     // No reconnect grace: the lost player goes as soon as it is lost
-    // (tests/resume.rs covers keeping it).
+    // (tests/e2e/resume.rs covers keeping it).
     let server = TestServer::start_with(|c| {
         c.idle_timeout = Duration::from_millis(600);
         c.reconnect_grace = Duration::ZERO;

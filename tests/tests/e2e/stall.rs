@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use ledge_client::background::NetStatus;
 use ledge_client::online::STALL_AFTER;
 use ledge_client::{OnlineGame, OnlineRequest, Trust};
+use ledge_netsim::LinkConfig;
 use ledge_server::{Server, ServerConfig};
 use ledge_shared::input::Buttons;
 use ledge_tests::{TestServer, UdpRelay};
@@ -114,6 +115,41 @@ fn a_gui_client_reconnects_by_itself_and_keeps_its_player() {
     assert_eq!(online.game().unwrap().me(), me, "the same player");
     let m = server.metrics();
     assert_eq!(ledge_tests::metric(&m, "ledge_sessions_resumed_total"), 1.0);
+    drop(online);
+    runtime.block_on(async { server.stop().await.unwrap() });
+}
+
+/// A reconnect over a slow link (0.9 s each way): the QUIC handshake fits
+/// in one attempt's time (3 s), the welcome does not. An attempt whose
+/// hello is out must not be given up: the server has handed it our player
+/// by then, and a connection dropped without a `Leave` reads as leaving,
+/// so the next attempt would be a new player.
+#[test]
+fn a_slow_reconnect_keeps_the_player() {
+    let (runtime, server, relay, mut online) = join_through_relay();
+    let me = online.game().unwrap().me();
+
+    relay.blackhole();
+    play_until(
+        &mut online,
+        "reconnecting",
+        Duration::from_secs(15),
+        |o, _| matches!(o.status(), NetStatus::Reconnecting { .. }),
+    );
+    let slow = LinkConfig::delay(Duration::from_millis(900));
+    relay.set_links(slow, slow);
+    relay.restore();
+    play_until(&mut online, "back", Duration::from_secs(20), |o, _| {
+        matches!(o.status(), NetStatus::Connected { .. })
+    });
+    assert_eq!(online.game().unwrap().me(), me, "the same player");
+    let m = server.metrics();
+    assert_eq!(ledge_tests::metric(&m, "ledge_sessions_resumed_total"), 1.0);
+    assert_eq!(
+        ledge_tests::metric(&m, "ledge_players{room=\"room-1\"}"),
+        1.0,
+        "one player"
+    );
     drop(online);
     runtime.block_on(async { server.stop().await.unwrap() });
 }

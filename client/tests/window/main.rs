@@ -1,0 +1,13 @@
+//! The client's integration tests that run the real window binary
+//! (`ledge-client`, the `gui` feature): pictures under Xvfb, failures and
+//! the command line. One binary, one link step; every file a module.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod art_screenshot;
+mod failure_screenshot;
+mod rooms_cli;
+mod run_screenshots;
+mod screenshot;
+mod trust_cli;
