@@ -1187,8 +1187,11 @@ proptest! {
                 let p = pushes(&m, h.stop, half, moved, flags);
                 let back = p.iter().any(|c| c.mtv.as_i64vec2().dot(d0.as_i64vec2()) < 0);
                 prop_assert!(!back, "stop {} pushed back: {:?}; {}", h.stop, p, render(&m));
-                // The hit is real: the motion is pushed right after it (the
-                // next lattice position); or, moving diagonally, a corner
+                // The hit is real: the motion is pushed at it (a hit exactly
+                // at a lattice position, say a foot entering a column from
+                // the left, which is in it from the column's line on) or
+                // right after it (the next lattice position); or, moving
+                // diagonally, a corner
                 // clips a tile between two lattice positions (seen at half
                 // the scale: the map doubled); or a slope's surface line
                 // runs up to half a unit above its unit-column steps between
@@ -1196,11 +1199,14 @@ proptest! {
                 // (one for that, one for rounding) is pushed.
                 // (A hit at toi 1: the end itself is pushed, and the stop is
                 // short of it.)
-                let jn = ((h.toi.num() as i128 * k as i128 / h.toi.den() as i128) as i32 + 1).min(k);
+                let (num, den) = (h.toi.num() as i128, h.toi.den() as i128);
+                let jat = ((num * k as i128 + den - 1) / den) as i32;
+                let jn = ((num * k as i128 / den) as i32 + 1).min(k);
                 let double = Tilemap::new(m.origin() * 2, 2 * T, 7, 5, m.tiles().to_vec()).unwrap();
                 let mid = d0 * (2 * jn - 1);
                 prop_assert!(
-                    !pushes(&m, start + d0 * jn, half, d0 * jn, flags).is_empty()
+                    !pushes(&m, start + d0 * jat, half, d0 * jat, flags).is_empty()
+                        || !pushes(&m, start + d0 * jn, half, d0 * jn, flags).is_empty()
                         || !pushes(&double, start * 2 + mid, half * 2, mid, flags).is_empty()
                         || !pushes(&m, h.stop + v(0, 2), half, moved + v(0, 2), flags).is_empty(),
                     "hit {:?} but lattice {} of {} is clean; {}", h, jn, k, render(&m)
@@ -1252,3 +1258,4 @@ proptest! {
         prop_assert_eq!((h.hit.normal, h.hit.stop.x + half.x), (w(-1, 0), ox + 256));
     }
 }
+
