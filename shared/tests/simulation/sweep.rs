@@ -1258,4 +1258,3 @@ proptest! {
         prop_assert_eq!((h.hit.normal, h.hit.stop.x + half.x), (w(-1, 0), ox + 256));
     }
 }
-
