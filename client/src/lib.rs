@@ -33,7 +33,6 @@
 //!   [`net::NetEvent`], [`net::NetStatus`]), whatever carries it;
 //! * [`background`]: the network on its own thread, for GUI front ends;
 //! * [`rng`]: a seedable generator (bots, effects);
-//! * [`timestep`]: fixed-step accumulator for render loops;
 //! * [`audio`]: sound effects, synthesized at start, played through ALSA
 //!   loaded at run time (off, never failing, without it);
 //! * [`cues`]: which sound effects to play, from frame-to-frame changes of
@@ -74,7 +73,6 @@ pub mod predict;
 pub mod rng;
 pub mod session;
 pub mod time;
-pub mod timestep;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod transport;
 #[cfg(not(target_arch = "wasm32"))]
