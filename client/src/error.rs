@@ -131,7 +131,7 @@ pub enum ClientError {
 
 #[cfg(not(target_arch = "wasm32"))]
 /// Why a certificate was not trusted, or the known-hosts file not used
-/// (see [`crate::trust`]).
+/// (see [`crate::net::trust`]).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum TrustError {
     /// The server presented a different certificate than the one stored for

@@ -3,7 +3,7 @@
 //! sequence of named steps ([`GameLoop::frame`]): input, simulation,
 //! sound, network, the scene, drawing, the page's report, the end.
 //!
-//! Both entry points ([`crate::native`], [`crate::web`]) prepare a
+//! Both entry points ([`crate::native`], and `web` in the browser) prepare a
 //! [`Setup`] and hand it to [`game`]; the loop uses the modules below it
 //! (play, keys, camera, render, effects, HUD, screenshot) and none of
 //! them uses it.

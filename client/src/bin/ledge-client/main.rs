@@ -29,10 +29,10 @@
 //! * 3 ([`outcome::EXIT_UNTRUSTED`]): the server's certificate was refused.
 //!
 //! Modules, top to bottom (each uses only those below it): the entry
-//! points ([`native`], [`web`]) prepare a [`game_loop::Setup`]; the
+//! points ([`native`], and `web` in the browser) prepare a [`game_loop::Setup`]; the
 //! [`game_loop`] runs the frames; [`play`], [`keys`], [`hud`], [`render`],
 //! [`fx`], [`shot`] and the rest do one thing each for it; at the bottom
-//! the page's glue ([`page`]), gamepads ([`pad`]) and how a run ends
+//! the page's glue (`page`, in the browser), gamepads ([`pad`]) and how a run ends
 //! ([`outcome`]).
 
 // The browser build leaves out the command line, files and the network

@@ -9,7 +9,7 @@
 
 use std::collections::BTreeMap;
 
-use ledge_client::link::{Link, Transmit};
+use ledge_client::net::link::{Link, Transmit};
 use ledge_client::net::{NetEvent, Network};
 use ledge_client::netstats::TransportSample;
 use ledge_client::time::Instant;

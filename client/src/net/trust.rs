@@ -19,8 +19,8 @@ use std::path::{Path, PathBuf};
 use ledge_shared::protocol::{Fingerprint, RoomInfo};
 
 use crate::error::{ClientError, TrustError};
-use crate::session::{handshake, list_rooms, JoinOptions, Session};
-use crate::transport::{dial_any_or, resolve, Dialed};
+use crate::net::session::{handshake, list_rooms, JoinOptions, Session};
+use crate::net::transport::{dial_any_or, resolve, Dialed};
 
 /// How to trust the server's certificate.
 #[derive(Debug, Clone, PartialEq, Eq)]
