@@ -1,5 +1,8 @@
 //! Everything that can go wrong on the client side of a connection.
 
+#[cfg(not(target_arch = "wasm32"))]
+use std::path::PathBuf;
+
 use ledge_shared::protocol::{CloseCode, Fingerprint, ProtocolError, RejectReason, MAX_NAME_LEN};
 
 /// Why connecting or talking to a server failed.
@@ -123,7 +126,54 @@ pub enum ClientError {
     /// this address before (trust on first use).
     #[cfg(not(target_arch = "wasm32"))]
     #[error("{0}")]
-    Trust(#[from] crate::trust::TrustError),
+    Trust(#[from] TrustError),
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+/// Why a certificate was not trusted, or the known-hosts file not used
+/// (see [`crate::net::trust`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum TrustError {
+    /// The server presented a different certificate than the one stored for
+    /// its address.
+    #[error(
+        "the certificate of {host} has CHANGED: it presented fingerprint {presented}, but \
+         {path} (line {line}) trusts {stored} for this address. If the server was \
+         reinstalled or its certificate regenerated, this is expected; otherwise someone may \
+         be intercepting the connection. Ask the server's operator for its fingerprint; if it \
+         is {presented}, remove line {line} from {path} and connect again (or pass \
+         --cert-hash {presented}). Refusing to connect."
+    )]
+    Changed {
+        /// The address, as looked up in the file.
+        host: String,
+        /// What the server presented now.
+        presented: Fingerprint,
+        /// What the file holds.
+        stored: Fingerprint,
+        /// The file.
+        path: PathBuf,
+        /// The line holding `stored` (1-based).
+        line: usize,
+    },
+    /// The file could not be read or written.
+    #[error("known hosts file {path}: {message}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What failed.
+        message: String,
+    },
+    /// A line of the file is not `HOST:PORT FINGERPRINT`.
+    #[error("known hosts file {path}, line {line}: {message} (expected `HOST:PORT FINGERPRINT`)")]
+    Malformed {
+        /// The file.
+        path: PathBuf,
+        /// The line (1-based).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
 }
 
 #[cfg(not(target_arch = "wasm32"))]

@@ -77,7 +77,7 @@ impl StatsTracker {
     }
 
     /// A snapshot of `tick` arrived at `at`; the server had sent
-    /// `previous` before it ([`crate::session::SnapshotUpdate::previous_tick`]).
+    /// `previous` before it ([`crate::net::session::SnapshotUpdate::previous_tick`]).
     pub fn snapshot(&mut self, tick: u64, previous: Option<u64>, at: Instant) {
         let epoch = *self.epoch.get_or_insert(at);
         let transit = at.saturating_duration_since(epoch).as_secs_f64() * self.rate - tick as f64;

@@ -2,7 +2,7 @@
 //! appear on the client (the simulation stays integer).
 //!
 //! A [`FrameView`] is built once per rendered frame by
-//! [`crate::game::ClientGame::view`] (or [`crate::online::OnlineGame::view`])
+//! [`crate::game::ClientGame::view`] (or [`crate::net::online::OnlineGame::view`])
 //! from the predicted game (the local player, platforms, walkers, coins:
 //! everything the client simulates itself), the interpolation buffer
 //! (remote players, drawn a little in the past) and the correction

@@ -17,9 +17,9 @@ use std::net::SocketAddr;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use ledge_client::game::predict::Reconciled;
+use ledge_client::net::transport::{dial, Dialed};
 use ledge_client::netstats::TransportSample;
-use ledge_client::predict::Reconciled;
-use ledge_client::transport::{dial, Dialed};
 use ledge_client::{connect, ClientGame, Session, SessionEvent, SnapshotUpdate};
 use ledge_netsim::{LinkConfig, Loss, Relay, RelayConfig};
 use ledge_server::admission::AdmissionConfig;

@@ -8,8 +8,6 @@ use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::PlayerId;
 
-pub use super::runner::Runner;
-
 /// Decides a bot's buttons, tick by tick.
 pub trait Brain: Send {
     /// A short name for reports (`idle`, `walker`, `runner`).

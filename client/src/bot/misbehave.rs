@@ -18,8 +18,8 @@ use ledge_shared::protocol::{
 
 use super::brain::SplitMix64;
 use crate::error::ClientError;
-use crate::session::{handshake, Session, SessionEvent};
-use crate::transport::dial;
+use crate::net::session::{handshake, Session, SessionEvent};
+use crate::net::transport::dial;
 
 /// One kind of abuse.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -11,12 +11,12 @@ use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{NoticeKind, PlayerId};
 
 use super::brain::Brain;
-use crate::bundle::{fetch_level, FetchOptions, Fetched, LevelCache};
 use crate::game::ClientGame;
-use crate::levels::level_for;
+use crate::net::bundle::{fetch_level, FetchOptions, Fetched, LevelCache};
+use crate::net::levels::level_for;
+use crate::net::session::{JoinOptions, Session, SessionEvent, SnapshotUpdate};
+use crate::net::trust::{connect_trusted, Trust};
 use crate::netstats::TransportSample;
-use crate::session::{JoinOptions, Session, SessionEvent, SnapshotUpdate};
-use crate::trust::{connect_trusted, Trust};
 use crate::view::NetStats;
 
 /// How often a bot reads QUIC's byte counters and RTT.

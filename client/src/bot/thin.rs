@@ -15,10 +15,10 @@ use ledge_shared::protocol::NoticeKind;
 
 use super::brain::RandomWalker;
 use super::run::{BotOptions, BotReport};
-use crate::clock::InputClock;
+use crate::game::clock::InputClock;
+use crate::net::session::{JoinOptions, SessionEvent};
+use crate::net::trust::{connect_trusted, Trust};
 use crate::netstats::TransportSample;
-use crate::session::{JoinOptions, SessionEvent};
-use crate::trust::{connect_trusted, Trust};
 
 /// The brain name thin bots report.
 pub const THIN: &str = "thin";

@@ -6,7 +6,7 @@ use crate::common;
 use std::time::{Duration, Instant};
 
 use common::TestServer;
-use ledge_client::background::NetStatus;
+use ledge_client::net::background::NetStatus;
 use ledge_client::{Fingerprint, OnlineGame, OnlineRequest, Trust};
 use ledge_shared::input::Buttons;
 

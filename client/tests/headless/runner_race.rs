@@ -9,7 +9,7 @@
 use std::collections::{BTreeMap, VecDeque};
 
 use ledge_client::bot::{Brain, Runner, SplitMix64};
-use ledge_client::predict::Predictor;
+use ledge_client::game::predict::Predictor;
 use ledge_levels::{default_level, default_route};
 use ledge_shared::game::{Game, GameEvent};
 use ledge_shared::input::Buttons;

@@ -14,8 +14,8 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use ledge_client::bot::RandomWalker;
-use ledge_client::session::{handshake, JoinOptions};
-use ledge_client::transport::{dial_from, endpoint};
+use ledge_client::net::session::{handshake, JoinOptions};
+use ledge_client::net::transport::{dial_from, endpoint};
 use ledge_server::admission::AdmissionConfig;
 use ledge_shared::protocol::{write_frame, ALPN};
 use ledge_tests::e2e::{assert_steady, bot_options, spawn_bot, task_panics, TickProbe};

@@ -3,7 +3,7 @@
 
 use std::time::{Duration, Instant};
 
-use ledge_client::background::{ConnectRequest, NetEvent, NetOptions, NetStatus, NetThread};
+use ledge_client::net::background::{ConnectRequest, NetEvent, NetOptions, NetStatus, NetThread};
 use ledge_shared::input::Buttons;
 use ledge_tests::TestServer;
 

@@ -2,7 +2,7 @@
 
 use std::time::{Duration, Instant};
 
-use ledge_client::transport::dial;
+use ledge_client::net::transport::dial;
 use ledge_client::{connect, connect_with, handshake, ClientError, Fingerprint, JoinOptions};
 use ledge_shared::protocol::ServerControl;
 use ledge_shared::protocol::{

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use ledge_client::bot::{BotOptions, RandomWalker};
-use ledge_client::bundle::{fetch_level, FetchOptions, LevelCache};
+use ledge_client::net::bundle::{fetch_level, FetchOptions, LevelCache};
 use ledge_client::ClientError;
 use ledge_levels::bundle::sha256;
 use ledge_server::{Server, ServerConfig, ServerError};

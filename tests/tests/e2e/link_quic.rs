@@ -8,9 +8,9 @@
 
 use std::time::Duration;
 
-use ledge_client::link::{Incoming, Link, Transmit};
+use ledge_client::net::link::{Incoming, Link, Transmit};
+use ledge_client::net::transport::{dial, Dialed};
 use ledge_client::net::{NetEvent, Network};
-use ledge_client::transport::{dial, Dialed};
 use ledge_client::JoinOptions;
 use ledge_levels::bundle::sha256;
 use ledge_shared::input::Buttons;

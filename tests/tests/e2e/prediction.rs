@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use ledge_client::predict::BLEND_KEEP;
+use ledge_client::game::predict::BLEND_KEEP;
 use ledge_client::view::Vec2;
 use ledge_client::ClientGame;
 use ledge_shared::input::Buttons;

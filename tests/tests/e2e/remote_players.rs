@@ -12,7 +12,7 @@
 use std::time::{Duration, Instant};
 
 use ledge_client::bot::{Brain, RandomWalker, SplitMix64};
-use ledge_client::interp::Interpolator;
+use ledge_client::game::interp::Interpolator;
 use ledge_client::netstats::StatsTracker;
 use ledge_client::view::px2;
 use ledge_client::view::Vec2;

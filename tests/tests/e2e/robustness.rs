@@ -4,7 +4,7 @@
 use std::net::SocketAddr;
 use std::time::{Duration, Instant};
 
-use ledge_client::transport::dial;
+use ledge_client::net::transport::dial;
 use ledge_client::{connect, ClientError, Fingerprint, Session};
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{

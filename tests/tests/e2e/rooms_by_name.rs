@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-use ledge_client::transport::dial;
+use ledge_client::net::transport::dial;
 use ledge_client::{connect_with, list_rooms, ClientError, JoinOptions, Session};
 use ledge_shared::protocol::{RejectReason, RoomInfo};
 use ledge_tests::{ids, snapshot_where, TestServer};

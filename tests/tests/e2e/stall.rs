@@ -7,8 +7,8 @@
 
 use std::time::{Duration, Instant};
 
-use ledge_client::background::NetStatus;
-use ledge_client::online::STALL_AFTER;
+use ledge_client::net::background::NetStatus;
+use ledge_client::net::online::STALL_AFTER;
 use ledge_client::{OnlineGame, OnlineRequest, Trust};
 use ledge_netsim::LinkConfig;
 use ledge_server::{Server, ServerConfig};

@@ -1,7 +1,8 @@
 //! Trusting the server's certificate: pinned, or trust on first use with a
 //! known-hosts file, over real QUIC.
 
-use ledge_client::trust::{connect_trusted, Trust, TrustError, Trusted};
+use ledge_client::error::TrustError;
+use ledge_client::net::trust::{connect_trusted, Trust, Trusted};
 use ledge_client::{ClientError, Fingerprint, JoinOptions};
 use ledge_tests::TestServer;
 

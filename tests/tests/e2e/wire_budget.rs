@@ -8,7 +8,7 @@
 
 use std::time::{Duration, Instant};
 
-use ledge_client::session::{Session, SessionEvent, SnapshotUpdate};
+use ledge_client::net::session::{Session, SessionEvent, SnapshotUpdate};
 use ledge_client::InputClock;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::PlayerId;

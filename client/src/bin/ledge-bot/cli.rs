@@ -9,9 +9,9 @@ use ledge_client::bot::{
     connect_and_run, misbehave, run_thin, run_thin_with, BotOptions, Brain, Idle, Misbehavior,
     RandomWalker, Runner,
 };
-use ledge_client::bundle::LevelCache;
-use ledge_client::transport::resolve;
-use ledge_client::trust::{KnownHosts, Trust};
+use ledge_client::net::bundle::LevelCache;
+use ledge_client::net::transport::resolve;
+use ledge_client::net::trust::{KnownHosts, Trust};
 use ledge_client::Fingerprint;
 use ledge_levels::default_route;
 use ledge_shared::input::Buttons;

@@ -56,8 +56,32 @@ fn arrow(from: Vec2, dir: Vec2, len: f32, color: Color) {
 
 /// Draws the overlay for `world` and a legend in the bottom-left corner.
 pub fn draw(world: &World, view: &View) {
+    draw_colliders(world, view);
+    draw_touched_sides(world, view);
+    // Broad phase: the strip boundaries of the two finest levels.
+    let strips = strips(world, view);
+    let tile_contacts = draw_tile_contacts(world, view);
+    let count = draw_contacts(world, view);
+    let lines = [
+        format!(
+            "debug (F1): {} bodies, {} colliders; {} tile contacts at the first detection; left unresolved: {} solid + {} trigger",
+            world.bodies().count(),
+            world.colliders().count(),
+            tile_contacts,
+            count.0,
+            count.1
+        ),
+        format!(
+            "shapes: yellow dynamic, blue kinematic, grey static, magenta trigger; red: touched sides; green: tile MTV x{MTV_SCALE} (units); blue: total push"
+        ),
+        strips,
+    ];
+    draw_legend(&lines);
+}
+
+/// Colliders, coloured by kind, and one-way platforms' directions.
+fn draw_colliders(world: &World, view: &View) {
     let seen = view.visible();
-    // Colliders.
     for c in world.colliders() {
         let (lo, hi) = c.world_bounds();
         let (lo, hi) = (world_px(lo), world_px(hi));
@@ -106,7 +130,10 @@ pub fn draw(world: &World, view: &View) {
             arrow(centre, vec2(n.x as f32, n.y as f32), 8.0, color);
         }
     }
-    // Touched sides of every body (from the last step).
+}
+
+/// Touched sides of every body (from the last step).
+fn draw_touched_sides(world: &World, view: &View) {
     for (id, body) in world.bodies() {
         let sides = body.sides();
         if sides.is_empty() {
@@ -134,9 +161,11 @@ pub fn draw(world: &World, view: &View) {
         side(Sides::TOP, lo, vec2(hi.x, lo.y));
         side(Sides::BOTTOM, vec2(lo.x, hi.y), hi);
     }
-    // Broad phase: the strip boundaries of the two finest levels.
-    let strips = strips(world, view);
-    // Tile contacts at the start of restitution, and each body's push.
+}
+
+/// Tile contacts at the start of restitution, and each body's push;
+/// returns how many tile contacts.
+fn draw_tile_contacts(world: &World, view: &View) -> usize {
     let mut tile_contacts = 0;
     if let Some(map) = world.tilemap() {
         let mut out = Vec::new();
@@ -185,8 +214,12 @@ pub fn draw(world: &World, view: &View) {
             }
         }
     }
-    // Contacts left in the world's buffer: the tile touched, and the MTV
-    // from A's centre.
+    tile_contacts
+}
+
+/// Contacts left in the world's buffer: the tile touched, and the MTV
+/// from A's centre; returns how many (solid, trigger).
+fn draw_contacts(world: &World, view: &View) -> (usize, usize) {
     let mut count = (0, 0);
     for contact in world.contacts() {
         if let (Some(tile), Some(map)) = (contact.tile(), world.tilemap()) {
@@ -221,21 +254,11 @@ pub fn draw(world: &World, view: &View) {
         let label = format!("{},{}", m.x, m.y);
         draw_text(&label, from.x + 6.0, from.y - 6.0, 14.0, WHITE);
     }
-    // Legend.
-    let lines = [
-        format!(
-            "debug (F1): {} bodies, {} colliders; {} tile contacts at the first detection; left unresolved: {} solid + {} trigger",
-            world.bodies().count(),
-            world.colliders().count(),
-            tile_contacts,
-            count.0,
-            count.1
-        ),
-        format!(
-            "shapes: yellow dynamic, blue kinematic, grey static, magenta trigger; red: touched sides; green: tile MTV x{MTV_SCALE} (units); blue: total push"
-        ),
-        strips,
-    ];
+    count
+}
+
+/// The legend's lines, bottom-left, on dark boxes.
+fn draw_legend(lines: &[String]) {
     let h = screen_height();
     for (i, l) in lines.iter().enumerate() {
         let y = h - 34.0 - (lines.len() - 1 - i) as f32 * 18.0;

@@ -283,57 +283,8 @@ impl Fx {
         self.recent.push(effect);
         let feet = at.feet();
         match effect {
-            Effect::Hurt => {
-                // The pop: bits of the player's colour, some white, a ring.
-                self.burst(
-                    at.pos,
-                    &[at.tint],
-                    Burst {
-                        spread: at.size * 0.4,
-                        speed: (70.0, 190.0),
-                        life: (0.45, 0.8),
-                        size: (2.0, 3.5),
-                        gravity: 420.0,
-                        drag: 0.3,
-                        ..Burst::new(22, Shape::Square)
-                    },
-                );
-                self.burst(
-                    at.pos,
-                    &[WHITE],
-                    Burst {
-                        speed: (30.0, 110.0),
-                        life: (0.25, 0.45),
-                        size: (1.0, 1.8),
-                        drag: 0.2,
-                        ..Burst::new(10, Shape::Dot)
-                    },
-                );
-                self.ring(at.pos, 3.0, 0.3, WHITE);
-                if ours {
-                    self.kick(0.6);
-                    self.flash_with(Color::new(0.85, 0.1, 0.12, 0.35));
-                }
-            }
-            Effect::Respawn => {
-                // A shimmer rising from the feet, and a ring.
-                self.burst(
-                    feet,
-                    &[WHITE, at.tint],
-                    Burst {
-                        spread: vec2(at.size.x * 0.7, 1.0),
-                        angle: 0.15,
-                        speed: (30.0, 90.0),
-                        life: (0.4, 0.7),
-                        size: (1.0, 2.0),
-                        ..Burst::new(16, Shape::Streak)
-                    },
-                );
-                self.ring(at.pos, 2.0, 0.35, at.tint);
-                if ours {
-                    self.flash_with(Color::new(1.0, 1.0, 1.0, 0.12));
-                }
-            }
+            Effect::Hurt => self.hurt(at, ours),
+            Effect::Respawn => self.respawn(at, ours),
             Effect::Coin => {
                 self.burst(
                     at.pos,
@@ -405,28 +356,85 @@ impl Fx {
                     self.kick(0.2);
                 }
             }
-            Effect::Goal => {
-                self.burst(
-                    at.pos,
-                    &palette::CONFETTI,
-                    Burst {
-                        angle: 1.1,
-                        speed: (90.0, 230.0),
-                        life: (1.0, 1.8),
-                        size: (1.5, 3.0),
-                        gravity: 260.0,
-                        drag: 0.35,
-                        ..Burst::new(if ours { 60 } else { 30 }, Shape::Square)
-                    },
-                );
-                self.ring(at.pos, 4.0, 0.5, palette::GOAL);
-                if ours {
-                    self.kick(0.25);
-                    self.flash_with(Color::new(1.0, 0.85, 0.25, 0.25));
-                }
-            }
+            Effect::Goal => self.goal(at, ours),
             Effect::Land => self.dust(feet, 6, 1.0),
             Effect::Jump => self.dust(feet, 4, 0.7),
+        }
+    }
+
+    /// A hurt player pops: bits of its colour, some white, a ring.
+    fn hurt(&mut self, at: At, ours: bool) {
+        self.burst(
+            at.pos,
+            &[at.tint],
+            Burst {
+                spread: at.size * 0.4,
+                speed: (70.0, 190.0),
+                life: (0.45, 0.8),
+                size: (2.0, 3.5),
+                gravity: 420.0,
+                drag: 0.3,
+                ..Burst::new(22, Shape::Square)
+            },
+        );
+        self.burst(
+            at.pos,
+            &[WHITE],
+            Burst {
+                speed: (30.0, 110.0),
+                life: (0.25, 0.45),
+                size: (1.0, 1.8),
+                drag: 0.2,
+                ..Burst::new(10, Shape::Dot)
+            },
+        );
+        self.ring(at.pos, 3.0, 0.3, WHITE);
+        if ours {
+            self.kick(0.6);
+            self.flash_with(Color::new(0.85, 0.1, 0.12, 0.35));
+        }
+    }
+
+    /// A respawn: a shimmer rising from the feet, and a ring.
+    fn respawn(&mut self, at: At, ours: bool) {
+        let feet = at.feet();
+        self.burst(
+            feet,
+            &[WHITE, at.tint],
+            Burst {
+                spread: vec2(at.size.x * 0.7, 1.0),
+                angle: 0.15,
+                speed: (30.0, 90.0),
+                life: (0.4, 0.7),
+                size: (1.0, 2.0),
+                ..Burst::new(16, Shape::Streak)
+            },
+        );
+        self.ring(at.pos, 2.0, 0.35, at.tint);
+        if ours {
+            self.flash_with(Color::new(1.0, 1.0, 1.0, 0.12));
+        }
+    }
+
+    /// The goal reached: confetti and a ring (more, a kick and a flash, for ours).
+    fn goal(&mut self, at: At, ours: bool) {
+        self.burst(
+            at.pos,
+            &palette::CONFETTI,
+            Burst {
+                angle: 1.1,
+                speed: (90.0, 230.0),
+                life: (1.0, 1.8),
+                size: (1.5, 3.0),
+                gravity: 260.0,
+                drag: 0.35,
+                ..Burst::new(if ours { 60 } else { 30 }, Shape::Square)
+            },
+        );
+        self.ring(at.pos, 4.0, 0.5, palette::GOAL);
+        if ours {
+            self.kick(0.25);
+            self.flash_with(Color::new(1.0, 0.85, 0.25, 0.25));
         }
     }
 

@@ -275,61 +275,7 @@ pub fn key_by_name(name: &str) -> Option<KeyCode> {
         .find(|k| format!("{k:?}").to_ascii_lowercase() == wanted)
 }
 
-/// One gamepad's controls that ledge reads, whatever reports them (gilrs
-/// natively, the browser's Gamepad API in a page).
-#[cfg_attr(
-    not(any(feature = "gamepad", target_arch = "wasm32")),
-    allow(dead_code, reason = "read only by builds with gamepads")
-)]
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct PadState {
-    /// D-pad directions held.
-    pub left: bool,
-    pub right: bool,
-    pub up: bool,
-    pub down: bool,
-    /// The south (A/cross) and east (B/circle) face buttons.
-    pub south: bool,
-    pub east: bool,
-    /// Select (back/share).
-    pub select: bool,
-    /// The left stick, -1..=1, x to the right and y up.
-    pub stick: (f32, f32),
-}
-
-#[cfg_attr(
-    not(any(feature = "gamepad", target_arch = "wasm32")),
-    allow(dead_code, reason = "read only by builds with gamepads")
-)]
-impl PadState {
-    /// D-pad or left stick to move, south or east to jump (down + jump
-    /// drops through), select to restart.
-    pub fn buttons(&self) -> Buttons {
-        let (x, y) = self.stick;
-        let mut bits = 0;
-        if self.left || x < -0.5 {
-            bits |= Buttons::LEFT;
-        }
-        if self.right || x > 0.5 {
-            bits |= Buttons::RIGHT;
-        }
-        if self.up || y > 0.5 {
-            bits |= Buttons::UP;
-        }
-        if self.down || y < -0.5 {
-            bits |= Buttons::DOWN;
-        }
-        if self.south || self.east {
-            bits |= Buttons::JUMP;
-        }
-        if self.select {
-            bits |= Buttons::RESTART;
-        }
-        Buttons(bits)
-    }
-}
-
-/// Gamepads through gilrs (see [`PadState::buttons`]).
+/// Gamepads through gilrs (see [`crate::pad::PadState::buttons`]).
 #[cfg(all(feature = "gamepad", not(target_arch = "wasm32")))]
 pub struct Gamepads {
     gilrs: Option<gilrs::Gilrs>,
@@ -358,7 +304,7 @@ impl Gamepads {
         while gilrs.next_event().is_some() {}
         let mut bits = 0;
         for (_, pad) in gilrs.gamepads() {
-            let state = PadState {
+            let state = crate::pad::PadState {
                 left: pad.is_pressed(Button::DPadLeft),
                 right: pad.is_pressed(Button::DPadRight),
                 up: pad.is_pressed(Button::DPadUp),
@@ -375,7 +321,7 @@ impl Gamepads {
 }
 
 /// Gamepads in a browser: the page's Gamepad API, read each frame (see
-/// [`PadState::buttons`]).
+/// [`crate::pad::PadState::buttons`]).
 #[cfg(target_arch = "wasm32")]
 pub struct Gamepads;
 
@@ -389,7 +335,7 @@ impl Gamepads {
 
     /// The buttons held on any connected gamepad.
     pub fn held(&mut self) -> Buttons {
-        let bits = crate::web::gamepads()
+        let bits = crate::page::gamepads()
             .iter()
             .fold(0, |bits, pad| bits | pad.buttons().0);
         Buttons(bits)
@@ -415,39 +361,6 @@ impl Gamepads {
 
 #[cfg(test)]
 mod tests {
-
-    #[test]
-    fn a_gamepad_moves_jumps_and_restarts_like_the_keys() {
-        let none = PadState::default();
-        assert_eq!(none.buttons(), Buttons::NONE);
-        let dpad = PadState {
-            right: true,
-            south: true,
-            ..none
-        };
-        assert_eq!(dpad.buttons(), Buttons(Buttons::RIGHT | Buttons::JUMP));
-        // The stick past half way counts; a resting stick's drift does not.
-        let stick = PadState {
-            stick: (-0.9, -0.8),
-            east: true,
-            ..none
-        };
-        assert_eq!(
-            stick.buttons(),
-            Buttons(Buttons::LEFT | Buttons::DOWN | Buttons::JUMP)
-        );
-        let drift = PadState {
-            stick: (0.2, -0.3),
-            ..none
-        };
-        assert_eq!(drift.buttons(), Buttons::NONE);
-        let restart = PadState {
-            select: true,
-            ..none
-        };
-        assert_eq!(restart.buttons(), Buttons(Buttons::RESTART));
-    }
-
     use super::*;
 
     #[test]

@@ -10,9 +10,11 @@ use clap::Parser;
 use ledge_client::{Fingerprint, OnlineRequest, Trust};
 use macroquad::prelude::vec2;
 
+use crate::game_loop::{game, Setup};
 use crate::keys::{self, Bindings};
+use crate::outcome::{tell, EXIT_CODE, EXIT_FAILED, EXIT_UNTRUSTED};
 use crate::script::Script;
-use crate::{game, local, play, tell, Setup, EXIT_CODE, EXIT_FAILED, EXIT_UNTRUSTED};
+use crate::{local, play};
 
 /// How long the window waits for the server's first answer before it
 /// opens (showing "connecting..."): enough for the TLS handshake, so a

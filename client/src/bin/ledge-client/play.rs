@@ -19,7 +19,7 @@ use ledge_client::OnlineRequest;
 #[cfg(not(target_arch = "wasm32"))]
 type OnlineGame = ledge_client::OnlineGame;
 #[cfg(target_arch = "wasm32")]
-type OnlineGame = ledge_client::OnlineGame<crate::web::WebNet>;
+type OnlineGame = ledge_client::OnlineGame<crate::page::WebNet>;
 use ledge_shared::game::PlayerView;
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
@@ -134,7 +134,7 @@ impl Play {
     /// Joins the server that served the page over `net`; the game starts
     /// when welcomed. `level` is drawn until then.
     #[cfg(target_arch = "wasm32")]
-    pub fn web(net: crate::web::WebNet, server: &str, level: Level, name: &str) -> Play {
+    pub fn web(net: crate::page::WebNet, server: &str, level: Level, name: &str) -> Play {
         Play {
             level,
             mode: Mode::Online(Box::new(OnlineGame::with_network(net, server, name))),

@@ -175,7 +175,6 @@ fn rgb(c: macroquad::color::Color) -> String {
 /// The JSON text (see the module documentation).
 pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
     let v = shot.view;
-    let px = |u: IVec2| Vec2::new(u.x as f32, u.y as f32) / 256.0;
     let mut s = String::from("{\n");
     let name = png
         .file_name()
@@ -193,30 +192,7 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
     let l = shot.level_px;
     let _ = writeln!(s, "  \"level_px\": [{}, {}, {}, {}],", l.x, l.y, l.w, l.h);
     let _ = writeln!(s, "  \"tile_px\": {},", shot.tile_px);
-    match shot.server {
-        Some((tick, id, pos, half)) => {
-            let p = px(pos);
-            let _ = writeln!(s, "  \"player\": {{");
-            let _ = writeln!(s, "    \"id\": {id},");
-            let _ = writeln!(s, "    \"server_tick\": {tick},");
-            let _ = writeln!(s, "    \"server_pos_units\": [{}, {}],", pos.x, pos.y);
-            let _ = writeln!(s, "    \"server_pos_px\": {},", pair(p));
-            let _ = writeln!(s, "    \"server_screen\": {},", pair(v.to_screen(p)));
-            let _ = writeln!(s, "    \"size_px\": {},", pair(px(half * 2)));
-            match shot.drawn {
-                Some(d) => {
-                    let _ = writeln!(s, "    \"drawn_screen\": {}", pair(v.to_screen(d)));
-                }
-                None => {
-                    let _ = writeln!(s, "    \"drawn_screen\": null");
-                }
-            }
-            let _ = writeln!(s, "  }},");
-        }
-        None => {
-            let _ = writeln!(s, "  \"player\": null,");
-        }
-    }
+    describe_player(&mut s, shot);
     let remotes: Vec<String> = shot
         .remotes
         .iter()
@@ -244,7 +220,61 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
         rgb(palette::LOCAL_PLAYER),
         rgb(palette::PLANK),
     );
-    match &shot.hud {
+    describe_hud(&mut s, shot.hud.as_ref());
+    let fx = &shot.fx;
+    let recent: Vec<String> = fx
+        .recent
+        .iter()
+        .map(|e| json_string(&format!("{e:?}")))
+        .collect();
+    let _ = writeln!(
+        s,
+        "  \"fx\": {{\"particles\": {}, \"shake_px\": {:.3}, \"flash_alpha\": {:.3}, \"recent\": [{}], \"dead\": {}}},",
+        fx.particles,
+        fx.shake,
+        fx.flash,
+        recent.join(", "),
+        fx.dead
+    );
+    describe_failure(&mut s, shot.failure);
+    s.push_str("}\n");
+    s
+}
+
+/// Our player, as the server last said and as drawn (`null` before the
+/// first snapshot).
+fn describe_player(s: &mut String, shot: &Shot) {
+    let v = shot.view;
+    let px = |u: IVec2| Vec2::new(u.x as f32, u.y as f32) / 256.0;
+    match shot.server {
+        Some((tick, id, pos, half)) => {
+            let p = px(pos);
+            let _ = writeln!(s, "  \"player\": {{");
+            let _ = writeln!(s, "    \"id\": {id},");
+            let _ = writeln!(s, "    \"server_tick\": {tick},");
+            let _ = writeln!(s, "    \"server_pos_units\": [{}, {}],", pos.x, pos.y);
+            let _ = writeln!(s, "    \"server_pos_px\": {},", pair(p));
+            let _ = writeln!(s, "    \"server_screen\": {},", pair(v.to_screen(p)));
+            let _ = writeln!(s, "    \"size_px\": {},", pair(px(half * 2)));
+            match shot.drawn {
+                Some(d) => {
+                    let _ = writeln!(s, "    \"drawn_screen\": {}", pair(v.to_screen(d)));
+                }
+                None => {
+                    let _ = writeln!(s, "    \"drawn_screen\": null");
+                }
+            }
+            let _ = writeln!(s, "  }},");
+        }
+        None => {
+            let _ = writeln!(s, "  \"player\": null,");
+        }
+    }
+}
+
+/// The HUD as drawn (`null` when hidden).
+fn describe_hud(s: &mut String, hud: Option<&HudShot>) {
+    match hud {
         Some(h) => {
             let _ = writeln!(s, "  \"hud\": {{");
             let _ = writeln!(s, "    \"name\": {},", json_string(h.name));
@@ -290,22 +320,11 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
             let _ = writeln!(s, "  \"hud\": null,");
         }
     }
-    let fx = &shot.fx;
-    let recent: Vec<String> = fx
-        .recent
-        .iter()
-        .map(|e| json_string(&format!("{e:?}")))
-        .collect();
-    let _ = writeln!(
-        s,
-        "  \"fx\": {{\"particles\": {}, \"shake_px\": {:.3}, \"flash_alpha\": {:.3}, \"recent\": [{}], \"dead\": {}}},",
-        fx.particles,
-        fx.shake,
-        fx.flash,
-        recent.join(", "),
-        fx.dead
-    );
-    match shot.failure {
+}
+
+/// The session's failure and its panel (`null` unless it failed).
+fn describe_failure(s: &mut String, failure: Option<(&str, &BannerLayout)>) {
+    match failure {
         Some((message, layout)) => {
             let p = layout.panel;
             let lines: Vec<String> = layout.lines.iter().map(|(_, l)| json_string(l)).collect();
@@ -325,8 +344,6 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
             let _ = writeln!(s, "  \"failure\": null");
         }
     }
-    s.push_str("}\n");
-    s
 }
 
 #[cfg(test)]

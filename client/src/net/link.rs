@@ -4,7 +4,7 @@
 //! stream as messages.
 //!
 //! [`Link`] is the [`Network`] of a browser's
-//! [`crate::online::OnlineGame`]: the driver calls [`Link::on_open`] when
+//! [`crate::net::online::OnlineGame`]: the driver calls [`Link::on_open`] when
 //! the transport is up, feeds what arrives ([`Link::on_message`],
 //! [`Link::on_closed`]), calls [`Link::poll`] once per frame (pings) and
 //! sends what [`Link::poll_transmit`] gives. Behind it are the same
@@ -26,11 +26,11 @@ use ledge_shared::protocol::{
     write_frame, ClientControl, CloseCode, Message, NoticeKind, PlayerId, Welcome,
 };
 
-use crate::download::{embedded, Download, Fetched};
 use crate::error::ClientError;
+use crate::net::download::{embedded, Download, Fetched};
+use crate::net::session::{Handshake, JoinOptions, SessionState};
 use crate::net::{NetEvent, Network};
 use crate::netstats::TransportSample;
-use crate::session::{Handshake, JoinOptions, SessionState};
 use crate::time::Instant;
 
 /// Something that arrived on the transport: the control stream's bytes,
@@ -46,7 +46,7 @@ pub const MAX_TRANSMITS: usize = 256;
 /// How often the server is pinged (round-trip time).
 pub const PING_EVERY: Duration = Duration::from_secs(1);
 /// How long the server has to answer the hello.
-pub const HELLO_TIMEOUT: Duration = crate::session::REPLY_TIMEOUT;
+pub const HELLO_TIMEOUT: Duration = crate::net::session::REPLY_TIMEOUT;
 
 /// Something to send.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -232,14 +232,14 @@ impl Link {
         };
         let mut moved = Vec::new();
         while let Some(event) = state.poll_event() {
-            if let crate::session::SessionEvent::Pong { rtt: Some(rtt), .. } = &event {
+            if let crate::net::session::SessionEvent::Pong { rtt: Some(rtt), .. } = &event {
                 self.sample.rtt = *rtt;
             }
             match &event {
-                crate::session::SessionEvent::Notice(NoticeKind::Kick { reason }) => {
+                crate::net::session::SessionEvent::Notice(NoticeKind::Kick { reason }) => {
                     self.last_word = Some((CloseCode::Kicked, reason.clone()));
                 }
-                crate::session::SessionEvent::Notice(NoticeKind::Shutdown) => {
+                crate::net::session::SessionEvent::Notice(NoticeKind::Shutdown) => {
                     self.last_word = Some((CloseCode::ServerShutdown, String::new()));
                 }
                 _ => {}

@@ -19,7 +19,7 @@ use crate::time::Instant;
 
 use ledge_shared::protocol::Welcome;
 
-use crate::session::state::input_interval;
+use crate::net::session::state::input_interval;
 
 /// Ticks the oldest input of a datagram waits for it at `tick_rate`.
 fn batch_wait(tick_rate: u32) -> u64 {

@@ -22,10 +22,10 @@ use ledge_levels::bundle::sha256;
 use ledge_levels::LevelBundle;
 use ledge_shared::protocol::{ClientControl, LevelOffer};
 
-pub use crate::download::Fetched;
-use crate::download::{decode, embedded, Download};
 use crate::error::ClientError;
-use crate::session::Session;
+pub use crate::net::download::Fetched;
+use crate::net::download::{decode, embedded, Download};
+use crate::net::session::Session;
 
 /// Most bytes the cache keeps; older bundles are deleted past it.
 pub const CACHE_BYTES: u64 = 512 << 20;

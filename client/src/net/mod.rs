@@ -3,10 +3,46 @@
 //! ([`NetStatus`]), and what a driver offers ([`Network`]).
 //!
 //! Natively the driver is the background thread
-//! ([`crate::background::NetThread`], QUIC); in a browser it is the
+//! ([`crate::net::background::NetThread`], QUIC); in a browser it is the
 //! page's WebTransport or WebSocket, driven from the page's frames. Either
-//! way [`crate::online::OnlineGame`] turns the events into the predicted
+//! way [`crate::net::online::OnlineGame`] turns the events into the predicted
 //! game.
+//!
+//! Everything about talking to a server lives in this directory, below the
+//! game ([`crate::game`]) and the bots:
+//!
+//! * [`session`]: the handshake, inputs out, snapshots and control
+//!   messages in: the protocol sans IO ([`session::SessionState`]) and its
+//!   QUIC driver ([`session::Session`]);
+//! * [`transport`]: resolve and dial a server over QUIC;
+//! * [`trust`]: pinned fingerprints and trust on first use (known hosts);
+//! * [`verifier`]: the certificate verifier behind both;
+//! * [`link`]: a session over a transport driven from outside (the
+//!   browser's WebTransport or WebSocket), sans IO ([`link::Link`]);
+//! * [`background`]: the network on its own thread, for GUI front ends;
+//! * [`online`]: a networked game for a GUI ([`online::OnlineGame`]);
+//! * [`levels`]: the server's level, checked by hash;
+//! * [`download`]: a level download checked, sans IO;
+//! * [`bundle`]: the server's level downloaded, cached by hash.
+//!
+//! The modules with sockets, threads or files (`background`, `bundle`,
+//! `transport`, `trust`, `verifier`, the QUIC session) are native only.
+
+#[cfg(not(target_arch = "wasm32"))]
+pub mod background;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod bundle;
+pub mod download;
+pub mod levels;
+pub mod link;
+pub mod online;
+pub mod session;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod transport;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod trust;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod verifier;
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -16,12 +52,12 @@ use ledge_levels::LevelBundle;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{NoticeKind, PlayerId, Welcome};
 
-use crate::download::Fetched;
+use crate::net::download::Fetched;
+use crate::net::session::{SessionEvent, SnapshotUpdate};
 use crate::netstats::TransportSample;
-use crate::session::{SessionEvent, SnapshotUpdate};
 
 /// A network driver, polled once per frame by
-/// [`crate::online::OnlineGame`]. Nothing here blocks.
+/// [`crate::net::online::OnlineGame`]. Nothing here blocks.
 pub trait Network {
     /// The next event, if any.
     fn try_recv(&mut self) -> Option<NetEvent>;

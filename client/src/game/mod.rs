@@ -5,8 +5,8 @@
 //! the [`FrameView`] and [`NetStats`] a front end draws.
 //!
 //! The caller owns the transport (a [`crate::Session`] for bots and tests,
-//! a [`crate::background::NetThread`] for the GUI, see
-//! [`crate::online::OnlineGame`]) and feeds it:
+//! a [`crate::net::background::NetThread`] for the GUI, see
+//! [`crate::net::online::OnlineGame`]) and feeds it:
 //!
 //! ```text
 //! every frame:   game.update(now, max_ticks, |i| buttons, |tick, b| send the input)
@@ -16,6 +16,17 @@
 //! the roster:    game.on_player_joined(id, name), game.on_player_left(id)
 //! to draw:       game.view(), game.net_stats(now)
 //! ```
+//!
+//! The parts it ties together are its submodules:
+//!
+//! * [`predict`]: prediction and reconciliation ([`Predictor`]);
+//! * [`interp`]: remote players drawn in the past ([`Interpolator`]);
+//! * [`clock`]: the synchronised local clock ([`SyncClock`]) and the
+//!   simple [`clock::InputClock`].
+
+pub mod clock;
+pub mod interp;
+pub mod predict;
 
 use std::collections::BTreeMap;
 use std::time::Duration;
@@ -30,13 +41,13 @@ use ledge_shared::level::Level;
 use ledge_shared::protocol::{decode_sim_config, EntityState, PlayerId, Welcome, MAX_ROSTER};
 use ledge_shared::world::Sides;
 
-use crate::clock::SyncClock;
 use crate::error::ClientError;
-use crate::interp::Interpolator;
-use crate::levels::check_level;
+use crate::game::clock::SyncClock;
+use crate::game::interp::Interpolator;
+use crate::game::predict::{Predictor, Reconciled};
+use crate::net::levels::check_level;
+use crate::net::session::SnapshotUpdate;
 use crate::netstats::{StatsTracker, TransportSample};
-use crate::predict::{Predictor, Reconciled};
-use crate::session::SnapshotUpdate;
 use crate::view::{px2, EntityDraw, EntityType, Facing, FrameView, NetStats, PlayerDraw};
 
 /// At most this many inputs are handed to `send` per [`ClientGame::update`]
@@ -132,7 +143,7 @@ impl ClientGame {
     }
 
     /// Sets the input margin the clock keeps with no jitter, ticks (default
-    /// [`crate::clock::BASE_MARGIN`]).
+    /// [`crate::game::clock::BASE_MARGIN`]).
     pub fn set_base_margin(&mut self, ticks: f64) {
         self.clock.set_base_margin(ticks);
     }

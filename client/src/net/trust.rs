@@ -18,9 +18,9 @@ use std::path::{Path, PathBuf};
 
 use ledge_shared::protocol::{Fingerprint, RoomInfo};
 
-use crate::error::ClientError;
-use crate::session::{handshake, list_rooms, JoinOptions, Session};
-use crate::transport::{dial_any_or, resolve, Dialed};
+use crate::error::{ClientError, TrustError};
+use crate::net::session::{handshake, list_rooms, JoinOptions, Session};
+use crate::net::transport::{dial_any_or, resolve, Dialed};
 
 /// How to trust the server's certificate.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -58,51 +58,6 @@ pub fn default_known_hosts() -> PathBuf {
         Some(dir) => dir.join("ledge").join("known_hosts"),
         None => PathBuf::from("known_hosts"),
     }
-}
-
-/// Why a certificate was not trusted, or the known-hosts file not used.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum TrustError {
-    /// The server presented a different certificate than the one stored for
-    /// its address.
-    #[error(
-        "the certificate of {host} has CHANGED: it presented fingerprint {presented}, but \
-         {path} (line {line}) trusts {stored} for this address. If the server was \
-         reinstalled or its certificate regenerated, this is expected; otherwise someone may \
-         be intercepting the connection. Ask the server's operator for its fingerprint; if it \
-         is {presented}, remove line {line} from {path} and connect again (or pass \
-         --cert-hash {presented}). Refusing to connect."
-    )]
-    Changed {
-        /// The address, as looked up in the file.
-        host: String,
-        /// What the server presented now.
-        presented: Fingerprint,
-        /// What the file holds.
-        stored: Fingerprint,
-        /// The file.
-        path: PathBuf,
-        /// The line holding `stored` (1-based).
-        line: usize,
-    },
-    /// The file could not be read or written.
-    #[error("known hosts file {path}: {message}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// What failed.
-        message: String,
-    },
-    /// A line of the file is not `HOST:PORT FINGERPRINT`.
-    #[error("known hosts file {path}, line {line}: {message} (expected `HOST:PORT FINGERPRINT`)")]
-    Malformed {
-        /// The file.
-        path: PathBuf,
-        /// The line (1-based).
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
 }
 
 /// One remembered server.

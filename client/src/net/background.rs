@@ -24,13 +24,13 @@ use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{CloseCode, Fingerprint, PlayerId};
 use tokio::sync::oneshot;
 
-use crate::bundle::{fetch_level, FetchOptions, LevelCache};
 use crate::error::ClientError;
+use crate::net::bundle::{fetch_level, FetchOptions, LevelCache};
+use crate::net::session::{handshake, JoinOptions, Session, SessionEvent};
+use crate::net::trust::{dial_trusted, Trust};
 use crate::net::Network;
 pub use crate::net::{NetEvent, NetStatus};
 use crate::netstats::TransportSample;
-use crate::session::{handshake, JoinOptions, Session, SessionEvent};
-use crate::trust::{dial_trusted, Trust};
 
 /// How often the background thread pings the server.
 const PING_INTERVAL: Duration = Duration::from_secs(1);
@@ -72,7 +72,7 @@ pub struct NetOptions {
     /// fingerprint is ignored.
     pub trust: Option<Trust>,
     /// Get the server's level after joining (embedded, cached or
-    /// downloaded: [`crate::bundle::fetch_level`]) and send it as
+    /// downloaded: [`crate::net::bundle::fetch_level`]) and send it as
     /// [`NetEvent::Level`] before [`NetEvent::Connected`]; `false` when the
     /// front end has the level file.
     pub download_level: bool,

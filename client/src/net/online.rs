@@ -37,17 +37,17 @@ use ledge_shared::level::Level;
 use ledge_shared::protocol::Fingerprint;
 use ledge_shared::protocol::{NoticeKind, PlayerId, StateSnapshot};
 
-#[cfg(not(target_arch = "wasm32"))]
-use crate::background::{ConnectRequest, NetOptions, NetThread};
-#[cfg(not(target_arch = "wasm32"))]
-use crate::bundle::LevelCache;
-use crate::download::Fetched;
 use crate::game::ClientGame;
-use crate::levels::{check_level, level_for};
+#[cfg(not(target_arch = "wasm32"))]
+use crate::net::background::{ConnectRequest, NetOptions, NetThread};
+#[cfg(not(target_arch = "wasm32"))]
+use crate::net::bundle::LevelCache;
+use crate::net::download::Fetched;
+use crate::net::levels::{check_level, level_for};
+#[cfg(not(target_arch = "wasm32"))]
+use crate::net::trust::Trust;
 use crate::net::{NetEvent, NetStatus, Network};
 use crate::time::Instant;
-#[cfg(not(target_arch = "wasm32"))]
-use crate::trust::Trust;
 use crate::view::{FrameView, NetStats};
 
 /// Chat lines kept.
@@ -74,7 +74,7 @@ pub struct OnlineRequest {
     /// embedded default level, the cache, or downloaded.
     pub level: Option<PathBuf>,
     /// Where downloaded levels are cached (`None`: in memory only;
-    /// [`crate::bundle::LevelCache::default_dir`] is the usual place).
+    /// [`crate::net::bundle::LevelCache::default_dir`] is the usual place).
     pub level_cache: Option<PathBuf>,
 }
 

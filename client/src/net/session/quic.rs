@@ -14,7 +14,7 @@ use ledge_shared::protocol::{
 
 use super::{JoinOptions, SessionEvent, SessionState, SessionStats, REPLY_TIMEOUT};
 use crate::error::ClientError;
-use crate::transport::{dial, Dialed};
+use crate::net::transport::{dial, Dialed};
 
 /// How long [`Session::close`] waits for the server to close after `Leave`.
 const CLOSE_LINGER: Duration = Duration::from_secs(1);

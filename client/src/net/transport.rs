@@ -8,7 +8,7 @@ use ledge_shared::protocol::{Fingerprint, ALPN};
 use quinn::crypto::rustls::QuicClientConfig;
 
 use crate::error::ClientError;
-use crate::verifier::PinnedCertVerifier;
+use crate::net::verifier::PinnedCertVerifier;
 
 /// Keep-alive interval: well inside the server's 10 s idle timeout.
 pub const KEEP_ALIVE: Duration = Duration::from_secs(3);

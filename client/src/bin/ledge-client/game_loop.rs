@@ -1,0 +1,696 @@
+//! The game loop: frame after frame until the player quits, the ticks
+//! asked for are played, or a failed session has been shown; each frame a
+//! sequence of named steps ([`GameLoop::frame`]): input, simulation,
+//! sound, network, the scene, drawing, the page's report, the end.
+//!
+//! Both entry points ([`crate::native`], and `web` in the browser) prepare a
+//! [`Setup`] and hand it to [`game`]; the loop uses the modules below it
+//! (play, keys, camera, render, effects, HUD, screenshot) and none of
+//! them uses it.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use ledge_client::anim::Animator;
+use ledge_client::audio::{Audio, AudioStatus, Effect};
+use ledge_client::cues::Cues;
+use ledge_client::time::Instant;
+use ledge_client::view::{px2, FrameView, NetStats};
+use ledge_shared::fixed::UNITS_PER_PX;
+use ledge_shared::game::PlayerView;
+use ledge_shared::input::Buttons;
+use ledge_shared::level::Level;
+use macroquad::prelude::*;
+
+use crate::art::ArtView;
+use crate::camera::{self, Camera};
+use crate::keys::{Bindings, Gamepads};
+use crate::outcome::{fail, EXIT_FAILED, EXIT_JOIN_TIMEOUT, EXIT_UNTRUSTED};
+use crate::render::{self, EntitySprite, PlayerSprite};
+use crate::script::Script;
+use crate::{debug, fx, hud, play, shot};
+
+/// How long "sound off: why" stays on screen, seconds from the start.
+const SOUND_NOTICE_SECONDS: f64 = 6.0;
+
+/// The controls hint stays this long after the first move, then fades
+/// out over [`HINT_FADE`] seconds.
+const HINT_STAYS: f64 = 4.0;
+const HINT_FADE: f64 = 1.5;
+
+/// Frames are not drawn faster than this (no vsync under Xvfb).
+const MAX_FPS: f64 = 240.0;
+
+/// Frames drawn with a failure's banner before `--exit-after-ticks` ends
+/// the run (and `--screenshot` takes the last): the first frames of a
+/// new window may not be on screen yet.
+const FAILURE_FRAMES: u32 = 3;
+
+/// The controls hint's opacity at `now`, the player having first moved at
+/// `first_move`.
+fn hint_alpha(first_move: Option<f64>, now: f64) -> f32 {
+    match first_move {
+        None => 1.0,
+        Some(t) => (1.0 - (now - t - HINT_STAYS) / HINT_FADE).clamp(0.0, 1.0) as f32,
+    }
+}
+
+/// Coins in `level`.
+fn coins_total(level: &Level) -> u32 {
+    let coins = level
+        .entities
+        .iter()
+        .filter(|e| matches!(e.kind, ledge_shared::level::EntityKind::Coin))
+        .count();
+    u32::try_from(coins).unwrap_or(u32::MAX)
+}
+
+/// Everything the game loop needs, prepared before the window opens.
+pub struct Setup {
+    pub play: play::Play,
+    pub bindings: Bindings,
+    pub script: Option<Script>,
+    pub exit_after: Option<u64>,
+    pub screenshot: Option<PathBuf>,
+    pub join_timeout: Duration,
+    pub name: String,
+    pub debug: bool,
+    pub net: bool,
+    /// Start with the HUD shown.
+    pub hud: bool,
+    /// Volume, 0..=1.
+    pub volume: f32,
+    pub mute: bool,
+    pub look_at: Option<Vec2>,
+    /// The level's art (textures are made when the window exists).
+    pub level_art: ledge_levels::art::LevelArt,
+    /// Kept alive for the whole game; dropped after the network thread.
+    #[cfg(not(target_arch = "wasm32"))]
+    pub server: Option<crate::local::LocalServer>,
+}
+
+/// Why the session cannot go on, if so: the exit code and the message
+/// (what went wrong and what to do). `waited`: time since the window
+/// opened.
+fn session_failure(setup: &Setup, waited: Duration) -> Option<(i32, String)> {
+    if let Some(message) = setup.play.untrusted() {
+        return Some((EXIT_UNTRUSTED, message.to_owned()));
+    }
+    if let Some(message) = setup.play.failure() {
+        return Some((EXIT_FAILED, message));
+    }
+    let waited_too_long =
+        setup.exit_after.is_some() && !setup.play.joined() && waited > setup.join_timeout;
+    waited_too_long.then(|| {
+        (
+            EXIT_JOIN_TIMEOUT,
+            format!(
+                "not joined to {} within {} s (--join-timeout): check the address and port \
+                 (the server prints them when it starts), that the server is running, and \
+                 that no firewall blocks UDP to that port",
+                setup.play.server(),
+                setup.join_timeout.as_secs()
+            ),
+        )
+    })
+}
+
+/// Runs the game in the window until it ends, then leaves the server.
+pub async fn game(setup: Setup) {
+    let mut game = GameLoop::new(setup);
+    // Closing the window ends the loop below, so we leave the server.
+    prevent_quit();
+    while game.frame() {
+        game.pace();
+        next_frame().await;
+    }
+    game.leave();
+}
+
+/// What lives from frame to frame.
+struct GameLoop {
+    setup: Setup,
+    started: Instant,
+    camera: Camera,
+    /// How players look from frame to frame (run, jump, landing squash).
+    animator: Animator,
+    pads: Gamepads,
+    graph: hud::NetGraph,
+    show_debug: bool,
+    show_hud: bool,
+    show_net: bool,
+    /// Sound: never fails; without a device it is off and says why.
+    audio: Audio,
+    /// Why there is no sound, if so.
+    sound_off: Option<String>,
+    cues: Cues,
+    effects: fx::Fx,
+    /// When the player first moved (the controls hint fades after it).
+    first_move: Option<f64>,
+    restart_key: String,
+    /// Ticks of play so far: the script's clock and --exit-after-ticks'.
+    played: u64,
+    last_frame: Instant,
+    art: ArtView,
+    /// The server's art arrives with its level (downloaded or cached).
+    server_art: bool,
+    /// The session's failure, once known: told once, then shown until the
+    /// player quits.
+    failed: Option<String>,
+    failed_frames: u32,
+}
+
+/// What a frame shows, and from where.
+struct Scene {
+    /// The level's extent, world pixels (the camera stays inside).
+    level_px: Rect,
+    frame_view: FrameView,
+    /// Our player as drawn, if in the game.
+    local: Option<PlayerSprite>,
+    remotes: Vec<PlayerSprite>,
+    /// The remote players' labels, in the order of `remotes`.
+    labels: Vec<String>,
+    entities: Vec<EntitySprite>,
+    me: Option<PlayerView>,
+    view: camera::View,
+}
+
+/// What the HUD (or the failure covering it) shows.
+struct Hud {
+    /// The failure's banner as drawn, if the session failed.
+    failure: Option<hud::BannerLayout>,
+    run: Option<hud::RunInfo>,
+    name: String,
+    results: Vec<hud::ResultRow>,
+}
+
+impl GameLoop {
+    /// The loop's state at the start: sound started, the level's art.
+    fn new(mut setup: Setup) -> GameLoop {
+        let started = Instant::now();
+        let camera = Camera::new();
+        let animator = Animator::new();
+        let pads = Gamepads::new();
+        let graph = hud::NetGraph::default();
+        let audio = Audio::start();
+        audio.set_volume(setup.volume);
+        audio.set_muted(setup.mute);
+        let sound_off = match audio.status() {
+            AudioStatus::Off { .. } => Some(audio.status().to_string()),
+            AudioStatus::Playing { .. } => None,
+        };
+        let restart_key = setup
+            .bindings
+            .restart_keys()
+            .first()
+            .map_or_else(|| "-".to_owned(), |k| format!("{k:?}"));
+        let art = ArtView::new(
+            std::mem::take(&mut setup.level_art),
+            &setup.play.level().tilemap,
+        );
+        GameLoop {
+            started,
+            camera,
+            animator,
+            pads,
+            graph,
+            show_debug: setup.debug,
+            show_hud: setup.hud,
+            show_net: setup.net,
+            audio,
+            sound_off,
+            cues: Cues::default(),
+            effects: fx::Fx::default(),
+            first_move: None,
+            restart_key,
+            played: 0,
+            last_frame: Instant::now(),
+            art,
+            server_art: false,
+            failed: None,
+            failed_frames: 0,
+            setup,
+        }
+    }
+
+    /// One frame, step by step; false once the game is over.
+    fn frame(&mut self) -> bool {
+        if self.quit_asked() {
+            return false;
+        }
+        self.adopt_server_art();
+        self.toggle_overlays();
+        let now = self.started.elapsed().as_secs_f64();
+        let dt = self.frame_time();
+        self.simulate(now);
+        let cued = self.play_sounds();
+        let stats = self.watch_network(now);
+        self.check_failure();
+        let mut scene = self.compose(dt);
+        self.animate_effects(&cued, &mut scene, dt);
+        self.draw_world(&scene, now);
+        let hud = self.hud_info(&scene);
+        self.draw_hud(&scene, &hud, stats.as_ref(), now);
+        #[cfg(target_arch = "wasm32")]
+        self.report_to_page(&scene);
+        !self.finished(&scene, &hud, now)
+    }
+
+    /// Esc (natively only: a page is left by closing its tab) or the window closed.
+    fn quit_asked(&self) -> bool {
+        let quit =
+            cfg!(not(target_arch = "wasm32")) && Bindings::pressed(&self.setup.bindings.quit);
+        quit || is_quit_requested()
+    }
+
+    /// Swaps in the server's level art once joined (it comes with its level).
+    fn adopt_server_art(&mut self) {
+        if !self.server_art && self.setup.play.joined() {
+            if let Some(level_art) = self.setup.play.level_art() {
+                self.art = ArtView::new(level_art.clone(), &self.setup.play.level().tilemap);
+            }
+            self.server_art = true;
+        }
+    }
+
+    /// Toggles the debug overlay, the HUD, the network panel and the sound by their keys.
+    fn toggle_overlays(&mut self) {
+        let bindings = &self.setup.bindings;
+        if Bindings::pressed(&bindings.debug) {
+            self.show_debug = !self.show_debug;
+        }
+        if Bindings::pressed(&bindings.hud) {
+            self.show_hud = !self.show_hud;
+        }
+        if Bindings::pressed(&bindings.net) {
+            self.show_net = !self.show_net;
+        }
+        if Bindings::pressed(&bindings.mute) {
+            self.audio.toggle_mute();
+        }
+    }
+
+    /// The time since the last frame (and this frame's start noted).
+    fn frame_time(&mut self) -> Duration {
+        let frame = self.last_frame.elapsed();
+        self.last_frame = Instant::now();
+        frame
+    }
+
+    /// Simulates the ticks due, with the script's or the player's buttons.
+    fn simulate(&mut self, now: f64) {
+        let remaining = self
+            .setup
+            .exit_after
+            .map_or(u64::MAX, |n| n.saturating_sub(self.played));
+        let script = &self.setup.script;
+        let bindings = &self.setup.bindings;
+        let pads = &mut self.pads;
+        let base = self.played;
+        let mut moved = false;
+        self.played += self.setup.play.update(remaining, |i| {
+            let b = match script {
+                Some(script) => script.at(base + i),
+                None => Buttons(bindings.held().0 | pads.held().0),
+            };
+            moved |= b.0 & Buttons::PLAY != 0;
+            b
+        });
+        if moved && self.first_move.is_none() {
+            self.first_move = Some(now);
+        }
+    }
+
+    /// Plays the sounds of what changed since the last frame; returns them (our effects).
+    fn play_sounds(&mut self) -> Vec<Effect> {
+        let cued = match self.setup.play.game() {
+            Some(g) => self.cues.observe(g.game(), g.me()),
+            None => Vec::new(),
+        };
+        for &effect in &cued {
+            self.audio.play(effect);
+        }
+        cued
+    }
+
+    /// Feeds the network graph (arrivals, round trip); returns the figures for the HUD.
+    fn watch_network(&mut self, now: f64) -> Option<NetStats> {
+        for _ in 0..self.setup.play.take_arrivals() {
+            self.graph.arrival(now);
+        }
+        let stats = self.setup.play.net_stats();
+        if let Some(stats) = &stats {
+            self.graph.rtt(now, stats.rtt_ms);
+        }
+        stats
+    }
+
+    /// Tells the session's failure, once, when it happens.
+    fn check_failure(&mut self) {
+        if self.failed.is_none() {
+            if let Some((code, message)) = session_failure(&self.setup, self.started.elapsed()) {
+                fail(code, &message);
+                self.failed = Some(message);
+            }
+        }
+    }
+
+    /// What to draw (players posed, entities), and the camera following us.
+    fn compose(&mut self, dt: Duration) -> Scene {
+        let level_px = level_extent(self.setup.play.level(), &self.art);
+        let frame_view = self.setup.play.view().unwrap_or_default();
+        let (local, remotes) = play::sprites(&frame_view, &mut self.animator, dt.as_secs_f32());
+        let entities: Vec<EntitySprite> =
+            frame_view.entities.iter().map(EntitySprite::from).collect();
+        let me = self.setup.play.me();
+        let focus = self.setup.look_at.unwrap_or_else(|| {
+            local
+                .as_ref()
+                .or(remotes.first())
+                .map_or(level_px.center(), |p| p.pos)
+        });
+        let screen = vec2(screen_width(), screen_height());
+        let view = self
+            .camera
+            .update(focus, level_px, screen, dt.as_secs_f32());
+        // Remote players wear their names (from the server's roster).
+        let labels: Vec<String> = remotes
+            .iter()
+            .map(|p| {
+                p.name
+                    .clone()
+                    .unwrap_or_else(|| format!("player #{}", p.id))
+            })
+            .collect();
+        Scene {
+            level_px,
+            frame_view,
+            local,
+            remotes,
+            labels,
+            entities,
+            me,
+            view,
+        }
+    }
+
+    /// Moves the effects on (ours from the cues, the others' from what is drawn); shakes the view.
+    fn animate_effects(&mut self, cued: &[Effect], scene: &mut Scene, dt: Duration) {
+        self.effects.local(
+            cued,
+            scene.local.as_ref().map(|p| fx::At {
+                pos: p.pos,
+                size: p.size,
+                tint: render::player_color(p.id, true),
+            }),
+        );
+        self.effects.watch(
+            &scene
+                .remotes
+                .iter()
+                .map(|p| fx::Watched {
+                    id: p.id,
+                    at: fx::At {
+                        pos: p.pos,
+                        size: p.size,
+                        tint: render::player_color(p.id, false),
+                    },
+                    dead: p.dead,
+                    won: p.won,
+                })
+                .collect::<Vec<_>>(),
+        );
+        let map = &self.setup.play.level().tilemap;
+        self.effects.update(dt.as_secs_f32(), |p| {
+            let units = (p * UNITS_PER_PX as f32).clamp(Vec2::splat(-1e9), Vec2::splat(1e9));
+            map.is_solid_at(IVec2::new(units.x as i32, units.y as i32))
+        });
+        // The shake moves the world, not the HUD.
+        scene.view = camera::View {
+            offset: scene.view.offset + self.effects.shake(),
+            ..scene.view
+        };
+    }
+
+    /// Draws the world: sky, art, tiles, entities, players, effects, debug overlay.
+    fn draw_world(&self, scene: &Scene, now: f64) {
+        let level = self.setup.play.level();
+        let view = &scene.view;
+        let time = now as f32;
+        match self.art.background() {
+            Some(colour) => clear_background(colour),
+            None => render::draw_background(view, time),
+        }
+        self.art.draw(view);
+        render::draw_tilemap(&level.tilemap, view, self.art.covered());
+        // A level's own art draws its solids; ledge draws them otherwise.
+        let statics = self.art.is_empty();
+        if statics {
+            render::draw_polygon_blocks(level, view);
+        }
+        render::draw_entities(
+            &scene.entities,
+            view,
+            scene.me.as_ref().and_then(|m| m.checkpoint),
+            time,
+            statics,
+        );
+        render::draw_players(
+            view,
+            scene.local.as_ref().zip(self.local_label(scene)),
+            scene
+                .remotes
+                .iter()
+                .zip(scene.labels.iter().map(String::as_str)),
+        );
+        self.effects.draw(view);
+        self.effects.draw_flash();
+        if self.show_debug {
+            if let Some(game) = self.setup.play.game() {
+                debug::draw(game.game().world(), view);
+            }
+        }
+    }
+
+    /// Our player's label: its name from the roster, else ours.
+    fn local_label<'a>(&'a self, scene: &'a Scene) -> Option<&'a str> {
+        scene
+            .local
+            .as_ref()
+            .map(|p| p.name.as_deref().unwrap_or(&self.setup.name))
+    }
+
+    /// Draws a failure over the scene; our run, name and the room's results for the HUD.
+    fn hud_info(&self, scene: &Scene) -> Hud {
+        // A failure covers the scene; the HUD's figures mean nothing then.
+        let failure = self.failed.as_deref().map(hud::failure);
+        let run = scene.me.as_ref().map(|m| hud::RunInfo {
+            coins: m.coins,
+            coins_total: coins_total(self.setup.play.level()),
+            deaths: m.deaths,
+            run_ticks: m.run_ticks,
+            tick_rate: self.setup.play.tick_rate(),
+            place: m.place,
+        });
+        let name = scene
+            .local
+            .as_ref()
+            .and_then(|p| p.name.as_deref())
+            .unwrap_or(&self.setup.name)
+            .to_owned();
+        // The room's results table, names from the roster.
+        let results: Vec<hud::ResultRow> = self.setup.play.game().map_or_else(Vec::new, |g| {
+            g.game()
+                .results()
+                .iter()
+                .map(|r| hud::ResultRow {
+                    place: r.place.unwrap_or(0),
+                    name: if r.id == g.me() {
+                        name.clone()
+                    } else {
+                        g.player_names()
+                            .get(&r.id)
+                            .cloned()
+                            .unwrap_or_else(|| format!("player #{}", r.id.0))
+                    },
+                    ticks: r.run_ticks,
+                    deaths: r.deaths,
+                    ours: r.id == g.me(),
+                })
+                .collect()
+        });
+        Hud {
+            failure,
+            run,
+            name,
+            results,
+        }
+    }
+
+    /// "sound off: why", for the first seconds after the start.
+    fn sound_notice(&self, now: f64) -> Option<&str> {
+        self.sound_off
+            .as_deref()
+            .filter(|_| now < SOUND_NOTICE_SECONDS)
+    }
+
+    /// Draws the HUD (unless a failure covers the scene) and the status banner.
+    fn draw_hud(&self, scene: &Scene, hud: &Hud, stats: Option<&NetStats>, now: f64) {
+        if self.show_hud && hud.failure.is_none() {
+            let status = self.setup.play.status_line();
+            let info = hud::HudInfo {
+                status: &status,
+                net: stats,
+                fps: get_fps(),
+                tick: scene.frame_view.tick,
+                name: &hud.name,
+                run: hud.run,
+                show_net: self.show_net,
+                hint_alpha: hint_alpha(self.first_move, now),
+                sound_notice: self.sound_notice(now),
+                muted: self.audio.is_muted(),
+                restart_key: &self.restart_key,
+                results: &hud.results,
+            };
+            hud::draw(&info, &self.graph, now);
+        }
+        if let (None, Some(text)) = (&hud.failure, self.setup.play.banner()) {
+            hud::banner(&text);
+        }
+    }
+
+    /// Publishes what the frame showed to the page (`window.ledgeState`).
+    #[cfg(target_arch = "wasm32")]
+    fn report_to_page(&self, scene: &Scene) {
+        use crate::page;
+        let view = &scene.view;
+        page::report(&page::Report {
+            played: self.played,
+            status: &self.setup.play.status_line(),
+            failure: self.failed.as_deref(),
+            joined: self.setup.play.joined(),
+            me: scene.me.as_ref().map(|m| m.pos),
+            players: scene
+                .local
+                .iter()
+                .map(|p| (p, true, self.local_label(scene).unwrap_or(&self.setup.name)))
+                .chain(
+                    scene
+                        .remotes
+                        .iter()
+                        .zip(&scene.labels)
+                        .map(|(p, l)| (p, false, l.as_str())),
+                )
+                .map(|(p, ours, label)| {
+                    let top_left = view.to_screen(p.pos - p.size / 2.0);
+                    let size = p.size * view.zoom;
+                    page::DrawnPlayer {
+                        id: p.id,
+                        name: label.to_owned(),
+                        local: ours,
+                        screen: [top_left.x, top_left.y, size.x, size.y],
+                        rgb: render::palette::bytes(render::player_color(p.id, ours)),
+                    }
+                })
+                .collect(),
+        });
+    }
+
+    /// Whether the run is over (a failure shown a few frames, or the ticks played); the screenshot then.
+    fn finished(&mut self, scene: &Scene, hud: &Hud, now: f64) -> bool {
+        if hud.failure.is_some() {
+            self.failed_frames += 1;
+        }
+        let done = match hud.failure {
+            Some(_) => self.setup.exit_after.is_some() && self.failed_frames >= FAILURE_FRAMES,
+            None => self.setup.exit_after.is_some_and(|n| self.played >= n),
+        };
+        if done {
+            if let Some(path) = &self.setup.screenshot {
+                self.save_screenshot(path, scene, hud, now);
+            }
+        }
+        done
+    }
+
+    /// Saves the frame as `path` and its description beside it (`--screenshot`).
+    fn save_screenshot(&self, path: &Path, scene: &Scene, hud: &Hud, now: f64) {
+        let level = self.setup.play.level();
+        let shot = shot::Shot {
+            tick: self.played,
+            view: &scene.view,
+            level_px: scene.level_px,
+            tile_px: level.tilemap.tile_size() / UNITS_PER_PX,
+            server: self.setup.play.server_me(),
+            drawn: scene.local.as_ref().map(|p| p.pos),
+            remotes: scene
+                .remotes
+                .iter()
+                .zip(&scene.labels)
+                .map(|(p, label)| shot::RemoteShot {
+                    id: p.id,
+                    label,
+                    pos: p.pos,
+                    size: p.size,
+                })
+                .collect(),
+            hud: (self.show_hud && hud.failure.is_none()).then(|| shot::HudShot {
+                name: &hud.name,
+                run: hud.run,
+                net_panel: self.show_net,
+                muted: self.audio.is_muted(),
+                sound_notice: self.sound_notice(now),
+                results: &hud.results,
+            }),
+            failure: self.failed.as_deref().zip(hud.failure.as_ref()),
+            fx: shot::FxShot {
+                particles: self.effects.particles().len(),
+                shake: self.effects.shake().length(),
+                flash: self.effects.flash().a,
+                recent: self.effects.recent(),
+                dead: scene.me.as_ref().is_some_and(|m| m.dead.is_some()),
+            },
+        };
+        if let Err(e) = shot::save(path, &shot) {
+            fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));
+        }
+    }
+
+    /// Waits out the rest of the frame's time natively (no vsync under Xvfb or some drivers: do not spin; a browser calls us once per display frame).
+    fn pace(&self) {
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let spent = self.last_frame.elapsed().as_secs_f64();
+            if spent < 1.0 / MAX_FPS {
+                std::thread::sleep(Duration::from_secs_f64(1.0 / MAX_FPS - spent));
+            }
+        }
+    }
+
+    /// Leaves the server (if connected) before the window closes, then stops the in-process server, if any.
+    fn leave(self) {
+        let GameLoop { setup, .. } = self;
+        #[cfg(not(target_arch = "wasm32"))]
+        let Setup { play, server, .. } = setup;
+        #[cfg(target_arch = "wasm32")]
+        let Setup { play, .. } = setup;
+        drop(play);
+        #[cfg(not(target_arch = "wasm32"))]
+        drop(server);
+    }
+}
+
+/// The world the camera stays inside: everything in the level (grid,
+/// entities, platform paths) and everything its art draws, world pixels.
+fn level_extent(level: &Level, art: &ArtView) -> Rect {
+    let things = level.bounds().map(|(lo, hi)| {
+        let (lo, hi) = (px2(lo), px2(hi));
+        Rect::new(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y)
+    });
+    match (things, art.extent()) {
+        (Some(a), Some(e)) => a.combine_with(e),
+        (Some(a), None) => a,
+        (None, Some(e)) => e,
+        (None, None) => Rect::new(0.0, 0.0, 1.0, 1.0),
+    }
+}

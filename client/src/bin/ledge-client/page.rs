@@ -1,0 +1,297 @@
+//! The browser page's glue (`wasm32-unknown-unknown`): the imports of
+//! `web/ledge.js` (a miniquad plugin) and what the game makes of them: the
+//! address's parameters, the page's host, its gamepads, its connection to
+//! the server ([`WebNet`]: WebTransport, or a WebSocket where the browser
+//! has no WebTransport), and the game's state reported to the page.
+//!
+//! Below the game: [`crate::web`], the browser's entry point, and the
+//! game loop call it; it calls nothing of theirs.
+
+use std::collections::BTreeMap;
+
+use ledge_client::net::link::{Link, Transmit};
+use ledge_client::net::{NetEvent, Network};
+use ledge_client::netstats::TransportSample;
+use ledge_client::time::Instant;
+use ledge_client::JoinOptions;
+use ledge_shared::fixed::UNITS_PER_PX;
+use ledge_shared::input::Buttons;
+use ledge_shared::protocol::{web, PlayerId};
+
+use crate::outcome::tell;
+use crate::pad::PadState;
+
+/// The glue's version: `web/ledge.js` says the same, and miniquad's loader
+/// compares them (`ledge_crate_version`) so a stale page says so.
+const GLUE_VERSION: u32 = 1;
+
+/// Longest address parameter read (a player name is at most 32 bytes).
+const MAX_PARAM: usize = 256;
+
+extern "C" {
+    /// Writes the address's parameter `name` (decoded, UTF-8) into `out`
+    /// (at most `cap` bytes); returns its length, or -1 if absent.
+    fn ledge_page_param(name: *const u8, name_len: u32, out: *mut u8, cap: u32) -> i32;
+    /// Publishes the game's state (JSON) as `window.ledgeState`, for the
+    /// page and for tests.
+    fn ledge_report(json: *const u8, len: u32);
+    /// Writes the page's `HOST:PORT` into `out` (at most `cap` bytes);
+    /// returns its length.
+    fn ledge_page_host(out: *mut u8, cap: u32) -> u32;
+    /// The page's gamepads (standard mapping) into `out`, 12 bytes each:
+    /// the pressed buttons as a bit set (bit i: `buttons[i]`, u32 LE),
+    /// then the left stick's x and y (f32 LE, y down); returns the bytes
+    /// written.
+    fn ledge_gamepads(out: *mut u8, cap: u32) -> u32;
+    /// Starts connecting to the server that served the page.
+    fn ledge_net_open();
+    /// The next message from the connection (tag byte, payload) into
+    /// `out`; its length, or -1 if none.
+    fn ledge_net_poll(out: *mut u8, cap: u32) -> i32;
+    /// Sends on the control stream (`kind` 0) or as a datagram (1);
+    /// 0 if dropped.
+    fn ledge_net_send(kind: u32, bytes: *const u8, len: u32) -> u32;
+}
+
+/// Message tags from the glue (`web/ledge.js`) besides the WebSocket
+/// framing's ([`web::Tag`]): the connection's own news.
+mod tag {
+    pub const OPENED: u8 = 0xF0;
+    pub const CLOSED: u8 = 0xF1;
+    pub const FAILED: u8 = 0xF2;
+}
+
+/// Largest message taken from the glue at once (longer stream and level
+/// chunks come split; a snapshot datagram is far smaller).
+const POLL_BUFFER: usize = 64 * 1024;
+
+/// The page's connection as a [`Network`]: the glue's messages fed to a
+/// [`Link`] (the session's protocol), its transmits handed to the glue.
+#[derive(Debug)]
+pub struct WebNet {
+    link: Link,
+    buf: Vec<u8>,
+    /// "WebTransport" or "WebSocket", once open.
+    transport: Option<String>,
+}
+
+impl WebNet {
+    /// Starts connecting, to join as `options` say.
+    pub fn open(options: JoinOptions) -> WebNet {
+        // SAFETY: an import without arguments.
+        unsafe { ledge_net_open() };
+        WebNet {
+            link: Link::new(options),
+            buf: vec![0; POLL_BUFFER],
+            transport: None,
+        }
+    }
+
+    /// The transport's name, once open.
+    pub fn transport_name(&self) -> Option<&str> {
+        self.transport.as_deref()
+    }
+
+    /// Feeds the glue's messages to the link; pings when due.
+    fn pump(&mut self) {
+        let now = Instant::now();
+        loop {
+            // SAFETY: `buf` is valid for its length; the glue writes at
+            // most that many bytes.
+            let n = unsafe { ledge_net_poll(self.buf.as_mut_ptr(), self.buf.len() as u32) };
+            let Ok(n) = usize::try_from(n) else { break };
+            let message = &self.buf[..n.min(self.buf.len())];
+            let Some((&t, payload)) = message.split_first() else {
+                continue;
+            };
+            match t {
+                tag::OPENED => {
+                    self.transport = Some(String::from_utf8_lossy(payload).into_owned());
+                    self.link.on_open(now);
+                }
+                tag::CLOSED => {
+                    let code = payload
+                        .get(..4)
+                        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                        .filter(|&c| c != u32::MAX);
+                    let reason = String::from_utf8_lossy(payload.get(4..).unwrap_or(&[]));
+                    self.link.on_closed(code, &reason);
+                }
+                tag::FAILED => self.link.on_failed(&String::from_utf8_lossy(payload)),
+                // The session's own messages, in the WebSocket framing.
+                _ => match web::decode(message) {
+                    Ok(m) => self.link.on_message(m, now),
+                    Err(e) => tell(&format!("the page's glue sent a bad message: {e}")),
+                },
+            }
+        }
+        self.link.poll(now);
+        self.flush();
+    }
+
+    /// Hands the link's transmits to the glue.
+    fn flush(&mut self) {
+        while let Some(t) = self.link.poll_transmit() {
+            let (kind, bytes) = match &t {
+                Transmit::Stream(b) => (web::Tag::Stream as u32, b),
+                Transmit::Datagram(b) => (web::Tag::Datagram as u32, b),
+            };
+            // SAFETY: a valid buffer and its length.
+            unsafe { ledge_net_send(kind, bytes.as_ptr(), bytes.len() as u32) };
+        }
+    }
+}
+
+impl Network for WebNet {
+    fn try_recv(&mut self) -> Option<NetEvent> {
+        if let Some(event) = self.link.try_recv() {
+            return Some(event);
+        }
+        self.pump();
+        self.link.try_recv()
+    }
+
+    fn send_input(&mut self, tick: u64, buttons: Buttons) -> bool {
+        let sent = self.link.send_input(tick, buttons);
+        self.flush();
+        sent
+    }
+
+    fn chat(&mut self, text: &str) -> bool {
+        let sent = self.link.chat(text);
+        self.flush();
+        sent
+    }
+
+    fn transport(&self) -> Option<TransportSample> {
+        self.link.transport()
+    }
+
+    fn players(&self) -> BTreeMap<PlayerId, String> {
+        self.link.players()
+    }
+}
+
+/// Tells the loader which glue this build expects.
+#[no_mangle]
+pub extern "C" fn ledge_crate_version() -> u32 {
+    GLUE_VERSION
+}
+
+/// The address's parameter `name`, if present (cut to [`MAX_PARAM`]
+/// bytes, invalid UTF-8 replaced).
+pub fn param(name: &str) -> Option<String> {
+    let mut out = vec![0u8; MAX_PARAM];
+    let len = u32::try_from(name.len()).ok()?;
+    // SAFETY: both buffers are valid for the lengths given; the glue
+    // writes at most `cap` bytes.
+    let n = unsafe { ledge_page_param(name.as_ptr(), len, out.as_mut_ptr(), MAX_PARAM as u32) };
+    let n = usize::try_from(n).ok()?.min(MAX_PARAM);
+    out.truncate(n);
+    Some(String::from_utf8_lossy(&out).into_owned())
+}
+
+/// Gamepads read at most.
+const MAX_PADS: usize = 4;
+
+/// The page's gamepads now (the Gamepad API's standard mapping: buttons
+/// 0 south, 1 east, 8 select, 12 to 15 the d-pad up, down, left, right).
+pub fn gamepads() -> Vec<PadState> {
+    let mut out = [0u8; 12 * MAX_PADS];
+    // SAFETY: `out` is valid for its length; the glue writes at most that.
+    let n = unsafe { ledge_gamepads(out.as_mut_ptr(), out.len() as u32) } as usize;
+    out[..n.min(out.len())]
+        .chunks_exact(12)
+        .map(|pad| {
+            let word = |at: usize| [pad[at], pad[at + 1], pad[at + 2], pad[at + 3]];
+            let bits = u32::from_le_bytes(word(0));
+            let held = |i: u32| bits & (1 << i) != 0;
+            let x = f32::from_le_bytes(word(4));
+            let y = f32::from_le_bytes(word(8));
+            let finite = |v: f32| if v.is_finite() { v } else { 0.0 };
+            PadState {
+                south: held(0),
+                east: held(1),
+                select: held(8),
+                up: held(12),
+                down: held(13),
+                left: held(14),
+                right: held(15),
+                // The Gamepad API's y points down; ledge's up.
+                stick: (finite(x), -finite(y)),
+            }
+        })
+        .collect()
+}
+
+/// The page's `HOST:PORT` (the server that served it).
+pub fn host() -> String {
+    let mut out = vec![0u8; MAX_PARAM];
+    // SAFETY: `out` is valid for its length; the glue writes at most that.
+    let n = unsafe { ledge_page_host(out.as_mut_ptr(), MAX_PARAM as u32) } as usize;
+    out.truncate(n.min(MAX_PARAM));
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// What a frame showed, for the page (and tests).
+pub struct Report<'a> {
+    /// Ticks played.
+    pub played: u64,
+    /// The status line.
+    pub status: &'a str,
+    /// The failure shown, if any.
+    pub failure: Option<&'a str>,
+    /// Whether we are in a game (offline, or welcomed with the level).
+    pub joined: bool,
+    /// Our player's centre, units (the predicted game's).
+    pub me: Option<glam::IVec2>,
+    /// The players drawn (ours first, if drawn).
+    pub players: Vec<DrawnPlayer>,
+}
+
+/// A player as drawn this frame: its box on the canvas and its colour.
+pub struct DrawnPlayer {
+    /// Its id.
+    pub id: u32,
+    /// Its name label (ours: our name).
+    pub name: String,
+    /// Ours.
+    pub local: bool,
+    /// Its box's top left corner and size, canvas pixels.
+    pub screen: [f32; 4],
+    /// Its body colour, RGB 0..=255.
+    pub rgb: [u8; 3],
+}
+
+/// Publishes `report` as `window.ledgeState` (a few times a second is
+/// plenty; every frame is cheap too).
+pub fn report(r: &Report<'_>) {
+    let px = |v: i32| f64::from(v) / f64::from(UNITS_PER_PX);
+    let players: Vec<serde_json::Value> = r
+        .players
+        .iter()
+        .map(|p| {
+            serde_json::json!({
+                "id": p.id, "name": p.name, "local": p.local,
+                "screen": p.screen, "rgb": p.rgb,
+            })
+        })
+        .collect();
+    let json = serde_json::json!({
+        "played": r.played,
+        "status": r.status,
+        "failure": r.failure,
+        "joined": r.joined,
+        "me": r.me.map(|p| serde_json::json!({"x": px(p.x), "y": px(p.y)})),
+        "players": players,
+        // The level's flat colours, for tests of what the canvas shows.
+        "palette": {
+            "sky": crate::render::palette::bytes(crate::render::palette::SKY),
+            "solid": crate::render::palette::bytes(crate::render::palette::SOLID),
+            "grass": crate::render::palette::bytes(crate::render::palette::GRASS),
+        },
+    })
+    .to_string();
+    // SAFETY: a valid buffer and its length.
+    unsafe { ledge_report(json.as_ptr(), json.len() as u32) };
+}
