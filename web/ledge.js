@@ -5,7 +5,7 @@
 //
 // The wasm checks the glue's version through `ledge_crate_version`
 // (miniquad's loader logs a mismatch): keep GLUE_VERSION equal to
-// `GLUE_VERSION` in client/src/bin/ledge-client/web.rs.
+// `GLUE_VERSION` in client/src/bin/ledge-client/page.rs.
 "use strict";
 
 (function () {

@@ -69,11 +69,3 @@ pub use net::session::{JoinOptions, SessionEvent, SessionState, SessionStats, Sn
 pub use net::trust::{connect_trusted, dial_trusted, list_rooms_trusted, Trust};
 pub use view::{EntityDraw, Facing, FrameView, NetStats, PlayerDraw};
 
-// The old paths of two modules, for the workspace's tests that name them
-// inline (not in a `use`): `ledge_client::clock::BASE_MARGIN`
-// (tests/tests/e2e/conditioned.rs) and `ledge_client::session::connect`
-// (tests/tests/e2e/admission.rs). Everything else uses the new paths.
-#[doc(hidden)]
-pub use game::clock;
-#[doc(hidden)]
-pub use net::session;

@@ -14,7 +14,7 @@
 //! and 5 % loss saw its hello time out on the server in each of three runs
 //! (`tests/e2e/conditioned.rs`), and it is not needed: clients time their input
 //! datagrams so that ACKs ride on the game's own packets
-//! (`ledge_client::session::state`).
+//! (`ledge_client::net::session::state`).
 
 use std::io;
 use std::net::SocketAddr;

@@ -14,7 +14,7 @@
 
 use std::f64::consts::TAU;
 
-use super::Effect;
+use super::effect::Effect;
 
 /// Output sample rate, Hz (mono).
 pub const SAMPLE_RATE: u32 = 44_100;

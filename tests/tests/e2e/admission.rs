@@ -440,7 +440,7 @@ async fn the_fifth_connection_from_one_address_is_refused_with_a_reason() {
     for i in 0..AdmissionConfig::default().per_address {
         players.push(server.join(&format!("p{i}")).await);
     }
-    let err = ledge_client::session::connect(server.addr, "localhost", server.fingerprint, "p5")
+    let err = ledge_client::connect(server.addr, "localhost", server.fingerprint, "p5")
         .await
         .expect_err("over the per-address cap");
     let text = err.to_string();

@@ -276,7 +276,7 @@ async fn at_150_ms_rtt_25_ms_jitter_and_5_percent_loss_play_stays_smooth() {
 
 /// The measured client keeps the clock's default base margin.
 fn clock_base_margin() -> f64 {
-    ledge_client::clock::BASE_MARGIN
+    ledge_client::game::clock::BASE_MARGIN
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

@@ -1,4 +1,4 @@
-//! The browser's session protocol ([`ledge_client::link::Link`], sans IO)
+//! The browser's session protocol ([`ledge_client::net::link::Link`], sans IO)
 //! against a real server, carried over native QUIC: a small driver gives
 //! it the control stream's bytes, the datagrams and the level stream, the
 //! way the page's glue gives it WebTransport's. It downloads a real Tiled
