@@ -24,6 +24,8 @@
 //!   path objects are not entities. Layer and group offsets shift objects.
 //! * Image layers are art only ([`crate::art`]).
 
+pub(crate) mod common;
+
 use std::cell::RefCell;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Cursor;
@@ -36,6 +38,7 @@ use ::tiled::{
 };
 use glam::IVec2;
 
+use self::common::{object_name, short_data};
 use super::collision::{self, tile_of_props, Outline, Prop, TileShape};
 use super::entities::is_entity_name;
 use super::entities::{
@@ -152,7 +155,7 @@ fn load(
         grid: (0, 0, map.width, map.height),
     }
     .run(path)?;
-    loaded.art = crate::art::from_tiled(&file, &map, options)?;
+    loaded.art = crate::art::tiled::from_tiled(&file, &map, options)?;
     Ok(loaded)
 }
 
@@ -1186,39 +1189,6 @@ impl Conv<'_> {
         }
         Ok(out)
     }
-}
-
-/// The name an object goes by: its class (`type` before Tiled 1.9), else
-/// its name, also when the class is no ledge entity (after the settings'
-/// aliases) and the name is.
-pub(crate) fn object_name<'o>(options: &LoadOptions, o: &'o ::tiled::ObjectData) -> &'o str {
-    let known = |n: &str| is_entity_name(options.entity_name(n));
-    if o.user_type.trim().is_empty() || (!known(&o.user_type) && known(&o.name)) {
-        &o.name
-    } else {
-        &o.user_type
-    }
-}
-
-/// Whether an object stands for an entity that moves or vanishes (a coin,
-/// a walker, a moving platform), which the game draws itself: the level's
-/// art leaves its picture out, or a collected coin would stay on screen.
-pub(crate) fn is_drawn_entity(options: &LoadOptions, o: &::tiled::ObjectData) -> bool {
-    crate::entities::moves_or_vanishes(options.entity_name(object_name(options, o)))
-}
-
-/// Whether a finite layer has fewer cells of data than its size: the tiled
-/// crate does not check, and indexing past short data panics. The pre-scan
-/// ([`crate::limits`]) refuses such data; this probe of the last cell is
-/// the second line, for every reader of a layer's cells.
-pub(crate) fn short_data(fl: &::tiled::FiniteTileLayer<'_>) -> bool {
-    let (w, h) = (fl.width(), fl.height());
-    w > 0
-        && h > 0
-        && catch_unwind(AssertUnwindSafe(|| {
-            fl.get_tile_data(w as i32 - 1, h as i32 - 1).is_some()
-        }))
-        .is_err()
 }
 
 /// How thick a solid polyline's legs are, in pixels.
