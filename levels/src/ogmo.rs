@@ -457,6 +457,7 @@ pub fn parse_level(
     })
 }
 
+/// Decodes one level layer (`f`: its path), by its kind.
 fn parse_layer(
     cx: &Cx<'_>,
     f: &str,
@@ -473,7 +474,46 @@ fn parse_layer(
             .find(|d| !eid.is_empty() && d.export_id == eid)
             .or_else(|| p.layers.iter().find(|d| d.name == name))
     });
-    let kind = match def.map(|d| d.definition.as_str()) {
+    let kind = layer_kind(cx, f, o, def)?;
+    let lx = cx.opt_num(o, "offsetX", f)?.unwrap_or(0.0);
+    let ly = cx.opt_num(o, "offsetY", f)?.unwrap_or(0.0);
+    let ox = px_to_units(cx.file, &join(f, "offsetX"), level_offset.0 + lx)?;
+    let oy = px_to_units(cx.file, &join(f, "offsetY"), level_offset.1 + ly)?;
+    let mut layer = OgmoLayer {
+        name,
+        field: f.into(),
+        origin: IVec2::new(ox as i32, oy as i32),
+        cell: (0, 0),
+        cells: (0, 0),
+        content: LayerContent::Decals,
+    };
+    if matches!(kind, Kind::Decal) {
+        return Ok(layer);
+    }
+    if matches!(kind, Kind::Tile | Kind::Grid) {
+        layer.cell = (
+            cx.cell_size(o, "gridCellWidth", f)?,
+            cx.cell_size(o, "gridCellHeight", f)?,
+        );
+        layer.cells = (cx.count(o, "gridCellsX", f)?, cx.count(o, "gridCellsY", f)?);
+    }
+    layer.content = match kind {
+        Kind::Decal => LayerContent::Decals,
+        Kind::Tile => tile_content(cx, f, o, def, project, layer.cells)?,
+        Kind::Grid => grid_content(cx, f, o, layer.cells)?,
+        Kind::Entity => entity_content(cx, f, o, &layer, project)?,
+    };
+    Ok(layer)
+}
+
+/// A layer's kind: its project definition's, else told from its fields.
+fn layer_kind(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    def: Option<&ProjectLayer>,
+) -> Result<Kind, LevelError> {
+    Ok(match def.map(|d| d.definition.as_str()) {
         Some("tile") => Kind::Tile,
         Some("grid") => Kind::Grid,
         Some("entity") => Kind::Entity,
@@ -503,151 +543,157 @@ fn parse_layer(
                 });
             }
         }
-    };
-    let lx = cx.opt_num(o, "offsetX", f)?.unwrap_or(0.0);
-    let ly = cx.opt_num(o, "offsetY", f)?.unwrap_or(0.0);
-    let ox = px_to_units(cx.file, &join(f, "offsetX"), level_offset.0 + lx)?;
-    let oy = px_to_units(cx.file, &join(f, "offsetY"), level_offset.1 + ly)?;
-    let mut layer = OgmoLayer {
-        name,
-        field: f.into(),
-        origin: IVec2::new(ox as i32, oy as i32),
-        cell: (0, 0),
-        cells: (0, 0),
-        content: LayerContent::Decals,
-    };
-    if matches!(kind, Kind::Decal) {
-        return Ok(layer);
-    }
-    if matches!(kind, Kind::Tile | Kind::Grid) {
-        layer.cell = (
-            cx.cell_size(o, "gridCellWidth", f)?,
-            cx.cell_size(o, "gridCellHeight", f)?,
-        );
-        layer.cells = (cx.count(o, "gridCellsX", f)?, cx.count(o, "gridCellsY", f)?);
-    }
-    let mode = |key: &str| -> Result<Option<i64>, LevelError> {
-        match o.get(key) {
-            None => Ok(None),
-            Some(v) => {
-                let field = join(f, key);
-                match cx.int(v, &field)? {
-                    m @ (0 | 1) => Ok(Some(m)),
-                    m => Err(cx.bad(&field, format!("expected 0 or 1, got {m}"))),
-                }
-            }
-        }
-    };
-    let pick =
-        |keys: [&'static str; 2], two_d: Option<i64>| -> Result<(&'static str, bool), LevelError> {
-            match two_d {
-                Some(m) => {
-                    let key = keys[m as usize];
-                    if o.contains_key(key) {
-                        Ok((key, m == 1))
-                    } else {
-                        Err(LevelError::Missing {
-                            file: cx.file.into(),
-                            field: join(f, key),
-                            hint: format!(" (arrayMode {m} stores the cells in {key:?})"),
-                        })
-                    }
-                }
-                None => keys
-                    .iter()
-                    .zip([false, true])
-                    .find(|(k, _)| o.contains_key(**k))
-                    .map(|(k, d)| (*k, d))
-                    .ok_or_else(|| LevelError::Missing {
-                        file: cx.file.into(),
-                        field: join(f, keys[0]),
-                        hint: format!(" (nor {:?})", keys[1]),
-                    }),
-            }
-        };
-    layer.content = match kind {
-        Kind::Decal => LayerContent::Decals,
-        Kind::Tile => {
-            let tileset = match cx.opt_str(o, "tileset", f)? {
-                Some(t) => t,
-                None => def.map(|d| d.default_tileset.clone()).unwrap_or_default(),
-            };
-            let coords = match mode("exportMode")? {
-                Some(m) => m == 1,
-                None => o.contains_key("dataCoords") || o.contains_key("dataCoords2D"),
-            };
-            let (key, two_d) = if coords {
-                pick(["dataCoords", "dataCoords2D"], mode("arrayMode")?)?
-            } else {
-                pick(["data", "data2D"], mode("arrayMode")?)?
-            };
-            let v = &o[key];
+    })
+}
+
+/// A layer's `exportMode` or `arrayMode` (`key`): 0, 1, or absent.
+fn export_mode(cx: &Cx<'_>, f: &str, o: &Obj, key: &str) -> Result<Option<i64>, LevelError> {
+    match o.get(key) {
+        None => Ok(None),
+        Some(v) => {
             let field = join(f, key);
-            let ids = if coords {
-                let columns = project
-                    .and_then(|p| p.tilesets.iter().find(|t| t.label == tileset))
-                    .and_then(|t| t.columns);
-                cx.cells(
-                    v,
-                    &field,
-                    layer.cells,
-                    two_d,
-                    &serde_json::json!([-1]),
-                    |c, cf| coord_id(cx, c, cf, columns, &tileset),
-                )?
-            } else {
-                cx.cells(v, &field, layer.cells, two_d, &Value::from(-1), |c, cf| {
-                    let id = cx.int(c, cf)?;
-                    if !(-1..=i32::MAX as i64).contains(&id) {
-                        return Err(cx.bad(
-                            cf,
-                            format!("tile id {id} is not -1 (empty) or a tile index"),
-                        ));
-                    }
-                    Ok(id as i32)
-                })?
-            };
-            LayerContent::Tiles { tileset, key, ids }
-        }
-        Kind::Grid => {
-            let (key, two_d) = pick(["grid", "grid2D"], mode("arrayMode")?)?;
-            let empty = Value::from("0");
-            let values = cx.cells(
-                &o[key],
-                &join(f, key),
-                layer.cells,
-                two_d,
-                &empty,
-                |c, cf| {
-                    Ok(match c {
-                        Value::String(s) => s.clone(),
-                        Value::Number(n) => n.to_string(),
-                        Value::Bool(b) => (*b as u8).to_string(),
-                        other => return Err(cx.expected(cf, "a string", other)),
-                    })
-                },
-            )?;
-            LayerContent::Grid { key, values }
-        }
-        Kind::Entity => {
-            let list = match o.get("entities") {
-                Some(v) => cx.arr(v, &join(f, "entities"))?,
-                None => &[],
-            };
-            let mut es = Vec::with_capacity(list.len());
-            for (k, e) in list.iter().enumerate() {
-                es.push(parse_entity(
-                    cx,
-                    &format!("{f}.entities[{k}]"),
-                    e,
-                    &layer,
-                    project,
-                )?);
+            match cx.int(v, &field)? {
+                m @ (0 | 1) => Ok(Some(m)),
+                m => Err(cx.bad(&field, format!("expected 0 or 1, got {m}"))),
             }
-            LayerContent::Entities(es)
         }
+    }
+}
+
+/// Which of the 1D and 2D fields `keys` holds a layer's cells, and whether
+/// it is the 2D one: the one `arrayMode` (`two_d`) names, else the first
+/// present.
+fn pick_cells_key(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    keys: [&'static str; 2],
+    two_d: Option<i64>,
+) -> Result<(&'static str, bool), LevelError> {
+    match two_d {
+        Some(m) => {
+            let key = keys[m as usize];
+            if o.contains_key(key) {
+                Ok((key, m == 1))
+            } else {
+                Err(LevelError::Missing {
+                    file: cx.file.into(),
+                    field: join(f, key),
+                    hint: format!(" (arrayMode {m} stores the cells in {key:?})"),
+                })
+            }
+        }
+        None => keys
+            .iter()
+            .zip([false, true])
+            .find(|(k, _)| o.contains_key(**k))
+            .map(|(k, d)| (*k, d))
+            .ok_or_else(|| LevelError::Missing {
+                file: cx.file.into(),
+                field: join(f, keys[0]),
+                hint: format!(" (nor {:?})", keys[1]),
+            }),
+    }
+}
+
+/// A tile layer's ids (tile coordinates turned into ids), from whichever
+/// of its four fields its modes name.
+fn tile_content(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    def: Option<&ProjectLayer>,
+    project: Option<&Project>,
+    cells: (u32, u32),
+) -> Result<LayerContent, LevelError> {
+    let tileset = match cx.opt_str(o, "tileset", f)? {
+        Some(t) => t,
+        None => def.map(|d| d.default_tileset.clone()).unwrap_or_default(),
     };
-    Ok(layer)
+    let coords = match export_mode(cx, f, o, "exportMode")? {
+        Some(m) => m == 1,
+        None => o.contains_key("dataCoords") || o.contains_key("dataCoords2D"),
+    };
+    let keys = if coords {
+        ["dataCoords", "dataCoords2D"]
+    } else {
+        ["data", "data2D"]
+    };
+    let mode = export_mode(cx, f, o, "arrayMode")?;
+    let (key, two_d) = pick_cells_key(cx, f, o, keys, mode)?;
+    let v = &o[key];
+    let field = join(f, key);
+    let ids = if coords {
+        let columns = project
+            .and_then(|p| p.tilesets.iter().find(|t| t.label == tileset))
+            .and_then(|t| t.columns);
+        cx.cells(
+            v,
+            &field,
+            cells,
+            two_d,
+            &serde_json::json!([-1]),
+            |c, cf| coord_id(cx, c, cf, columns, &tileset),
+        )?
+    } else {
+        cx.cells(v, &field, cells, two_d, &Value::from(-1), |c, cf| {
+            let id = cx.int(c, cf)?;
+            if !(-1..=i32::MAX as i64).contains(&id) {
+                return Err(cx.bad(
+                    cf,
+                    format!("tile id {id} is not -1 (empty) or a tile index"),
+                ));
+            }
+            Ok(id as i32)
+        })?
+    };
+    Ok(LayerContent::Tiles { tileset, key, ids })
+}
+
+/// A grid layer's values (numbers and booleans as text).
+fn grid_content(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    cells: (u32, u32),
+) -> Result<LayerContent, LevelError> {
+    let mode = export_mode(cx, f, o, "arrayMode")?;
+    let (key, two_d) = pick_cells_key(cx, f, o, ["grid", "grid2D"], mode)?;
+    let empty = Value::from("0");
+    let values = cx.cells(&o[key], &join(f, key), cells, two_d, &empty, |c, cf| {
+        Ok(match c {
+            Value::String(s) => s.clone(),
+            Value::Number(n) => n.to_string(),
+            Value::Bool(b) => (*b as u8).to_string(),
+            other => return Err(cx.expected(cf, "a string", other)),
+        })
+    })?;
+    Ok(LayerContent::Grid { key, values })
+}
+
+/// An entity layer's entities, placed in `layer`.
+fn entity_content(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    layer: &OgmoLayer,
+    project: Option<&Project>,
+) -> Result<LayerContent, LevelError> {
+    let list = match o.get("entities") {
+        Some(v) => cx.arr(v, &join(f, "entities"))?,
+        None => &[],
+    };
+    let mut es = Vec::with_capacity(list.len());
+    for (k, e) in list.iter().enumerate() {
+        es.push(parse_entity(
+            cx,
+            &format!("{f}.entities[{k}]"),
+            e,
+            layer,
+            project,
+        )?);
+    }
+    Ok(LayerContent::Entities(es))
 }
 
 fn coord_id(
