@@ -25,7 +25,8 @@
 //! * **Decal layers** are ignored. Any other layer kind is an error.
 //!
 //! Level and layer `offsetX`/`offsetY` shift everything in the layer.
-//! The decoded project and level are [`model`]'s types.
+//! The decoded project and level are the `model` module's types,
+//! re-exported here.
 
 pub(crate) mod model;
 
