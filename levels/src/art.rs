@@ -20,15 +20,12 @@
 //!   OGMO writes it), the project's background colour; OGMO draws its first
 //!   layer on top, so the layers are listed last to first.
 
-mod ogmo;
-mod tiled;
+pub(crate) mod ogmo;
+pub(crate) mod tiled;
 
 use serde::{Deserialize, Serialize};
 
 use crate::LevelError;
-
-pub(crate) use self::ogmo::{decode_base64, from_ogmo};
-pub(crate) use self::tiled::from_tiled;
 
 /// Largest image file, bytes (16 MiB).
 pub const MAX_ART_IMAGE_BYTES: u64 = 16 << 20;

@@ -19,6 +19,12 @@
 //!
 //! Every refusal is a [`LevelError`] naming the file, the element path (like
 //! `map.layers[3].data`) and the bound; see `docs/LEVELS.md` ("Limits").
+//!
+//! The counts an element kind adds to, and their bounds, are one table
+//! (`LIMITS`, after `EVERY_ELEMENT`); the rewriting of a document for the
+//! `tiled` crate is the `rewrite` module's.
+
+mod rewrite;
 
 use std::collections::BTreeMap;
 use std::io::{self, Read};
@@ -26,6 +32,7 @@ use std::path::{Path, PathBuf};
 
 use quick_xml::events::{BytesStart, Event};
 
+use self::rewrite::Patch;
 use crate::{LevelError, MAX_FILE_BYTES, MAX_LEVEL_TILES};
 
 /// Deepest element nesting in a TMX, TSX or template document (the `tiled`
@@ -94,6 +101,310 @@ pub(crate) struct Budget {
     /// Objects using each template (path as the `tiled` crate resolves it).
     template_uses: BTreeMap<PathBuf, u64>,
 }
+
+/// A load-wide total of [`Budget`].
+#[derive(Clone, Copy)]
+enum Total {
+    Elements,
+    Layers,
+    TilesetTiles,
+    Cells,
+    Objects,
+    Points,
+    Properties,
+}
+
+impl Total {
+    /// Its counter in `budget`.
+    fn of(self, budget: &mut Budget) -> &mut u64 {
+        match self {
+            Total::Elements => &mut budget.elements,
+            Total::Layers => &mut budget.layers,
+            Total::TilesetTiles => &mut budget.tileset_tiles,
+            Total::Cells => &mut budget.cells,
+            Total::Objects => &mut budget.objects,
+            Total::Points => &mut budget.points,
+            Total::Properties => &mut budget.properties,
+        }
+    }
+}
+
+/// Which elements of a kind a limit applies to, by where they are.
+#[derive(Clone, Copy)]
+enum Place {
+    /// Anywhere.
+    Any,
+    /// The document's root.
+    Root,
+    /// Inside a tileset.
+    InTileset,
+    /// Inside a tile layer.
+    InLayer,
+    /// Inside an infinite map's layer data (its chunks).
+    InChunkedData,
+}
+
+/// The number an element brings to a count.
+#[derive(Clone, Copy)]
+enum Amount {
+    /// One.
+    One,
+    /// Its nesting depth, itself included.
+    Depth,
+    /// A whole-number attribute (none, or not a number: nothing counted),
+    /// named in the error's field.
+    Attr(&'static str),
+    /// A signed attribute's distance from 0 (none: 0), named in the
+    /// error's field.
+    Coord(&'static str),
+    /// The points of its `points` attribute, named in the error's field.
+    Points,
+    /// The cells of the tile layer its `<data>` holds (nothing for an
+    /// infinite map's, or a layer without its size: its chunks count).
+    LayerCells,
+    /// The cells a chunk costs: its own, or the tiled crate's whole 16 x
+    /// 16 blocks it touches, whichever is more.
+    ChunkCells,
+}
+
+/// What an element's amount is added to before the bound is checked.
+#[derive(Clone, Copy)]
+enum Count {
+    /// Nothing: the amount itself is bounded.
+    Own,
+    /// The tilesets of the map it is in (only when its parent is the map).
+    MapTilesets,
+    /// The `<tile>` elements of the tileset it is in.
+    TilesOfTileset,
+    /// A load-wide total, once for each object using the document (a
+    /// template).
+    PerUse(Total),
+    /// A load-wide total, once.
+    Once(Total),
+}
+
+/// One bound of the pre-scan: the elements it counts, what it counts, and
+/// the error naming it (`what`, `max`, `bound`).
+struct Limit {
+    /// Element names (local) it applies to; empty: every element.
+    names: &'static [&'static str],
+    place: Place,
+    amount: Amount,
+    count: Count,
+    max: u64,
+    what: &'static str,
+    bound: &'static str,
+}
+
+/// Checked on every element before its attributes are read.
+const EVERY_ELEMENT: [Limit; 2] = [
+    Limit {
+        names: &[],
+        place: Place::Any,
+        amount: Amount::Depth,
+        count: Count::Own,
+        max: MAX_XML_DEPTH as u64,
+        what: "levels of element nesting",
+        bound: "MAX_XML_DEPTH",
+    },
+    Limit {
+        names: &[],
+        place: Place::Any,
+        amount: Amount::One,
+        count: Count::PerUse(Total::Elements),
+        max: MAX_ELEMENTS,
+        what: "elements in the map and its tilesets and templates",
+        bound: "MAX_ELEMENTS",
+    },
+];
+
+/// Element kinds that are layers.
+const LAYER_KINDS: &[&str] = &["layer", "objectgroup", "imagelayer", "group"];
+
+/// Checked on the elements of each kind, in this order, once their
+/// attributes are read (an `<image>`'s size is [`Scan::image`]'s).
+const LIMITS: [Limit; 20] = [
+    Limit {
+        names: &["map"],
+        place: Place::Root,
+        amount: Amount::Attr("width"),
+        count: Count::Own,
+        max: MAX_LEVEL_TILES as u64,
+        what: "tiles",
+        bound: "MAX_LEVEL_TILES",
+    },
+    Limit {
+        names: &["map"],
+        place: Place::Root,
+        amount: Amount::Attr("height"),
+        count: Count::Own,
+        max: MAX_LEVEL_TILES as u64,
+        what: "tiles",
+        bound: "MAX_LEVEL_TILES",
+    },
+    Limit {
+        names: &["tileset"],
+        place: Place::Any,
+        amount: Amount::One,
+        count: Count::MapTilesets,
+        max: MAX_TILESETS,
+        what: "tilesets",
+        bound: "MAX_TILESETS",
+    },
+    Limit {
+        names: &["tileset"],
+        place: Place::Any,
+        amount: Amount::Attr("tilecount"),
+        count: Count::Own,
+        max: MAX_TILESET_TILES,
+        what: "tiles",
+        bound: "MAX_TILESET_TILES",
+    },
+    Limit {
+        names: &["tileset"],
+        place: Place::Any,
+        amount: Amount::Attr("tilecount"),
+        count: Count::PerUse(Total::TilesetTiles),
+        max: MAX_TOTAL_TILESET_TILES,
+        what: "tiles in all tilesets",
+        bound: "MAX_TOTAL_TILESET_TILES",
+    },
+    Limit {
+        names: &["tile"],
+        place: Place::InTileset,
+        amount: Amount::One,
+        count: Count::TilesOfTileset,
+        max: MAX_TILESET_TILES,
+        what: "<tile> elements in one tileset",
+        bound: "MAX_TILESET_TILES",
+    },
+    Limit {
+        names: &["tile"],
+        place: Place::InTileset,
+        amount: Amount::One,
+        count: Count::PerUse(Total::TilesetTiles),
+        max: MAX_TOTAL_TILESET_TILES,
+        what: "tiles in all tilesets",
+        bound: "MAX_TOTAL_TILESET_TILES",
+    },
+    Limit {
+        names: LAYER_KINDS,
+        place: Place::Any,
+        amount: Amount::One,
+        count: Count::PerUse(Total::Layers),
+        max: MAX_LAYERS,
+        what: "layers",
+        bound: "MAX_LAYERS",
+    },
+    Limit {
+        names: &["layer"],
+        place: Place::Any,
+        amount: Amount::Attr("width"),
+        count: Count::Own,
+        max: MAX_LEVEL_TILES as u64,
+        what: "tiles",
+        bound: "MAX_LEVEL_TILES",
+    },
+    Limit {
+        names: &["layer"],
+        place: Place::Any,
+        amount: Amount::Attr("height"),
+        count: Count::Own,
+        max: MAX_LEVEL_TILES as u64,
+        what: "tiles",
+        bound: "MAX_LEVEL_TILES",
+    },
+    Limit {
+        names: &["data"],
+        place: Place::InLayer,
+        amount: Amount::LayerCells,
+        count: Count::Once(Total::Cells),
+        max: MAX_LEVEL_CELLS,
+        what: "tile cells in all layers",
+        bound: "MAX_LEVEL_CELLS",
+    },
+    Limit {
+        names: &["chunk"],
+        place: Place::InChunkedData,
+        amount: Amount::Coord("x"),
+        count: Count::Own,
+        max: MAX_CHUNK_COORD as u64,
+        what: "tiles from the origin",
+        bound: "MAX_CHUNK_COORD",
+    },
+    Limit {
+        names: &["chunk"],
+        place: Place::InChunkedData,
+        amount: Amount::Coord("y"),
+        count: Count::Own,
+        max: MAX_CHUNK_COORD as u64,
+        what: "tiles from the origin",
+        bound: "MAX_CHUNK_COORD",
+    },
+    Limit {
+        names: &["chunk"],
+        place: Place::InChunkedData,
+        amount: Amount::Attr("width"),
+        count: Count::Own,
+        max: MAX_LEVEL_TILES as u64,
+        what: "tiles",
+        bound: "MAX_LEVEL_TILES",
+    },
+    Limit {
+        names: &["chunk"],
+        place: Place::InChunkedData,
+        amount: Amount::Attr("height"),
+        count: Count::Own,
+        max: MAX_LEVEL_TILES as u64,
+        what: "tiles",
+        bound: "MAX_LEVEL_TILES",
+    },
+    Limit {
+        names: &["chunk"],
+        place: Place::InChunkedData,
+        amount: Amount::ChunkCells,
+        count: Count::Once(Total::Cells),
+        max: MAX_LEVEL_CELLS,
+        what: "tile cells in all layers (infinite maps count whole 16 x 16 blocks)",
+        bound: "MAX_LEVEL_CELLS",
+    },
+    Limit {
+        names: &["object"],
+        place: Place::Any,
+        amount: Amount::One,
+        count: Count::PerUse(Total::Objects),
+        max: MAX_OBJECTS,
+        what: "objects",
+        bound: "MAX_OBJECTS",
+    },
+    Limit {
+        names: &["polygon", "polyline"],
+        place: Place::Any,
+        amount: Amount::Points,
+        count: Count::Own,
+        max: MAX_SHAPE_POINTS,
+        what: "points",
+        bound: "MAX_SHAPE_POINTS",
+    },
+    Limit {
+        names: &["polygon", "polyline"],
+        place: Place::Any,
+        amount: Amount::Points,
+        count: Count::PerUse(Total::Points),
+        max: MAX_TOTAL_POINTS,
+        what: "polygon and polyline points",
+        bound: "MAX_TOTAL_POINTS",
+    },
+    Limit {
+        names: &["property"],
+        place: Place::Any,
+        amount: Amount::One,
+        count: Count::PerUse(Total::Properties),
+        max: MAX_PROPERTIES,
+        what: "properties",
+        bound: "MAX_PROPERTIES",
+    },
+];
 
 fn limit(
     file: &str,
@@ -170,25 +481,8 @@ pub(crate) fn check_tmx_resource(
         }
     }
     scan.run(&bytes)?;
-    let mut patches = std::mem::take(&mut scan.patches);
-    if patches.is_empty() {
-        return Ok(bytes);
-    }
-    // Ranges never overlap (each is a start tag, an insertion point in one,
-    // or the content of one element); a stable sort keeps insertions at the
-    // same point in document order.
-    patches.sort_by_key(|p| p.start);
-    let extra: usize = patches.iter().map(|p| p.text.len()).sum();
-    let mut out = Vec::with_capacity(bytes.len() + extra);
-    let mut at = 0;
-    for p in patches {
-        let start = p.start.max(at);
-        out.extend_from_slice(&bytes[at..start]);
-        out.extend_from_slice(p.text.as_bytes());
-        at = p.end.max(start);
-    }
-    out.extend_from_slice(&bytes[at..]);
-    Ok(out)
+    let patches = std::mem::take(&mut scan.patches);
+    Ok(rewrite::apply(bytes, patches))
 }
 
 /// What an open element is, for the checks at its children and its end.
@@ -251,12 +545,9 @@ impl DataScan {
         self.encoding.is_none()
     }
 
-    /// Tile data the `tiled` crate (built without zstd, and not reading
-    /// `<tile>` children) is handed rewritten as CSV.
+    /// Tile data the `tiled` crate is handed rewritten as CSV.
     fn rewritten(&self) -> bool {
-        self.is_xml()
-            || (self.encoding.as_deref() == Some("base64")
-                && self.compression.as_deref() == Some("zstd"))
+        rewrite::is_rewritten(self.encoding.as_deref(), self.compression.as_deref())
     }
 
     /// Most gids kept for the rewrite: the cells the layer has, or, when its
@@ -289,13 +580,6 @@ struct Scan<'a> {
     root_seen: bool,
 }
 
-/// Replaces `bytes[start..end]` with `text` in what the Tiled reader sees.
-struct Patch {
-    start: usize,
-    end: usize,
-    text: String,
-}
-
 /// The attributes of an element, by local name, unescaped.
 struct Attrs(Vec<(String, String)>);
 
@@ -308,6 +592,22 @@ impl Attrs {
     }
     fn int(&self, k: &str) -> Option<i64> {
         self.get(k).and_then(|v| v.parse().ok())
+    }
+}
+
+/// Where an element's start tag is in the document, and whether it is an
+/// empty-element tag (`<data/>`).
+#[derive(Clone, Copy)]
+struct Tag {
+    start: usize,
+    end: usize,
+    empty: bool,
+}
+
+impl Tag {
+    /// Where attributes can be added to it: before `>` or `/>`.
+    fn insert_at(self) -> usize {
+        self.end.saturating_sub(if self.empty { 2 } else { 1 })
     }
 }
 
@@ -444,6 +744,9 @@ impl Scan<'_> {
         Ok(())
     }
 
+    /// Opens an element: checks the limits on it ([`EVERY_ELEMENT`], then
+    /// [`LIMITS`] once its attributes are read), counting it, then notes
+    /// what it is for its children and its end.
     fn open(
         &mut self,
         e: &BytesStart<'_>,
@@ -453,172 +756,192 @@ impl Scan<'_> {
     ) -> Result<(), LevelError> {
         let name = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
         let field = self.segment(&name);
-        if self.stack.len() + 1 > MAX_XML_DEPTH {
-            return Err(limit(
-                &self.file,
-                field,
-                "levels of element nesting",
-                MAX_XML_DEPTH as u64,
-                self.stack.len() as u64 + 1,
-                "MAX_XML_DEPTH",
-            ));
-        }
-        let file = self.file.clone();
-        Self::add(
-            &file,
-            &mut self.budget.elements,
-            self.uses,
-            MAX_ELEMENTS,
-            &field,
-            "elements in the map and its tilesets and templates",
-            "MAX_ELEMENTS",
-        )?;
-        let a = self.attrs(e, &field)?;
         let is_root = self.stack.is_empty();
+        self.check_limits(&EVERY_ELEMENT, &name, &field, is_root, &Attrs(Vec::new()))?;
+        let a = self.attrs(e, &field)?;
         if is_root {
             if self.root_seen {
                 return Err(self.syntax(&field, "more than one root element"));
             }
             self.root_seen = true;
         }
-        // Where attributes go in the start tag: before `>` or `/>`.
-        let insert_at = end.saturating_sub(if empty { 2 } else { 1 });
-        let parent_is = |s: &Self, f: fn(&Ctx) -> bool| s.stack.last().is_some_and(|p| f(&p.ctx));
-        let in_template = self
-            .path
-            .extension()
-            .is_some_and(|x| x.eq_ignore_ascii_case("tx") || x.eq_ignore_ascii_case("tsx"));
-        let mut ctx = Ctx::Other;
-        match name.as_str() {
-            "map" if is_root => {
-                for k in ["width", "height"] {
-                    if let Some(v) = a.num(k) {
-                        if v > MAX_LEVEL_TILES as u64 {
-                            return Err(limit(
-                                &file,
-                                format!("{field}.{k}"),
-                                "tiles",
-                                MAX_LEVEL_TILES as u64,
-                                v,
-                                "MAX_LEVEL_TILES",
-                            ));
-                        }
+        self.check_limits(&LIMITS, &name, &field, is_root, &a)?;
+        let tag = Tag { start, end, empty };
+        let ctx = self.context(&name, &field, is_root, &a, tag)?;
+        self.stack.push(Frame {
+            path: field,
+            ctx,
+            counts: Vec::new(),
+        });
+        Ok(())
+    }
+
+    /// Checks the `limits` that apply to element `name` (at `field`, with
+    /// attributes `a`), in order, counting it in each.
+    fn check_limits(
+        &mut self,
+        limits: &[Limit],
+        name: &str,
+        field: &str,
+        is_root: bool,
+        a: &Attrs,
+    ) -> Result<(), LevelError> {
+        for l in limits {
+            if !(l.names.is_empty() || l.names.contains(&name)) || !self.is_at(l.place, is_root) {
+                continue;
+            }
+            let Some(n) = self.amount(l.amount, a) else {
+                continue;
+            };
+            let found = match l.count {
+                Count::Own => n,
+                Count::MapTilesets | Count::TilesOfTileset => match self.parent_count(l.count) {
+                    Some(c) => {
+                        *c += n;
+                        *c
                     }
+                    None => continue,
+                },
+                Count::PerUse(total) => {
+                    let n = n.saturating_mul(self.uses);
+                    let c = total.of(self.budget);
+                    *c = c.saturating_add(n);
+                    *c
                 }
-                ctx = Ctx::Map {
-                    infinite: a.get("infinite") == Some("1"),
-                    tilesets: 0,
+                Count::Once(total) => {
+                    let c = total.of(self.budget);
+                    *c = c.saturating_add(n);
+                    *c
+                }
+            };
+            if found > l.max {
+                let field = match l.amount {
+                    Amount::Attr(k) | Amount::Coord(k) => format!("{field}.{k}"),
+                    Amount::Points => format!("{field}.points"),
+                    _ => field.to_owned(),
                 };
+                return Err(limit(&self.file, field, l.what, l.max, found, l.bound));
             }
-            "tileset" => {
-                if let Some(Frame {
-                    ctx: Ctx::Map { tilesets, .. },
-                    ..
-                }) = self.stack.last_mut()
-                {
-                    *tilesets += 1;
-                    if *tilesets > MAX_TILESETS {
-                        return Err(limit(
-                            &file,
-                            field,
-                            "tilesets",
-                            MAX_TILESETS,
-                            *tilesets,
-                            "MAX_TILESETS",
-                        ));
+        }
+        Ok(())
+    }
+
+    /// Whether the element being opened is at `place`.
+    fn is_at(&self, place: Place, is_root: bool) -> bool {
+        match place {
+            Place::Any => true,
+            Place::Root => is_root,
+            Place::InTileset => self.parent_is(|c| matches!(c, Ctx::Tileset(_))),
+            Place::InLayer => self.parent_is(|c| matches!(c, Ctx::Layer { .. })),
+            Place::InChunkedData => self.parent_is(|c| matches!(c, Ctx::Data(d) if !d.decodes)),
+        }
+    }
+
+    /// Whether the innermost open element (the parent of the one being
+    /// opened) is `f`.
+    fn parent_is(&self, f: impl Fn(&Ctx) -> bool) -> bool {
+        self.stack.last().is_some_and(|p| f(&p.ctx))
+    }
+
+    /// The number the element being opened (attributes `a`) brings to a
+    /// count; `None`: nothing to count.
+    fn amount(&self, amount: Amount, a: &Attrs) -> Option<u64> {
+        match amount {
+            Amount::One => Some(1),
+            Amount::Depth => Some(self.stack.len() as u64 + 1),
+            Amount::Attr(k) => a.num(k),
+            // `abs` as before this was a table: it overflows on i64::MIN (a
+            // panic in debug builds, which the Tiled reader's catch turns into
+            // a refusal; in release the coordinate passes).
+            Amount::Coord(k) => Some(u64::try_from(a.int(k).unwrap_or(0).abs()).unwrap_or(0)),
+            Amount::Points => Some(
+                a.get("points")
+                    .map_or(0, |p| p.split_ascii_whitespace().count() as u64),
+            ),
+            Amount::LayerCells => self.layer_cells().1,
+            Amount::ChunkCells => {
+                let (x, y) = (a.int("x").unwrap_or(0), a.int("y").unwrap_or(0));
+                let (w, h) = (a.num("width").unwrap_or(0), a.num("height").unwrap_or(0));
+                // The tiled crate stores infinite layers in 16 x 16
+                // blocks: count the blocks the chunk touches.
+                let blocks = |p: i64, n: u64| {
+                    if n == 0 {
+                        0
+                    } else {
+                        ((p + n as i64 - 1).div_euclid(16) - p.div_euclid(16) + 1) as u64
                     }
-                }
-                let tilecount = a.num("tilecount");
-                if let Some(n) = tilecount {
-                    if n > MAX_TILESET_TILES {
-                        return Err(limit(
-                            &file,
-                            format!("{field}.tilecount"),
-                            "tiles",
-                            MAX_TILESET_TILES,
-                            n,
-                            "MAX_TILESET_TILES",
-                        ));
-                    }
-                    Self::add(
-                        &file,
-                        &mut self.budget.tileset_tiles,
-                        n.saturating_mul(self.uses),
-                        MAX_TOTAL_TILESET_TILES,
-                        &format!("{field}.tilecount"),
-                        "tiles in all tilesets",
-                        "MAX_TOTAL_TILESET_TILES",
-                    )?;
-                }
-                ctx = Ctx::Tileset(Box::new(TilesetScan {
-                    name: a.get("name").unwrap_or_default().to_owned(),
-                    field: field.clone(),
-                    tilecount,
-                    has_columns: a.get("columns").is_some(),
-                    tile_size: (a.num("tilewidth"), a.num("tileheight")),
-                    spacing: a.num("spacing").unwrap_or(0),
-                    margin: a.num("margin").unwrap_or(0),
-                    image: None,
-                    tiles: 0,
-                    insert_at,
-                    external: !is_root && a.get("source").is_some(),
-                }));
-            }
-            "tile" if parent_is(self, |c| matches!(c, Ctx::Tileset(_))) => {
-                if let Some(Frame {
-                    ctx: Ctx::Tileset(ts),
-                    ..
-                }) = self.stack.last_mut()
-                {
-                    ts.tiles += 1;
-                    if ts.tiles > MAX_TILESET_TILES {
-                        return Err(limit(
-                            &file,
-                            field,
-                            "<tile> elements in one tileset",
-                            MAX_TILESET_TILES,
-                            ts.tiles,
-                            "MAX_TILESET_TILES",
-                        ));
-                    }
-                }
-                Self::add(
-                    &file,
-                    &mut self.budget.tileset_tiles,
-                    self.uses,
-                    MAX_TOTAL_TILESET_TILES,
-                    &field,
-                    "tiles in all tilesets",
-                    "MAX_TOTAL_TILESET_TILES",
-                )?;
-            }
-            "tile"
-                if parent_is(
-                    self,
-                    |c| matches!(c, Ctx::Data(d) if d.decodes && d.is_xml()),
-                ) =>
-            {
-                let gid = match a.get("gid") {
-                    None => 0,
-                    Some(g) => g.trim().parse::<u32>().map_err(|e| LevelError::BadValue {
-                        file: file.clone(),
-                        field: format!("{field}.gid"),
-                        message: format!("{g:?} is not a tile gid: {e}"),
-                    })?,
                 };
-                let remaining = MAX_LEVEL_CELLS.saturating_sub(self.budget.cells);
-                if let Some(Frame {
-                    ctx: Ctx::Data(d), ..
-                }) = self.stack.last_mut()
-                {
-                    d.tiles += 1;
-                    if d.gids.len() < d.keep(remaining) {
-                        d.gids.push(gid);
-                    }
-                }
+                Some((w * h).max(blocks(x, w) * blocks(y, h) * 256))
+            }
+        }
+    }
+
+    /// The parent's count of children like the one being opened (`count`
+    /// is [`Count::MapTilesets`] or [`Count::TilesOfTileset`]), if the parent
+    /// keeps one.
+    fn parent_count(&mut self, count: Count) -> Option<&mut u64> {
+        match (count, &mut self.stack.last_mut()?.ctx) {
+            (Count::MapTilesets, Ctx::Map { tilesets, .. }) => Some(tilesets),
+            (Count::TilesOfTileset, Ctx::Tileset(ts)) => Some(&mut ts.tiles),
+            _ => None,
+        }
+    }
+
+    /// Whether the map is infinite, and the cells the innermost tile
+    /// layer's data must hold (`None`: an infinite map's, whose chunks are
+    /// counted, or a layer without its size).
+    fn layer_cells(&self) -> (bool, Option<u64>) {
+        let infinite = self
+            .stack
+            .iter()
+            .any(|f| matches!(f.ctx, Ctx::Map { infinite: true, .. }));
+        let size = match self.stack.last().map(|f| &f.ctx) {
+            Some(Ctx::Layer { size }) => *size,
+            _ => None,
+        };
+        let expected = if infinite {
+            None
+        } else {
+            size.map(|(w, h)| w * h)
+        };
+        (infinite, expected)
+    }
+
+    /// What the element being opened is, for its children and its end, and
+    /// what its kind does besides being counted (gids kept, image sizes
+    /// checked, templates' uses counted, start tags rewritten).
+    fn context(
+        &mut self,
+        name: &str,
+        field: &str,
+        is_root: bool,
+        a: &Attrs,
+        tag: Tag,
+    ) -> Result<Ctx, LevelError> {
+        Ok(match name {
+            "map" if is_root => Ctx::Map {
+                infinite: a.get("infinite") == Some("1"),
+                tilesets: 0,
+            },
+            "tileset" => Ctx::Tileset(Box::new(TilesetScan {
+                name: a.get("name").unwrap_or_default().to_owned(),
+                field: field.to_owned(),
+                tilecount: a.num("tilecount"),
+                has_columns: a.get("columns").is_some(),
+                tile_size: (a.num("tilewidth"), a.num("tileheight")),
+                spacing: a.num("spacing").unwrap_or(0),
+                margin: a.num("margin").unwrap_or(0),
+                image: None,
+                tiles: 0,
+                insert_at: tag.insert_at(),
+                external: !is_root && a.get("source").is_some(),
+            })),
+            "tile" if self.parent_is(|c| matches!(c, Ctx::Data(d) if d.decodes && d.is_xml())) => {
+                self.xml_tile(a, field)?;
+                Ctx::Other
             }
             "image" => {
-                let size = self.image(&a, &field, insert_at)?;
+                let size = self.image(a, field, tag.insert_at())?;
                 if let Some(Frame {
                     ctx: Ctx::Tileset(ts),
                     ..
@@ -626,221 +949,121 @@ impl Scan<'_> {
                 {
                     ts.image = Some(size);
                 }
+                Ctx::Other
             }
-            "layer" | "objectgroup" | "imagelayer" | "group" => {
-                Self::add(
-                    &file,
-                    &mut self.budget.layers,
-                    self.uses,
-                    MAX_LAYERS,
-                    &field,
-                    "layers",
-                    "MAX_LAYERS",
-                )?;
-                if name == "layer" {
-                    let (w, h) = (a.num("width"), a.num("height"));
-                    for (v, k) in [(w, "width"), (h, "height")] {
-                        if let Some(v) = v {
-                            if v > MAX_LEVEL_TILES as u64 {
-                                return Err(limit(
-                                    &file,
-                                    format!("{field}.{k}"),
-                                    "tiles",
-                                    MAX_LEVEL_TILES as u64,
-                                    v,
-                                    "MAX_LEVEL_TILES",
-                                ));
-                            }
-                        }
-                    }
-                    ctx = Ctx::Layer { size: w.zip(h) };
-                }
+            "layer" => Ctx::Layer {
+                size: a.num("width").zip(a.num("height")),
+            },
+            "data" if self.parent_is(|c| matches!(c, Ctx::Layer { .. })) => {
+                self.data(a, field, tag)
             }
-            "data" if parent_is(self, |c| matches!(c, Ctx::Layer { .. })) => {
-                let infinite = self
-                    .stack
-                    .iter()
-                    .any(|f| matches!(f.ctx, Ctx::Map { infinite: true, .. }));
-                let size = match self.stack.last().map(|f| &f.ctx) {
-                    Some(Ctx::Layer { size }) => *size,
-                    _ => None,
-                };
-                let expected = if infinite {
-                    None
-                } else {
-                    size.map(|(w, h)| w * h)
-                };
-                if let Some(n) = expected {
-                    Self::add(
-                        &file,
-                        &mut self.budget.cells,
-                        n,
-                        MAX_LEVEL_CELLS,
-                        &field,
-                        "tile cells in all layers",
-                        "MAX_LEVEL_CELLS",
-                    )?;
-                }
-                let d = DataScan {
-                    field: field.clone(),
-                    encoding: a.get("encoding").map(str::to_owned),
-                    compression: a.get("compression").map(str::to_owned),
-                    expected,
-                    done: false,
-                    decodes: !infinite,
-                    chunks: 0,
-                    content_start: end,
-                    empty,
-                    tiles: 0,
-                    gids: Vec::new(),
-                };
-                if d.rewritten() {
-                    // The content (or each chunk's) becomes CSV.
-                    let close = if empty { "/>" } else { ">" };
-                    self.patches.push(Patch {
-                        start,
-                        end,
-                        text: format!("<data encoding=\"csv\"{close}"),
-                    });
-                }
-                ctx = Ctx::Data(d);
-            }
-            "chunk" => {
-                let parent = self.stack.last_mut().map(|f| &mut f.ctx);
-                if let Some(Ctx::Data(d)) = parent {
-                    if !d.decodes {
-                        d.chunks += 1;
-                        let (encoding, compression) = (d.encoding.clone(), d.compression.clone());
-                        let (x, y) = (a.int("x").unwrap_or(0), a.int("y").unwrap_or(0));
-                        let (w, h) = (a.num("width").unwrap_or(0), a.num("height").unwrap_or(0));
-                        for (v, k) in [(x, "x"), (y, "y")] {
-                            if v.abs() > MAX_CHUNK_COORD {
-                                return Err(limit(
-                                    &file,
-                                    format!("{field}.{k}"),
-                                    "tiles from the origin",
-                                    MAX_CHUNK_COORD as u64,
-                                    v.unsigned_abs(),
-                                    "MAX_CHUNK_COORD",
-                                ));
-                            }
-                        }
-                        for (v, k) in [(w, "width"), (h, "height")] {
-                            if v > MAX_LEVEL_TILES as u64 {
-                                return Err(limit(
-                                    &file,
-                                    format!("{field}.{k}"),
-                                    "tiles",
-                                    MAX_LEVEL_TILES as u64,
-                                    v,
-                                    "MAX_LEVEL_TILES",
-                                ));
-                            }
-                        }
-                        // The tiled crate stores infinite layers in 16 x 16
-                        // blocks: count the blocks the chunk touches.
-                        let blocks = |p: i64, n: u64| {
-                            if n == 0 {
-                                0
-                            } else {
-                                ((p + n as i64 - 1).div_euclid(16) - p.div_euclid(16) + 1) as u64
-                            }
-                        };
-                        let cost = (w * h).max(blocks(x, w) * blocks(y, h) * 256);
-                        Self::add(
-                            &file,
-                            &mut self.budget.cells,
-                            cost,
-                            MAX_LEVEL_CELLS,
-                            &field,
-                            "tile cells in all layers (infinite maps count whole 16 x 16 blocks)",
-                            "MAX_LEVEL_CELLS",
-                        )?;
-                        ctx = Ctx::Data(DataScan {
-                            field: field.clone(),
-                            encoding,
-                            compression,
-                            expected: Some(w * h),
-                            done: false,
-                            decodes: true,
-                            chunks: 0,
-                            content_start: end,
-                            empty,
-                            tiles: 0,
-                            gids: Vec::new(),
-                        });
-                    }
-                }
-            }
+            "chunk" => self.chunk(a, field, tag),
             "object" => {
-                Self::add(
-                    &file,
-                    &mut self.budget.objects,
-                    self.uses,
-                    MAX_OBJECTS,
-                    &field,
-                    "objects",
-                    "MAX_OBJECTS",
-                )?;
-                if let Some(t) = a.get("template") {
-                    if in_template {
-                        return Err(LevelError::BadValue {
-                            file,
-                            field: format!("{field}.template"),
-                            message: "an object in a tileset or template cannot use a template"
-                                .into(),
-                        });
-                    }
-                    let dir = self.path.parent().unwrap_or(Path::new(""));
-                    *self
-                        .budget
-                        .template_uses
-                        .entry(dir.join(Path::new(t)))
-                        .or_insert(0) += 1;
-                }
+                self.object_template(a, field)?;
+                Ctx::Other
             }
-            "polygon" | "polyline" => {
-                let n = a
-                    .get("points")
-                    .map_or(0, |p| p.split_ascii_whitespace().count() as u64);
-                if n > MAX_SHAPE_POINTS {
-                    return Err(limit(
-                        &file,
-                        format!("{field}.points"),
-                        "points",
-                        MAX_SHAPE_POINTS,
-                        n,
-                        "MAX_SHAPE_POINTS",
-                    ));
-                }
-                Self::add(
-                    &file,
-                    &mut self.budget.points,
-                    n.saturating_mul(self.uses),
-                    MAX_TOTAL_POINTS,
-                    &format!("{field}.points"),
-                    "polygon and polyline points",
-                    "MAX_TOTAL_POINTS",
-                )?;
+            _ => Ctx::Other,
+        })
+    }
+
+    /// A `<tile>` of XML tile data: counted, and its gid kept for the
+    /// rewrite (at most the cells the layer may have).
+    fn xml_tile(&mut self, a: &Attrs, field: &str) -> Result<(), LevelError> {
+        let gid = match a.get("gid") {
+            None => 0,
+            Some(g) => g.trim().parse::<u32>().map_err(|e| LevelError::BadValue {
+                file: self.file.clone(),
+                field: format!("{field}.gid"),
+                message: format!("{g:?} is not a tile gid: {e}"),
+            })?,
+        };
+        let remaining = MAX_LEVEL_CELLS.saturating_sub(self.budget.cells);
+        if let Some(Frame {
+            ctx: Ctx::Data(d), ..
+        }) = self.stack.last_mut()
+        {
+            d.tiles += 1;
+            if d.gids.len() < d.keep(remaining) {
+                d.gids.push(gid);
             }
-            "property" => {
-                Self::add(
-                    &file,
-                    &mut self.budget.properties,
-                    self.uses,
-                    MAX_PROPERTIES,
-                    &field,
-                    "properties",
-                    "MAX_PROPERTIES",
-                )?;
-            }
-            _ => {}
         }
-        self.stack.push(Frame {
-            path: field,
-            ctx,
-            counts: Vec::new(),
-        });
+        Ok(())
+    }
+
+    /// A tile layer's `<data>`: the cells it must hold, and its start tag
+    /// rewritten when its content (or each chunk's) becomes CSV.
+    fn data(&mut self, a: &Attrs, field: &str, tag: Tag) -> Ctx {
+        let (infinite, expected) = self.layer_cells();
+        let d = DataScan {
+            field: field.to_owned(),
+            encoding: a.get("encoding").map(str::to_owned),
+            compression: a.get("compression").map(str::to_owned),
+            expected,
+            done: false,
+            decodes: !infinite,
+            chunks: 0,
+            content_start: tag.end,
+            empty: tag.empty,
+            tiles: 0,
+            gids: Vec::new(),
+        };
+        if d.rewritten() {
+            self.patches
+                .push(Patch::csv_data_tag(tag.start, tag.end, tag.empty));
+        }
+        Ctx::Data(d)
+    }
+
+    /// A `<chunk>` of an infinite map's layer data: the cells it must hold,
+    /// in its parent's encoding.
+    fn chunk(&mut self, a: &Attrs, field: &str, tag: Tag) -> Ctx {
+        let Some(Ctx::Data(d)) = self.stack.last_mut().map(|f| &mut f.ctx) else {
+            return Ctx::Other;
+        };
+        if d.decodes {
+            return Ctx::Other;
+        }
+        d.chunks += 1;
+        let (w, h) = (a.num("width").unwrap_or(0), a.num("height").unwrap_or(0));
+        Ctx::Data(DataScan {
+            field: field.to_owned(),
+            encoding: d.encoding.clone(),
+            compression: d.compression.clone(),
+            expected: Some(w * h),
+            done: false,
+            decodes: true,
+            chunks: 0,
+            content_start: tag.end,
+            empty: tag.empty,
+            tiles: 0,
+            gids: Vec::new(),
+        })
+    }
+
+    /// An `<object>` made from a template: one more use of the template
+    /// (whose objects then count again); a tileset's or template's own
+    /// objects cannot use one.
+    fn object_template(&mut self, a: &Attrs, field: &str) -> Result<(), LevelError> {
+        let Some(t) = a.get("template") else {
+            return Ok(());
+        };
+        let in_template = self
+            .path
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("tx") || x.eq_ignore_ascii_case("tsx"));
+        if in_template {
+            return Err(LevelError::BadValue {
+                file: self.file.clone(),
+                field: format!("{field}.template"),
+                message: "an object in a tileset or template cannot use a template".into(),
+            });
+        }
+        let dir = self.path.parent().unwrap_or(Path::new(""));
+        *self
+            .budget
+            .template_uses
+            .entry(dir.join(Path::new(t)))
+            .or_insert(0) += 1;
         Ok(())
     }
 
@@ -858,11 +1081,7 @@ impl Scan<'_> {
             if let Some(src) = a.get("source") {
                 let dir = self.path.parent().unwrap_or(Path::new(""));
                 if let Some((w, h)) = png_size(&dir.join(src)) {
-                    self.patches.push(Patch {
-                        start: insert_at,
-                        end: insert_at,
-                        text: format!(" width=\"{w}\" height=\"{h}\""),
-                    });
+                    self.patches.push(Patch::image_size(insert_at, w, h));
                     size = Some((w as u64, h as u64));
                 }
             }
@@ -906,11 +1125,7 @@ impl Scan<'_> {
             if d.decodes && !d.done && !d.is_xml() {
                 d.done = true;
                 if let Some(gids) = decode_data(&file, d, text, remaining)? {
-                    self.patches.push(Patch {
-                        start,
-                        end,
-                        text: csv_text(&gids),
-                    });
+                    self.patches.push(Patch::csv_data(start, end, &gids));
                 }
                 return Ok(());
             }
@@ -939,11 +1154,8 @@ impl Scan<'_> {
                 let remaining = MAX_LEVEL_CELLS.saturating_sub(self.budget.cells);
                 check_cells(&self.file, &d, d.tiles, remaining)?;
                 if !d.empty {
-                    self.patches.push(Patch {
-                        start: d.content_start,
-                        end: content_end,
-                        text: csv_text(&d.gids),
-                    });
+                    self.patches
+                        .push(Patch::csv_data(d.content_start, content_end, &d.gids));
                 }
             }
             Ctx::Data(d) if d.decodes && !d.done => {
@@ -1007,15 +1219,9 @@ impl Scan<'_> {
                 "MAX_TOTAL_TILESET_TILES",
             )?;
         }
-        let mut attrs = format!(" tilecount=\"{count}\"");
-        if !ts.has_columns {
-            attrs.push_str(&format!(" columns=\"{columns}\""));
-        }
-        self.patches.push(Patch {
-            start: ts.insert_at,
-            end: ts.insert_at,
-            text: attrs,
-        });
+        let columns = (!ts.has_columns).then_some(columns);
+        self.patches
+            .push(Patch::tileset_count(ts.insert_at, count, columns));
         Ok(())
     }
 }
@@ -1204,19 +1410,6 @@ fn zstd_cells(b64: impl Read, cap: u64, cells: &mut Cells) -> io::Result<()> {
             return Ok(());
         }
     }
-}
-
-/// The gids as the `tiled` crate reads CSV tile data.
-fn csv_text(gids: &[u32]) -> String {
-    use std::fmt::Write;
-    let mut s = String::with_capacity(gids.len() * 4);
-    for (i, g) in gids.iter().enumerate() {
-        if i > 0 {
-            s.push(',');
-        }
-        let _ = write!(s, "{g}");
-    }
-    s
 }
 
 /// Reads `r` to its end or to `cap + 1` bytes, whichever is first, into a

@@ -25,6 +25,10 @@
 //! * **Decal layers** are ignored. Any other layer kind is an error.
 //!
 //! Level and layer `offsetX`/`offsetY` shift everything in the layer.
+//! The decoded project and level are the `model` module's types,
+//! re-exported here.
+
+pub(crate) mod model;
 
 use std::collections::BTreeMap;
 
@@ -38,124 +42,11 @@ use super::entities::{
 use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
 use ledge_shared::tilemap::Tile;
 
+pub use self::model::{
+    LayerContent, OgmoLayer, OgmoLevel, Project, ProjectEntity, ProjectLayer, ProjectTileset,
+};
+
 type Obj = Map<String, Value>;
-
-/// An OGMO project: only what the loader uses.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Project {
-    /// The project's name.
-    pub name: String,
-    /// Layer definitions.
-    pub layers: Vec<ProjectLayer>,
-    /// Entity definitions.
-    pub entities: Vec<ProjectEntity>,
-    /// Tilesets.
-    pub tilesets: Vec<ProjectTileset>,
-    /// `backgroundColor` (`#rrggbbaa`), empty when absent.
-    pub background_color: String,
-}
-
-/// A layer definition of a [`Project`].
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct ProjectLayer {
-    /// `name`.
-    pub name: String,
-    /// `definition`: `tile`, `grid`, `entity` or `decal`.
-    pub definition: String,
-    /// `exportID` (the level layer's `_eid`).
-    pub export_id: String,
-    /// `defaultTileset`, for tile layers.
-    pub default_tileset: String,
-}
-
-/// An entity definition of a [`Project`].
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct ProjectEntity {
-    /// `name`.
-    pub name: String,
-    /// `exportID` (the level entity's `_eid`).
-    pub export_id: String,
-    /// Default size, pixels.
-    pub size: (f64, f64),
-    /// Default origin, pixels from the top-left corner.
-    pub origin: (f64, f64),
-}
-
-/// A tileset of a [`Project`].
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct ProjectTileset {
-    /// `label` (what tile layers name).
-    pub label: String,
-    /// Tile width, pixels.
-    pub tile_width: u32,
-    /// Tile height, pixels.
-    pub tile_height: u32,
-    /// Tiles per row, when the embedded image's width could be read.
-    pub columns: Option<u32>,
-    /// `tileMarginX`, pixels.
-    pub margin: u32,
-    /// `tileSeparationX`, pixels.
-    pub spacing: u32,
-    /// `path`: the image file the tileset was made from.
-    pub path: String,
-    /// `image`: the embedded image, a `data:image/png;base64,` URI.
-    pub image: String,
-}
-
-/// A decoded OGMO level: layers in file order, positions still per layer.
-#[derive(Debug, Clone, PartialEq)]
-pub struct OgmoLevel {
-    /// Level `offsetX`, `offsetY`, pixels.
-    pub offset: (f64, f64),
-    /// Every layer, in file order.
-    pub layers: Vec<OgmoLayer>,
-    /// Tolerated irregularities, one line each (short 2D rows).
-    pub warnings: Vec<String>,
-}
-
-/// One decoded layer.
-#[derive(Debug, Clone, PartialEq)]
-pub struct OgmoLayer {
-    /// `name`.
-    pub name: String,
-    /// Path in the file: `layers[i]`.
-    pub field: String,
-    /// World position of the layer's top-left corner, in units (level and
-    /// layer offsets).
-    pub origin: IVec2,
-    /// `gridCellWidth`, `gridCellHeight`, pixels.
-    pub cell: (u32, u32),
-    /// `gridCellsX`, `gridCellsY`.
-    pub cells: (u32, u32),
-    /// The layer's content.
-    pub content: LayerContent,
-}
-
-/// What a layer holds.
-#[derive(Debug, Clone, PartialEq)]
-pub enum LayerContent {
-    /// Tile ids, row-major, `-1` empty (coordinates already turned into ids).
-    Tiles {
-        /// The tileset's label.
-        tileset: String,
-        /// The field the ids came from (`data`, `data2D`, `dataCoords`,
-        /// `dataCoords2D`).
-        key: &'static str,
-        /// One id per cell, row-major.
-        ids: Vec<i32>,
-    },
-    /// Grid values, row-major.
-    Grid {
-        /// The field the values came from (`grid` or `grid2D`).
-        key: &'static str,
-        /// One value per cell, row-major.
-        values: Vec<String>,
-    },
-    /// Entities, converted to centres and sizes in units.
-    Entities(Vec<PlacedEntity>),
-    /// A decal layer (ignored).
-    Decals,
-}
 
 struct Cx<'a> {
     file: &'a str,
@@ -518,7 +409,7 @@ pub fn parse_project(file: &str, text: &str) -> Result<Project, LevelError> {
 fn png_width(uri: &str) -> Option<u32> {
     let b64 = uri.split_once("base64,")?.1.as_bytes();
     // The first 24 bytes hold the signature and IHDR's width.
-    let bytes = crate::art::decode_base64(std::str::from_utf8(b64.get(..32)?).ok()?)?;
+    let bytes = crate::art::ogmo::decode_base64(std::str::from_utf8(b64.get(..32)?).ok()?)?;
     (bytes.get(..8)? == b"\x89PNG\r\n\x1a\n" && bytes.get(12..16)? == b"IHDR")
         .then(|| u32::from_be_bytes(bytes[16..20].try_into().unwrap_or_default()))
 }
@@ -567,6 +458,7 @@ pub fn parse_level(
     })
 }
 
+/// Decodes one level layer (`f`: its path), by its kind.
 fn parse_layer(
     cx: &Cx<'_>,
     f: &str,
@@ -583,7 +475,46 @@ fn parse_layer(
             .find(|d| !eid.is_empty() && d.export_id == eid)
             .or_else(|| p.layers.iter().find(|d| d.name == name))
     });
-    let kind = match def.map(|d| d.definition.as_str()) {
+    let kind = layer_kind(cx, f, o, def)?;
+    let lx = cx.opt_num(o, "offsetX", f)?.unwrap_or(0.0);
+    let ly = cx.opt_num(o, "offsetY", f)?.unwrap_or(0.0);
+    let ox = px_to_units(cx.file, &join(f, "offsetX"), level_offset.0 + lx)?;
+    let oy = px_to_units(cx.file, &join(f, "offsetY"), level_offset.1 + ly)?;
+    let mut layer = OgmoLayer {
+        name,
+        field: f.into(),
+        origin: IVec2::new(ox as i32, oy as i32),
+        cell: (0, 0),
+        cells: (0, 0),
+        content: LayerContent::Decals,
+    };
+    if matches!(kind, Kind::Decal) {
+        return Ok(layer);
+    }
+    if matches!(kind, Kind::Tile | Kind::Grid) {
+        layer.cell = (
+            cx.cell_size(o, "gridCellWidth", f)?,
+            cx.cell_size(o, "gridCellHeight", f)?,
+        );
+        layer.cells = (cx.count(o, "gridCellsX", f)?, cx.count(o, "gridCellsY", f)?);
+    }
+    layer.content = match kind {
+        Kind::Decal => LayerContent::Decals,
+        Kind::Tile => tile_content(cx, f, o, def, project, layer.cells)?,
+        Kind::Grid => grid_content(cx, f, o, layer.cells)?,
+        Kind::Entity => entity_content(cx, f, o, &layer, project)?,
+    };
+    Ok(layer)
+}
+
+/// A layer's kind: its project definition's, else told from its fields.
+fn layer_kind(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    def: Option<&ProjectLayer>,
+) -> Result<Kind, LevelError> {
+    Ok(match def.map(|d| d.definition.as_str()) {
         Some("tile") => Kind::Tile,
         Some("grid") => Kind::Grid,
         Some("entity") => Kind::Entity,
@@ -613,151 +544,157 @@ fn parse_layer(
                 });
             }
         }
-    };
-    let lx = cx.opt_num(o, "offsetX", f)?.unwrap_or(0.0);
-    let ly = cx.opt_num(o, "offsetY", f)?.unwrap_or(0.0);
-    let ox = px_to_units(cx.file, &join(f, "offsetX"), level_offset.0 + lx)?;
-    let oy = px_to_units(cx.file, &join(f, "offsetY"), level_offset.1 + ly)?;
-    let mut layer = OgmoLayer {
-        name,
-        field: f.into(),
-        origin: IVec2::new(ox as i32, oy as i32),
-        cell: (0, 0),
-        cells: (0, 0),
-        content: LayerContent::Decals,
-    };
-    if matches!(kind, Kind::Decal) {
-        return Ok(layer);
-    }
-    if matches!(kind, Kind::Tile | Kind::Grid) {
-        layer.cell = (
-            cx.cell_size(o, "gridCellWidth", f)?,
-            cx.cell_size(o, "gridCellHeight", f)?,
-        );
-        layer.cells = (cx.count(o, "gridCellsX", f)?, cx.count(o, "gridCellsY", f)?);
-    }
-    let mode = |key: &str| -> Result<Option<i64>, LevelError> {
-        match o.get(key) {
-            None => Ok(None),
-            Some(v) => {
-                let field = join(f, key);
-                match cx.int(v, &field)? {
-                    m @ (0 | 1) => Ok(Some(m)),
-                    m => Err(cx.bad(&field, format!("expected 0 or 1, got {m}"))),
-                }
-            }
-        }
-    };
-    let pick =
-        |keys: [&'static str; 2], two_d: Option<i64>| -> Result<(&'static str, bool), LevelError> {
-            match two_d {
-                Some(m) => {
-                    let key = keys[m as usize];
-                    if o.contains_key(key) {
-                        Ok((key, m == 1))
-                    } else {
-                        Err(LevelError::Missing {
-                            file: cx.file.into(),
-                            field: join(f, key),
-                            hint: format!(" (arrayMode {m} stores the cells in {key:?})"),
-                        })
-                    }
-                }
-                None => keys
-                    .iter()
-                    .zip([false, true])
-                    .find(|(k, _)| o.contains_key(**k))
-                    .map(|(k, d)| (*k, d))
-                    .ok_or_else(|| LevelError::Missing {
-                        file: cx.file.into(),
-                        field: join(f, keys[0]),
-                        hint: format!(" (nor {:?})", keys[1]),
-                    }),
-            }
-        };
-    layer.content = match kind {
-        Kind::Decal => LayerContent::Decals,
-        Kind::Tile => {
-            let tileset = match cx.opt_str(o, "tileset", f)? {
-                Some(t) => t,
-                None => def.map(|d| d.default_tileset.clone()).unwrap_or_default(),
-            };
-            let coords = match mode("exportMode")? {
-                Some(m) => m == 1,
-                None => o.contains_key("dataCoords") || o.contains_key("dataCoords2D"),
-            };
-            let (key, two_d) = if coords {
-                pick(["dataCoords", "dataCoords2D"], mode("arrayMode")?)?
-            } else {
-                pick(["data", "data2D"], mode("arrayMode")?)?
-            };
-            let v = &o[key];
+    })
+}
+
+/// A layer's `exportMode` or `arrayMode` (`key`): 0, 1, or absent.
+fn export_mode(cx: &Cx<'_>, f: &str, o: &Obj, key: &str) -> Result<Option<i64>, LevelError> {
+    match o.get(key) {
+        None => Ok(None),
+        Some(v) => {
             let field = join(f, key);
-            let ids = if coords {
-                let columns = project
-                    .and_then(|p| p.tilesets.iter().find(|t| t.label == tileset))
-                    .and_then(|t| t.columns);
-                cx.cells(
-                    v,
-                    &field,
-                    layer.cells,
-                    two_d,
-                    &serde_json::json!([-1]),
-                    |c, cf| coord_id(cx, c, cf, columns, &tileset),
-                )?
-            } else {
-                cx.cells(v, &field, layer.cells, two_d, &Value::from(-1), |c, cf| {
-                    let id = cx.int(c, cf)?;
-                    if !(-1..=i32::MAX as i64).contains(&id) {
-                        return Err(cx.bad(
-                            cf,
-                            format!("tile id {id} is not -1 (empty) or a tile index"),
-                        ));
-                    }
-                    Ok(id as i32)
-                })?
-            };
-            LayerContent::Tiles { tileset, key, ids }
-        }
-        Kind::Grid => {
-            let (key, two_d) = pick(["grid", "grid2D"], mode("arrayMode")?)?;
-            let empty = Value::from("0");
-            let values = cx.cells(
-                &o[key],
-                &join(f, key),
-                layer.cells,
-                two_d,
-                &empty,
-                |c, cf| {
-                    Ok(match c {
-                        Value::String(s) => s.clone(),
-                        Value::Number(n) => n.to_string(),
-                        Value::Bool(b) => (*b as u8).to_string(),
-                        other => return Err(cx.expected(cf, "a string", other)),
-                    })
-                },
-            )?;
-            LayerContent::Grid { key, values }
-        }
-        Kind::Entity => {
-            let list = match o.get("entities") {
-                Some(v) => cx.arr(v, &join(f, "entities"))?,
-                None => &[],
-            };
-            let mut es = Vec::with_capacity(list.len());
-            for (k, e) in list.iter().enumerate() {
-                es.push(parse_entity(
-                    cx,
-                    &format!("{f}.entities[{k}]"),
-                    e,
-                    &layer,
-                    project,
-                )?);
+            match cx.int(v, &field)? {
+                m @ (0 | 1) => Ok(Some(m)),
+                m => Err(cx.bad(&field, format!("expected 0 or 1, got {m}"))),
             }
-            LayerContent::Entities(es)
         }
+    }
+}
+
+/// Which of the 1D and 2D fields `keys` holds a layer's cells, and whether
+/// it is the 2D one: the one `arrayMode` (`two_d`) names, else the first
+/// present.
+fn pick_cells_key(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    keys: [&'static str; 2],
+    two_d: Option<i64>,
+) -> Result<(&'static str, bool), LevelError> {
+    match two_d {
+        Some(m) => {
+            let key = keys[m as usize];
+            if o.contains_key(key) {
+                Ok((key, m == 1))
+            } else {
+                Err(LevelError::Missing {
+                    file: cx.file.into(),
+                    field: join(f, key),
+                    hint: format!(" (arrayMode {m} stores the cells in {key:?})"),
+                })
+            }
+        }
+        None => keys
+            .iter()
+            .zip([false, true])
+            .find(|(k, _)| o.contains_key(**k))
+            .map(|(k, d)| (*k, d))
+            .ok_or_else(|| LevelError::Missing {
+                file: cx.file.into(),
+                field: join(f, keys[0]),
+                hint: format!(" (nor {:?})", keys[1]),
+            }),
+    }
+}
+
+/// A tile layer's ids (tile coordinates turned into ids), from whichever
+/// of its four fields its modes name.
+fn tile_content(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    def: Option<&ProjectLayer>,
+    project: Option<&Project>,
+    cells: (u32, u32),
+) -> Result<LayerContent, LevelError> {
+    let tileset = match cx.opt_str(o, "tileset", f)? {
+        Some(t) => t,
+        None => def.map(|d| d.default_tileset.clone()).unwrap_or_default(),
     };
-    Ok(layer)
+    let coords = match export_mode(cx, f, o, "exportMode")? {
+        Some(m) => m == 1,
+        None => o.contains_key("dataCoords") || o.contains_key("dataCoords2D"),
+    };
+    let keys = if coords {
+        ["dataCoords", "dataCoords2D"]
+    } else {
+        ["data", "data2D"]
+    };
+    let mode = export_mode(cx, f, o, "arrayMode")?;
+    let (key, two_d) = pick_cells_key(cx, f, o, keys, mode)?;
+    let v = &o[key];
+    let field = join(f, key);
+    let ids = if coords {
+        let columns = project
+            .and_then(|p| p.tilesets.iter().find(|t| t.label == tileset))
+            .and_then(|t| t.columns);
+        cx.cells(
+            v,
+            &field,
+            cells,
+            two_d,
+            &serde_json::json!([-1]),
+            |c, cf| coord_id(cx, c, cf, columns, &tileset),
+        )?
+    } else {
+        cx.cells(v, &field, cells, two_d, &Value::from(-1), |c, cf| {
+            let id = cx.int(c, cf)?;
+            if !(-1..=i32::MAX as i64).contains(&id) {
+                return Err(cx.bad(
+                    cf,
+                    format!("tile id {id} is not -1 (empty) or a tile index"),
+                ));
+            }
+            Ok(id as i32)
+        })?
+    };
+    Ok(LayerContent::Tiles { tileset, key, ids })
+}
+
+/// A grid layer's values (numbers and booleans as text).
+fn grid_content(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    cells: (u32, u32),
+) -> Result<LayerContent, LevelError> {
+    let mode = export_mode(cx, f, o, "arrayMode")?;
+    let (key, two_d) = pick_cells_key(cx, f, o, ["grid", "grid2D"], mode)?;
+    let empty = Value::from("0");
+    let values = cx.cells(&o[key], &join(f, key), cells, two_d, &empty, |c, cf| {
+        Ok(match c {
+            Value::String(s) => s.clone(),
+            Value::Number(n) => n.to_string(),
+            Value::Bool(b) => (*b as u8).to_string(),
+            other => return Err(cx.expected(cf, "a string", other)),
+        })
+    })?;
+    Ok(LayerContent::Grid { key, values })
+}
+
+/// An entity layer's entities, placed in `layer`.
+fn entity_content(
+    cx: &Cx<'_>,
+    f: &str,
+    o: &Obj,
+    layer: &OgmoLayer,
+    project: Option<&Project>,
+) -> Result<LayerContent, LevelError> {
+    let list = match o.get("entities") {
+        Some(v) => cx.arr(v, &join(f, "entities"))?,
+        None => &[],
+    };
+    let mut es = Vec::with_capacity(list.len());
+    for (k, e) in list.iter().enumerate() {
+        es.push(parse_entity(
+            cx,
+            &format!("{f}.entities[{k}]"),
+            e,
+            layer,
+            project,
+        )?);
+    }
+    Ok(LayerContent::Entities(es))
 }
 
 fn coord_id(
@@ -1009,7 +946,7 @@ pub fn load_str(
     let project = project.map(|(pf, pt)| parse_project(pf, pt)).transpose()?;
     let level = parse_level(file, text, project.as_ref())?;
     let art = match (project_file, &project) {
-        (Some(pf), Some(p)) => crate::art::from_ogmo(file, pf, p, &level)?,
+        (Some(pf), Some(p)) => crate::art::ogmo::from_ogmo(file, pf, p, &level)?,
         _ => crate::art::LevelArt::default(),
     };
     let mut warnings = level.warnings;

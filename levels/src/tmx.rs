@@ -24,6 +24,8 @@
 //!   path objects are not entities. Layer and group offsets shift objects.
 //! * Image layers are art only ([`crate::art`]).
 
+pub(crate) mod common;
+
 use std::cell::RefCell;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Cursor;
@@ -36,6 +38,7 @@ use ::tiled::{
 };
 use glam::IVec2;
 
+use self::common::{object_name, short_data};
 use super::collision::{self, tile_of_props, Outline, Prop, TileShape};
 use super::entities::is_entity_name;
 use super::entities::{
@@ -152,7 +155,7 @@ fn load(
         grid: (0, 0, map.width, map.height),
     }
     .run(path)?;
-    loaded.art = crate::art::from_tiled(&file, &map, options)?;
+    loaded.art = crate::art::tiled::from_tiled(&file, &map, options)?;
     Ok(loaded)
 }
 
@@ -826,7 +829,6 @@ impl Conv<'_> {
             }
             return Ok(());
         }
-        let tile_px = self.map.tile_width as f64;
         for (k, o) in ol.objects().enumerate() {
             if paths.used.contains(&o.id()) && paths.by_id.contains_key(&o.id()) {
                 continue;
@@ -835,101 +837,15 @@ impl Conv<'_> {
             let known = |n: &str| is_entity_name(self.options.entity_name(n));
             let name = object_name(self.options, &o).to_owned();
             let (x, y) = (o.x as f64 + off.0, o.y as f64 + off.1);
-            let at = || {
-                format!(
-                    "{} object {} {:?} at ({:.0}, {:.0}) px",
-                    info.describe(),
-                    o.id(),
-                    name,
-                    x,
-                    y
-                )
-            };
             if !o.visible {
                 self.notes.borrow_mut().add(
                     "hidden objects are ignored (make them visible in Tiled to use them)".into(),
-                    at,
+                    || object_place(info, &o, &name, (x, y)),
                 );
                 continue;
             }
             if !known(&name) {
-                // Not an entity: solid geometry if it says so (or is an
-                // unnamed shape), a hazard, or something to skip.
-                let tile = o.get_tile();
-                let own = tile_of_props(props(&o.properties), "")
-                    .map_err(|m| self.bad(format!("{f}.properties"), m))?;
-                let from_tile = match (own, &tile) {
-                    (None, Some(t)) => match t.get_tile() {
-                        Some(td) => tile_of_props(props(&td.properties), &td.user_type)
-                            .map_err(|m| self.bad(format!("{f}.properties"), m))?,
-                        None => None,
-                    },
-                    _ => None,
-                };
-                let said = own.or(from_tile);
-                let unnamed_shape = name.trim().is_empty()
-                    && tile.is_none()
-                    && matches!(
-                        o.shape,
-                        ObjectShape::Rect { .. }
-                            | ObjectShape::Ellipse { .. }
-                            | ObjectShape::Polygon { .. }
-                            | ObjectShape::Polyline { .. }
-                    );
-                match said {
-                    Some(Tile::Solid) | Some(Tile::Slope(_)) => {}
-                    None if unnamed_shape => {}
-                    Some(Tile::Hazard) => {
-                        if let Some((l, t, w, h)) = object_box(&o.shape, x, y, tile.is_some()) {
-                            let lu = px_to_units(self.file, &format!("{f}.x"), l)?;
-                            let tu = px_to_units(self.file, &format!("{f}.y"), t)?;
-                            let (centre, size) = place_box(self.file, &f, lu, tu, w, h)?;
-                            let mut e = geometry_entity(info, &f, centre, size, None);
-                            e.name = "hazard".into();
-                            out.push(e);
-                        }
-                        continue;
-                    }
-                    Some(Tile::OneWay) => {
-                        self.notes.borrow_mut().add(
-                            "one-way objects are not supported (use one-way tiles or a platform object named \"platform\" with `one_way`); ignored".into(),
-                            at,
-                        );
-                        continue;
-                    }
-                    Some(Tile::Empty) => continue,
-                    None if name.trim().is_empty() => {
-                        // Decoration (tile objects, drawn), markers
-                        // (points), labels (text): nothing to collide
-                        // with; said for the ones that are not drawn.
-                        if tile.is_none() {
-                            self.notes.borrow_mut().add(
-                                "unnamed points, text and capsules are markers and labels: not used (name a point \"spawn\", \"coin\", ... to make it an entity)".into(),
-                                at,
-                            );
-                        }
-                        continue;
-                    }
-                    None => {
-                        if !self.options.skip_unknown_entities {
-                            return Err(LevelError::UnknownEntity {
-                                file: self.file.into(),
-                                field: format!("{f}.name"),
-                                layer: info.name.into(),
-                                name: name.clone(),
-                            });
-                        }
-                        self.notes.borrow_mut().add(
-                            format!(
-                                "skipped objects named {name:?}: not a ledge entity (known: {}); give them a known name or class, or an alias in the level's settings",
-                                crate::ENTITY_NAMES.join(", ")
-                            ),
-                            at,
-                        );
-                        continue;
-                    }
-                }
-                self.solid_object(info, &f, &o, (x, y), out)?;
+                self.other_object(info, &f, &o, &name, (x, y), out)?;
                 continue;
             }
             if let ObjectShape::Polygon { points } = &o.shape {
@@ -947,71 +863,11 @@ impl Conv<'_> {
                 });
                 continue;
             }
-            let (left, top, w, h) = match &o.shape {
-                ObjectShape::Point(..) => (x - tile_px / 2.0, y - tile_px / 2.0, tile_px, tile_px),
-                shape => match object_box(shape, x, y, o.tile_data().is_some()) {
-                    Some(b) => b,
-                    None => {
-                        let shape = match shape {
-                            ObjectShape::Polyline { .. } => "polyline",
-                            ObjectShape::Text { .. } => "text",
-                            _ => "capsule",
-                        };
-                        return Err(self.bad(
-                            format!("{f}.shape"),
-                            format!("a {shape} object is not an entity (polylines are platform paths: name them in a platform's `path` property)"),
-                        ));
-                    }
-                },
-            };
+            let (left, top, w, h) = self.entity_box(&f, &o, (x, y))?;
             let l = px_to_units(self.file, &format!("{f}.x"), left)?;
             let t = px_to_units(self.file, &format!("{f}.y"), top)?;
             let (centre, size) = place_box(self.file, &f, l, t, w, h)?;
-            let mut values = Vec::new();
-            let mut nodes = Vec::new();
-            let mut props: Vec<_> = o.properties.iter().collect();
-            props.sort_by(|a, b| a.0.cmp(b.0));
-            for (key, v) in props {
-                let pv = match v {
-                    PropertyValue::BoolValue(b) => PropValue::Bool(*b),
-                    PropertyValue::FloatValue(x) => PropValue::Number(*x as f64),
-                    PropertyValue::IntValue(i) => PropValue::Number(*i as f64),
-                    PropertyValue::StringValue(s) | PropertyValue::FileValue(s) => {
-                        PropValue::Text(s.clone())
-                    }
-                    PropertyValue::ObjectValue(id) if key == "path" => {
-                        let pf = format!("{f}.properties.path");
-                        let Some(p) = paths.by_id.get(id) else {
-                            return Err(
-                                self.bad(pf, format!("object {id} is not a polyline or polygon"))
-                            );
-                        };
-                        for (i, &(px, py)) in p.points.iter().enumerate() {
-                            let nf = format!("{pf} (object {id} point {i})");
-                            let nx = px_to_units(self.file, &format!("{nf}.x"), px)?;
-                            let ny = px_to_units(self.file, &format!("{nf}.y"), py)?;
-                            let (c, _) = place_box(
-                                self.file,
-                                &nf,
-                                nx - size.x as i64 / 2,
-                                ny - size.y as i64 / 2,
-                                w,
-                                h,
-                            )?;
-                            if !(i == 0 && c == centre) {
-                                nodes.push(c);
-                            }
-                        }
-                        if p.closed && !o.properties.keys().any(|k| k.eq_ignore_ascii_case("loop"))
-                        {
-                            values.push(("loop".into(), PropValue::Bool(true)));
-                        }
-                        continue;
-                    }
-                    other => PropValue::Text(format!("{other:?}")),
-                };
-                values.push((key.clone(), pv));
-            }
+            let (values, nodes) = self.entity_values(&f, &o, paths, centre, size, (w, h))?;
             out.push(PlacedEntity {
                 name,
                 layer: info.name.into(),
@@ -1025,6 +881,185 @@ impl Conv<'_> {
             });
         }
         Ok(())
+    }
+
+    /// An object that is no entity: solid geometry if it says so (or is an
+    /// unnamed shape), a hazard, or something to skip (with a note, or an
+    /// error when unknown entities are refused).
+    fn other_object(
+        &self,
+        info: &LayerInfo<'_>,
+        f: &str,
+        o: &::tiled::Object<'_>,
+        name: &str,
+        (x, y): (f64, f64),
+        out: &mut Vec<PlacedEntity>,
+    ) -> Result<(), LevelError> {
+        let at = || object_place(info, o, name, (x, y));
+        let tile = o.get_tile();
+        let own = tile_of_props(props(&o.properties), "")
+            .map_err(|m| self.bad(format!("{f}.properties"), m))?;
+        let from_tile = match (own, &tile) {
+            (None, Some(t)) => match t.get_tile() {
+                Some(td) => tile_of_props(props(&td.properties), &td.user_type)
+                    .map_err(|m| self.bad(format!("{f}.properties"), m))?,
+                None => None,
+            },
+            _ => None,
+        };
+        let said = own.or(from_tile);
+        let unnamed_shape = name.trim().is_empty()
+            && tile.is_none()
+            && matches!(
+                o.shape,
+                ObjectShape::Rect { .. }
+                    | ObjectShape::Ellipse { .. }
+                    | ObjectShape::Polygon { .. }
+                    | ObjectShape::Polyline { .. }
+            );
+        match said {
+            Some(Tile::Solid) | Some(Tile::Slope(_)) => {}
+            None if unnamed_shape => {}
+            Some(Tile::Hazard) => {
+                if let Some((l, t, w, h)) = object_box(&o.shape, x, y, tile.is_some()) {
+                    let lu = px_to_units(self.file, &format!("{f}.x"), l)?;
+                    let tu = px_to_units(self.file, &format!("{f}.y"), t)?;
+                    let (centre, size) = place_box(self.file, f, lu, tu, w, h)?;
+                    let mut e = geometry_entity(info, f, centre, size, None);
+                    e.name = "hazard".into();
+                    out.push(e);
+                }
+                return Ok(());
+            }
+            Some(Tile::OneWay) => {
+                self.notes.borrow_mut().add(
+                    "one-way objects are not supported (use one-way tiles or a platform object named \"platform\" with `one_way`); ignored".into(),
+                    at,
+                );
+                return Ok(());
+            }
+            Some(Tile::Empty) => return Ok(()),
+            None if name.trim().is_empty() => {
+                // Decoration (tile objects, drawn), markers
+                // (points), labels (text): nothing to collide
+                // with; said for the ones that are not drawn.
+                if tile.is_none() {
+                    self.notes.borrow_mut().add(
+                        "unnamed points, text and capsules are markers and labels: not used (name a point \"spawn\", \"coin\", ... to make it an entity)".into(),
+                        at,
+                    );
+                }
+                return Ok(());
+            }
+            None => {
+                if !self.options.skip_unknown_entities {
+                    return Err(LevelError::UnknownEntity {
+                        file: self.file.into(),
+                        field: format!("{f}.name"),
+                        layer: info.name.into(),
+                        name: name.to_owned(),
+                    });
+                }
+                self.notes.borrow_mut().add(
+                    format!(
+                        "skipped objects named {name:?}: not a ledge entity (known: {}); give them a known name or class, or an alias in the level's settings",
+                        crate::ENTITY_NAMES.join(", ")
+                    ),
+                    at,
+                );
+                return Ok(());
+            }
+        }
+        self.solid_object(info, f, o, (x, y), out)
+    }
+
+    /// An entity object's box `(left, top, width, height)` in pixels: a
+    /// point is one tile centred on it; polylines, text and capsules are
+    /// refused.
+    fn entity_box(
+        &self,
+        f: &str,
+        o: &::tiled::Object<'_>,
+        (x, y): (f64, f64),
+    ) -> Result<(f64, f64, f64, f64), LevelError> {
+        let tile_px = self.map.tile_width as f64;
+        Ok(match &o.shape {
+            ObjectShape::Point(..) => (x - tile_px / 2.0, y - tile_px / 2.0, tile_px, tile_px),
+            shape => match object_box(shape, x, y, o.tile_data().is_some()) {
+                Some(b) => b,
+                None => {
+                    let shape = match shape {
+                        ObjectShape::Polyline { .. } => "polyline",
+                        ObjectShape::Text { .. } => "text",
+                        _ => "capsule",
+                    };
+                    return Err(self.bad(
+                        format!("{f}.shape"),
+                        format!("a {shape} object is not an entity (polylines are platform paths: name them in a platform's `path` property)"),
+                    ));
+                }
+            },
+        })
+    }
+
+    /// An entity object's parameters (its custom properties, by name) and
+    /// path nodes (the points of the object its `path` property names, as
+    /// centres of its `size`; `(w, h)` its box in pixels).
+    #[allow(clippy::type_complexity)]
+    fn entity_values(
+        &self,
+        f: &str,
+        o: &::tiled::Object<'_>,
+        paths: &Paths,
+        centre: IVec2,
+        size: IVec2,
+        (w, h): (f64, f64),
+    ) -> Result<(Vec<(String, PropValue)>, Vec<IVec2>), LevelError> {
+        let mut values = Vec::new();
+        let mut nodes = Vec::new();
+        let mut props: Vec<_> = o.properties.iter().collect();
+        props.sort_by(|a, b| a.0.cmp(b.0));
+        for (key, v) in props {
+            let pv = match v {
+                PropertyValue::BoolValue(b) => PropValue::Bool(*b),
+                PropertyValue::FloatValue(x) => PropValue::Number(*x as f64),
+                PropertyValue::IntValue(i) => PropValue::Number(*i as f64),
+                PropertyValue::StringValue(s) | PropertyValue::FileValue(s) => {
+                    PropValue::Text(s.clone())
+                }
+                PropertyValue::ObjectValue(id) if key == "path" => {
+                    let pf = format!("{f}.properties.path");
+                    let Some(p) = paths.by_id.get(id) else {
+                        return Err(
+                            self.bad(pf, format!("object {id} is not a polyline or polygon"))
+                        );
+                    };
+                    for (i, &(px, py)) in p.points.iter().enumerate() {
+                        let nf = format!("{pf} (object {id} point {i})");
+                        let nx = px_to_units(self.file, &format!("{nf}.x"), px)?;
+                        let ny = px_to_units(self.file, &format!("{nf}.y"), py)?;
+                        let (c, _) = place_box(
+                            self.file,
+                            &nf,
+                            nx - size.x as i64 / 2,
+                            ny - size.y as i64 / 2,
+                            w,
+                            h,
+                        )?;
+                        if !(i == 0 && c == centre) {
+                            nodes.push(c);
+                        }
+                    }
+                    if p.closed && !o.properties.keys().any(|k| k.eq_ignore_ascii_case("loop")) {
+                        values.push(("loop".into(), PropValue::Bool(true)));
+                    }
+                    continue;
+                }
+                other => PropValue::Text(format!("{other:?}")),
+            };
+            values.push((key.clone(), pv));
+        }
+        Ok((values, nodes))
     }
 
     /// A solid object that is not an entity: a rectangle (turned by its
@@ -1188,39 +1223,6 @@ impl Conv<'_> {
     }
 }
 
-/// The name an object goes by: its class (`type` before Tiled 1.9), else
-/// its name, also when the class is no ledge entity (after the settings'
-/// aliases) and the name is.
-pub(crate) fn object_name<'o>(options: &LoadOptions, o: &'o ::tiled::ObjectData) -> &'o str {
-    let known = |n: &str| is_entity_name(options.entity_name(n));
-    if o.user_type.trim().is_empty() || (!known(&o.user_type) && known(&o.name)) {
-        &o.name
-    } else {
-        &o.user_type
-    }
-}
-
-/// Whether an object stands for an entity that moves or vanishes (a coin,
-/// a walker, a moving platform), which the game draws itself: the level's
-/// art leaves its picture out, or a collected coin would stay on screen.
-pub(crate) fn is_drawn_entity(options: &LoadOptions, o: &::tiled::ObjectData) -> bool {
-    crate::entities::moves_or_vanishes(options.entity_name(object_name(options, o)))
-}
-
-/// Whether a finite layer has fewer cells of data than its size: the tiled
-/// crate does not check, and indexing past short data panics. The pre-scan
-/// ([`crate::limits`]) refuses such data; this probe of the last cell is
-/// the second line, for every reader of a layer's cells.
-pub(crate) fn short_data(fl: &::tiled::FiniteTileLayer<'_>) -> bool {
-    let (w, h) = (fl.width(), fl.height());
-    w > 0
-        && h > 0
-        && catch_unwind(AssertUnwindSafe(|| {
-            fl.get_tile_data(w as i32 - 1, h as i32 - 1).is_some()
-        }))
-        .is_err()
-}
-
 /// How thick a solid polyline's legs are, in pixels.
 const POLYLINE_THICKNESS: f64 = 2.0;
 
@@ -1239,6 +1241,23 @@ fn object_box(shape: &ObjectShape, x: f64, y: f64, is_tile: bool) -> Option<(f64
         }
         _ => None,
     }
+}
+
+/// Where an object is, for notes: its layer, id, name and position.
+fn object_place(
+    info: &LayerInfo<'_>,
+    o: &::tiled::ObjectData,
+    name: &str,
+    (x, y): (f64, f64),
+) -> String {
+    format!(
+        "{} object {} {:?} at ({:.0}, {:.0}) px",
+        info.describe(),
+        o.id(),
+        name,
+        x,
+        y
+    )
 }
 
 /// A static solid from a tile collision shape or a solid object.

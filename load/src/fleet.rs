@@ -911,20 +911,103 @@ fn wait_for_room(
     }
 }
 
+/// When a fleet run's phases end: every bot process plays until the same
+/// end, after the allocations' budget, the warm-up and the window.
+struct Timing {
+    /// When the allocations start (once every server is Ready).
+    start: Instant,
+    /// The allocations' budget: [`FleetConfig::room_timeout`] each.
+    budget: Duration,
+    /// When every bot process stops playing.
+    end: Instant,
+}
+
+impl Timing {
+    /// The timing of a run whose allocations start now.
+    fn new(config: &FleetConfig) -> Self {
+        let start = Instant::now();
+        let budget = config.room_timeout * u32::try_from(config.rooms()).unwrap_or(u32::MAX);
+        let end = start + budget + config.warmup + config.duration + BOT_TAIL;
+        Timing { start, budget, end }
+    }
+}
+
+/// What the allocations (phase 2) made.
+struct Allocated {
+    /// The allocations, in order.
+    allocations: Vec<Allocation>,
+    /// A bot process per allocated room, in allocation order.
+    bots: Vec<BotProcess>,
+    /// The rooms allocated to each server.
+    rooms_of: Vec<Vec<String>>,
+    /// What one more allocation found.
+    one_more: Option<usize>,
+}
+
+/// What the window of play (phase 3) measured.
+struct Window {
+    /// The servers' figures, in order.
+    server_figures: Vec<ServerFigures>,
+    /// Each bot process's CPU over the window, percent of one core.
+    bot_cpu_pct: Vec<f64>,
+    /// The window, seconds (measured).
+    window_s: f64,
+    /// 1-minute load average at the window's start and end.
+    load: (f64, f64),
+}
+
 /// Runs the fleet: every child is killed and every sidecar stopped before
 /// this returns, whatever happens.
 pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetReport> {
     config.validate()?;
-    let (s, r, k) = (
-        config.servers,
-        config.rooms_per_server,
-        config.bots_per_room,
-    );
     let mut problems = Vec::new();
+    let mut members = start_servers(config, stop)?;
+    let timing = Timing::new(config);
+    let Allocated {
+        allocations,
+        mut bots,
+        rooms_of,
+        one_more,
+    } = allocate_rooms(config, &timing, &mut members, &mut problems, stop)?;
+    let window = play_window(
+        config,
+        &timing,
+        &mut members,
+        &mut bots,
+        &rooms_of,
+        &allocations,
+        &mut problems,
+        stop,
+    )?;
+    let bot_figures = finish_bots(
+        config,
+        &timing,
+        &mut bots,
+        &window.bot_cpu_pct,
+        &mut problems,
+        stop,
+    )?;
+    let shutdowns = check_shutdowns(config, &mut members, &bots, &mut problems, stop)?;
+    Ok(FleetReport {
+        servers: config.servers,
+        rooms_per_server: config.rooms_per_server,
+        bots_per_room: config.bots_per_room,
+        brain: config.brain.clone(),
+        window_s: window.window_s,
+        allocations,
+        one_more,
+        server_figures: window.server_figures,
+        bot_figures,
+        shutdowns,
+        problems,
+        load: window.load,
+    })
+}
 
-    // 1. The servers, each with its sidecar, Ready.
+/// Phase 1: the servers, each with its sidecar, Ready.
+fn start_servers(config: &FleetConfig, stop: &Stop) -> anyhow::Result<Vec<Member>> {
     let mut members = Vec::new();
-    for i in 0..s {
+    for i in 0..config.servers {
         let m = start_member(config, i, stop)?;
         eprintln!(
             "  {} Ready at {} (sidecar port {}, fingerprint {}...)",
@@ -935,19 +1018,27 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
         );
         members.push(m);
     }
+    Ok(members)
+}
 
-    // 2. Allocations, one at a time. Every bot process plays until the
-    // same end: after the allocations' budget, the warm-up and the window.
+/// Phase 2: the allocations, one at a time, each with its bot process and a
+/// wait until its room shows; then the packing, and one more allocation,
+/// which must find no server.
+fn allocate_rooms(
+    config: &FleetConfig,
+    timing: &Timing,
+    members: &mut [Member],
+    problems: &mut Vec<String>,
+    stop: &Stop,
+) -> anyhow::Result<Allocated> {
     let total = config.rooms();
-    let start = Instant::now();
-    let budget = config.room_timeout * u32::try_from(total).unwrap_or(u32::MAX);
-    let end = start + budget + config.warmup + config.duration + BOT_TAIL;
-    let packing = expected_packing(s, r);
+    let Timing { start, budget, end } = *timing;
+    let packing = expected_packing(config.servers, config.rooms_per_server);
     let mut allocations = Vec::new();
     let mut bots: Vec<BotProcess> = Vec::new();
-    let mut rooms_of: Vec<Vec<String>> = vec![Vec::new(); s];
+    let mut rooms_of: Vec<Vec<String>> = vec![Vec::new(); config.servers];
     for (i, &expected) in packing.iter().enumerate() {
-        check_servers(&mut members, "during the allocations")?;
+        check_servers(members, "during the allocations")?;
         let fleet: Vec<&FakeSidecar> = members.iter().map(|m| &m.sidecar).collect();
         let allocated_at = Instant::now();
         let Some(server) = allocate(&fleet, Want::AnyRoom) else {
@@ -997,6 +1088,17 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
         });
         bots.push(process);
     }
+    let one_more = one_more_allocation(members, problems);
+    Ok(Allocated {
+        allocations,
+        bots,
+        rooms_of,
+        one_more,
+    })
+}
+
+/// One more allocation on the full fleet: a server it finds is a problem.
+fn one_more_allocation(members: &[Member], problems: &mut Vec<String>) -> Option<usize> {
     let one_more = {
         let fleet: Vec<&FakeSidecar> = members.iter().map(|m| &m.sidecar).collect();
         allocate(&fleet, Want::AnyRoom)
@@ -1008,43 +1110,23 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
             members[i].sidecar.counter(ROOMS)
         ));
     }
+    one_more
+}
 
-    // Every bot in (by the end of the allocations' budget at the latest),
-    // the warm-up, then the window; the bots play on until their end.
-    let latest = end - BOT_TAIL - config.duration - config.warmup;
-    let want_players = (r * k) as i64;
-    let all_in = |members: &[Member]| {
-        members.iter().all(|m| {
-            m.sidecar
-                .counter(PLAYERS)
-                .is_some_and(|(n, _)| n == want_players)
-        })
-    };
-    while !all_in(&members) && Instant::now() < latest {
-        check_servers(&mut members, "before the window")?;
-        stop.sleep(POLL)?;
-    }
-    let joined_after = start.elapsed();
-    let window_start = Instant::now() + config.warmup;
-    if all_in(&members) {
-        eprintln!(
-            "  all {} bots in after {:.1} s; window of {:?} after {:?} of warm-up",
-            s * r * k,
-            joined_after.as_secs_f64(),
-            config.duration,
-            config.warmup
-        );
-    } else {
-        let counts: Vec<Option<(i64, i64)>> =
-            members.iter().map(|m| m.sidecar.counter(PLAYERS)).collect();
-        problems.push(format!(
-            "not every bot joined before the window: players counters {counts:?}, \
-             {want_players} each expected"
-        ));
-    }
-    stop.sleep(window_start.saturating_duration_since(Instant::now()))?;
-
-    // 3. The window.
+/// Phase 3: every bot in and the warm-up, the window measured, then the
+/// checks for cross-talk at its end.
+#[allow(clippy::too_many_arguments)]
+fn play_window(
+    config: &FleetConfig,
+    timing: &Timing,
+    members: &mut [Member],
+    bots: &mut [BotProcess],
+    rooms_of: &[Vec<String>],
+    allocations: &[Allocation],
+    problems: &mut Vec<String>,
+    stop: &Stop,
+) -> anyhow::Result<Window> {
+    wait_for_players(config, timing, members, problems, stop)?;
     let load_start = procstat::load_average().map(|l| l[0]).unwrap_or(f64::NAN);
     let firsts = members
         .iter()
@@ -1057,8 +1139,8 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
     let window_end = firsts[0].at + config.duration;
     while Instant::now() < window_end {
         stop.sleep(CHECK_EVERY.min(window_end.saturating_duration_since(Instant::now())))?;
-        check_servers(&mut members, "during the window")?;
-        for b in &mut bots {
+        check_servers(members, "during the window")?;
+        for b in bots.iter_mut() {
             if let Some(status) = b.child.exited()? {
                 if b.exited_at.is_none() {
                     b.exited_at = Some(Instant::now());
@@ -1086,9 +1168,76 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
         .collect::<Vec<_>>();
     let load_end = procstat::load_average().map(|l| l[0]).unwrap_or(f64::NAN);
     let window_s = lasts[0].at.duration_since(firsts[0].at).as_secs_f64();
+    let server_figures = check_cross_talk(config, members, rooms_of, &firsts, &lasts, problems)?;
+    check_rooms_by_name(members, allocations, problems);
+    Ok(Window {
+        server_figures,
+        bot_cpu_pct,
+        window_s,
+        load: (load_start, load_end),
+    })
+}
 
-    // No cross-talk: the metrics, the lists and counters, and the rule's
-    // answer for each room by name.
+/// Every bot in (by the end of the allocations' budget at the latest),
+/// then the warm-up; the bots play on until their end.
+fn wait_for_players(
+    config: &FleetConfig,
+    timing: &Timing,
+    members: &mut [Member],
+    problems: &mut Vec<String>,
+    stop: &Stop,
+) -> anyhow::Result<()> {
+    let (s, r, k) = (
+        config.servers,
+        config.rooms_per_server,
+        config.bots_per_room,
+    );
+    let latest = timing.end - BOT_TAIL - config.duration - config.warmup;
+    let want_players = (r * k) as i64;
+    let all_in = |members: &[Member]| {
+        members.iter().all(|m| {
+            m.sidecar
+                .counter(PLAYERS)
+                .is_some_and(|(n, _)| n == want_players)
+        })
+    };
+    while !all_in(members) && Instant::now() < latest {
+        check_servers(members, "before the window")?;
+        stop.sleep(POLL)?;
+    }
+    let joined_after = timing.start.elapsed();
+    let window_start = Instant::now() + config.warmup;
+    if all_in(members) {
+        eprintln!(
+            "  all {} bots in after {:.1} s; window of {:?} after {:?} of warm-up",
+            s * r * k,
+            joined_after.as_secs_f64(),
+            config.duration,
+            config.warmup
+        );
+    } else {
+        let counts: Vec<Option<(i64, i64)>> =
+            members.iter().map(|m| m.sidecar.counter(PLAYERS)).collect();
+        problems.push(format!(
+            "not every bot joined before the window: players counters {counts:?}, \
+             {want_players} each expected"
+        ));
+    }
+    stop.sleep(window_start.saturating_duration_since(Instant::now()))
+}
+
+/// No cross-talk at the window's end: each server's metrics, list and
+/// counters hold its own rooms and players; returns its figures.
+fn check_cross_talk(
+    config: &FleetConfig,
+    members: &[Member],
+    rooms_of: &[Vec<String>],
+    firsts: &[Reading],
+    lasts: &[Reading],
+    problems: &mut Vec<String>,
+) -> anyhow::Result<Vec<ServerFigures>> {
+    let (r, k) = (config.rooms_per_server, config.bots_per_room);
+    let want_players = (r * k) as i64;
     let mut server_figures = Vec::new();
     for (i, m) in members.iter().enumerate() {
         let expected = &rooms_of[i];
@@ -1121,30 +1270,45 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
         }
         server_figures.push(figures(m, expected.clone(), &firsts[i], &lasts[i])?);
     }
-    {
-        let fleet: Vec<&FakeSidecar> = members.iter().map(|m| &m.sidecar).collect();
-        for a in &allocations {
-            if is_start_room(&a.room) {
-                // Every server lists its start-up room: not a unique name.
-                continue;
-            }
-            let found = allocate(&fleet, Want::Room(&a.room));
-            if found != Some(a.server) {
-                problems.push(format!(
-                    "Want::Room({}) found {}, not gs-{}",
-                    a.room,
-                    found.map_or_else(|| "no server".to_owned(), |i| format!("gs-{}", i + 1)),
-                    a.server + 1
-                ));
-            }
+    Ok(server_figures)
+}
+
+/// The rule's answer for each allocated room by name (`Want::Room`): the
+/// server it was allocated on.
+fn check_rooms_by_name(members: &[Member], allocations: &[Allocation], problems: &mut Vec<String>) {
+    let fleet: Vec<&FakeSidecar> = members.iter().map(|m| &m.sidecar).collect();
+    for a in allocations {
+        if is_start_room(&a.room) {
+            // Every server lists its start-up room: not a unique name.
+            continue;
+        }
+        let found = allocate(&fleet, Want::Room(&a.room));
+        if found != Some(a.server) {
+            problems.push(format!(
+                "Want::Room({}) found {}, not gs-{}",
+                a.room,
+                found.map_or_else(|| "no server".to_owned(), |i| format!("gs-{}", i + 1)),
+                a.server + 1
+            ));
         }
     }
+}
 
-    // The bots finish and report.
-    let until = end + BOT_EXIT_GRACE;
+/// The end of phase 3: the bots finish (killed when they overstay) and
+/// their reports are checked.
+fn finish_bots(
+    config: &FleetConfig,
+    timing: &Timing,
+    bots: &mut [BotProcess],
+    bot_cpu_pct: &[f64],
+    problems: &mut Vec<String>,
+    stop: &Stop,
+) -> anyhow::Result<Vec<BotFigures>> {
+    let k = config.bots_per_room;
+    let until = timing.end + BOT_EXIT_GRACE;
     loop {
         let mut running = 0;
-        for b in &mut bots {
+        for b in bots.iter_mut() {
             if b.exited_at.is_none() {
                 if b.child.exited()?.is_some() {
                     b.exited_at = Some(Instant::now());
@@ -1170,7 +1334,7 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
         stop.sleep(POLL)?;
     }
     let mut bot_figures = Vec::new();
-    for (b, cpu_pct) in bots.iter().zip(bot_cpu_pct) {
+    for (b, &cpu_pct) in bots.iter().zip(bot_cpu_pct) {
         let output = std::fs::read_to_string(&b.out).unwrap_or_default();
         let lines = parse_bot_lines(&output, &b.prefix);
         let what = format!("{} on gs-{}", b.child.name(), b.server + 1);
@@ -1185,9 +1349,19 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
             cpu_pct,
         });
     }
+    Ok(bot_figures)
+}
 
-    // 4. Each server, Allocated and empty, shuts itself down.
-    let left_at: Vec<Option<Instant>> = (0..s)
+/// Phase 4: each server, Allocated and empty, shuts itself down in time
+/// once its bots have left.
+fn check_shutdowns(
+    config: &FleetConfig,
+    members: &mut [Member],
+    bots: &[BotProcess],
+    problems: &mut Vec<String>,
+    stop: &Stop,
+) -> anyhow::Result<Vec<ShutdownFigures>> {
+    let left_at: Vec<Option<Instant>> = (0..config.servers)
         .map(|i| {
             bots.iter()
                 .filter(|b| b.server == i)
@@ -1202,7 +1376,7 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
         .copied()
         .unwrap_or_else(Instant::now);
     let until = last_left + config.shutdown_after + SHUTDOWN_MARGIN;
-    let mut exited_at: Vec<Option<(Instant, ExitStatus)>> = vec![None; s];
+    let mut exited_at: Vec<Option<(Instant, ExitStatus)>> = vec![None; config.servers];
     loop {
         for (i, m) in members.iter_mut().enumerate() {
             if exited_at[i].is_none() {
@@ -1216,111 +1390,111 @@ pub fn run_fleet(config: &FleetConfig, stop: &Stop) -> anyhow::Result<FleetRepor
         }
         stop.sleep(POLL)?;
     }
-    let mut shutdowns = Vec::new();
-    for (i, m) in members.iter_mut().enumerate() {
-        let events = m.sidecar.events();
-        let shutdown_at = events
-            .iter()
-            .find(|e| e.call == Call::Shutdown)
-            .map(|e| e.at);
-        // When the sidecar last saw the players count go to 0.
-        let empty_at = events
-            .iter()
-            .filter(|e| {
-                matches!(&e.call, Call::UpdateCounter { name, count: Some(0), .. }
-                    if name == PLAYERS)
-            })
-            .map(|e| e.at)
-            .filter(|&t| shutdown_at.is_none_or(|s| t <= s))
-            .max();
-        let empty_to_shutdown = match (empty_at, shutdown_at) {
-            (Some(e), Some(s)) => Some(s.duration_since(e)),
-            _ => None,
-        };
-        let left_to_exit = match (left_at[i], exited_at[i]) {
-            (Some(l), Some((x, _))) => Some(x.saturating_duration_since(l)),
-            _ => None,
-        };
-        let exit = match exited_at[i] {
-            Some((_, status)) => {
-                if !status.success() {
-                    problems.push(format!(
-                        "{} exited with {status} after its shutdown: {}",
-                        m.name,
-                        server_failure(&m.log)
-                    ));
-                }
-                status.to_string()
-            }
-            None => {
+    Ok(members
+        .iter_mut()
+        .enumerate()
+        .map(|(i, m)| shutdown_figures(config, m, left_at[i], exited_at[i], problems))
+        .collect())
+}
+
+/// How server `m` ended: when it called `Shutdown` after it was empty, when
+/// it exited after its last bot left (`left_at`; `exited_at`: when and how
+/// it exited, if it did), each checked against `--agones-shutdown-after`;
+/// one still running is terminated.
+fn shutdown_figures(
+    config: &FleetConfig,
+    m: &mut Member,
+    left_at: Option<Instant>,
+    exited_at: Option<(Instant, ExitStatus)>,
+    problems: &mut Vec<String>,
+) -> ShutdownFigures {
+    let events = m.sidecar.events();
+    let shutdown_at = events
+        .iter()
+        .find(|e| e.call == Call::Shutdown)
+        .map(|e| e.at);
+    // When the sidecar last saw the players count go to 0.
+    let empty_at = events
+        .iter()
+        .filter(|e| {
+            matches!(&e.call, Call::UpdateCounter { name, count: Some(0), .. }
+                if name == PLAYERS)
+        })
+        .map(|e| e.at)
+        .filter(|&t| shutdown_at.is_none_or(|s| t <= s))
+        .max();
+    let empty_to_shutdown = match (empty_at, shutdown_at) {
+        (Some(e), Some(s)) => Some(s.duration_since(e)),
+        _ => None,
+    };
+    let left_to_exit = match (left_at, exited_at) {
+        (Some(l), Some((x, _))) => Some(x.saturating_duration_since(l)),
+        _ => None,
+    };
+    let exit = match exited_at {
+        Some((_, status)) => {
+            if !status.success() {
                 problems.push(format!(
-                    "{} still ran {:.1} s after its last bot left (--agones-shutdown-after \
-                     {:.1} s + {:.0} s margin); sidecar state {:?}, Shutdown called: {}",
+                    "{} exited with {status} after its shutdown: {}",
                     m.name,
-                    left_at[i].map_or(0.0, |l| l.elapsed().as_secs_f64()),
-                    config.shutdown_after.as_secs_f64(),
-                    SHUTDOWN_MARGIN.as_secs_f64(),
-                    m.sidecar.state(),
-                    shutdown_at.is_some()
+                    server_failure(&m.log)
                 ));
-                m.child.terminate(Duration::from_secs(5));
-                "still running: terminated".to_owned()
             }
-        };
-        if shutdown_at.is_none() {
-            problems.push(format!("{} never called Agones Shutdown", m.name));
-        } else if m.sidecar.state() != "Shutdown" {
+            status.to_string()
+        }
+        None => {
             problems.push(format!(
-                "{}: sidecar state {:?} after Shutdown",
+                "{} still ran {:.1} s after its last bot left (--agones-shutdown-after \
+                 {:.1} s + {:.0} s margin); sidecar state {:?}, Shutdown called: {}",
                 m.name,
-                m.sidecar.state()
+                left_at.map_or(0.0, |l| l.elapsed().as_secs_f64()),
+                config.shutdown_after.as_secs_f64(),
+                SHUTDOWN_MARGIN.as_secs_f64(),
+                m.sidecar.state(),
+                shutdown_at.is_some()
+            ));
+            m.child.terminate(Duration::from_secs(5));
+            "still running: terminated".to_owned()
+        }
+    };
+    if shutdown_at.is_none() {
+        problems.push(format!("{} never called Agones Shutdown", m.name));
+    } else if m.sidecar.state() != "Shutdown" {
+        problems.push(format!(
+            "{}: sidecar state {:?} after Shutdown",
+            m.name,
+            m.sidecar.state()
+        ));
+    }
+    if let Some(d) = left_to_exit {
+        if d > config.shutdown_after + SHUTDOWN_MARGIN {
+            problems.push(format!(
+                "{} exited {:.1} s after its last bot left: more than \
+                 --agones-shutdown-after {:.1} s + {:.0} s",
+                m.name,
+                d.as_secs_f64(),
+                config.shutdown_after.as_secs_f64(),
+                SHUTDOWN_MARGIN.as_secs_f64()
             ));
         }
-        if let Some(d) = left_to_exit {
-            if d > config.shutdown_after + SHUTDOWN_MARGIN {
-                problems.push(format!(
-                    "{} exited {:.1} s after its last bot left: more than \
-                     --agones-shutdown-after {:.1} s + {:.0} s",
-                    m.name,
-                    d.as_secs_f64(),
-                    config.shutdown_after.as_secs_f64(),
-                    SHUTDOWN_MARGIN.as_secs_f64()
-                ));
-            }
-        }
-        if let Some(d) = empty_to_shutdown {
-            if d + SHUTDOWN_EARLY_TOLERANCE < config.shutdown_after {
-                problems.push(format!(
-                    "{} called Shutdown {:.2} s after it was empty, before \
-                     --agones-shutdown-after {:.1} s",
-                    m.name,
-                    d.as_secs_f64(),
-                    config.shutdown_after.as_secs_f64()
-                ));
-            }
-        }
-        shutdowns.push(ShutdownFigures {
-            name: m.name.clone(),
-            empty_to_shutdown,
-            left_to_exit,
-            exit,
-        });
     }
-
-    Ok(FleetReport {
-        servers: s,
-        rooms_per_server: r,
-        bots_per_room: k,
-        brain: config.brain.clone(),
-        window_s,
-        allocations,
-        one_more,
-        server_figures,
-        bot_figures,
-        shutdowns,
-        problems,
-        load: (load_start, load_end),
-    })
+    if let Some(d) = empty_to_shutdown {
+        if d + SHUTDOWN_EARLY_TOLERANCE < config.shutdown_after {
+            problems.push(format!(
+                "{} called Shutdown {:.2} s after it was empty, before \
+                 --agones-shutdown-after {:.1} s",
+                m.name,
+                d.as_secs_f64(),
+                config.shutdown_after.as_secs_f64()
+            ));
+        }
+    }
+    ShutdownFigures {
+        name: m.name.clone(),
+        empty_to_shutdown,
+        left_to_exit,
+        exit,
+    }
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@ use super::{
     check_image_bytes, check_tile_count, ArtCell, ArtContent, ArtLayer, ArtTileset, Budget, Images,
     LevelArt, TileGrid,
 };
-use crate::ogmo::{LayerContent, OgmoLevel, Project};
+use crate::ogmo::model::{LayerContent, OgmoLevel, Project};
 use crate::LevelError;
 
 /// The art of an OGMO level: its tile layers whose project tileset embeds

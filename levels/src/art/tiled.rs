@@ -188,7 +188,7 @@ impl<'m> Build<'m> {
         };
         let (w, h) = (fl.width(), fl.height());
         self.budget.cells(self.file, field, w as u64 * h as u64)?;
-        if crate::tmx::short_data(fl) {
+        if crate::tmx::common::short_data(fl) {
             return Err(self.bad(
                 format!("{field}.data"),
                 format!("fewer entries than the layer's {w} x {h} cells"),
@@ -237,7 +237,7 @@ impl<'m> Build<'m> {
             }
             let Some(t) = o.get_tile() else { continue };
             // The game draws its entities (a coin vanishes when collected).
-            if crate::tmx::is_drawn_entity(self.options, &o) {
+            if crate::tmx::common::is_drawn_entity(self.options, &o) {
                 continue;
             }
             let of = format!("{field}.objects[{k}]");
