@@ -850,10 +850,9 @@ impl Scan<'_> {
             Amount::One => Some(1),
             Amount::Depth => Some(self.stack.len() as u64 + 1),
             Amount::Attr(k) => a.num(k),
-            // `abs` as before this was a table: it overflows on i64::MIN (a
-            // panic in debug builds, which the Tiled reader's catch turns into
-            // a refusal; in release the coordinate passes).
-            Amount::Coord(k) => Some(u64::try_from(a.int(k).unwrap_or(0).abs()).unwrap_or(0)),
+            // The distance from 0, which i64::MIN has too (`abs` overflowed
+            // on it: a panic in debug builds, a pass in release).
+            Amount::Coord(k) => Some(a.int(k).unwrap_or(0).unsigned_abs()),
             Amount::Points => Some(
                 a.get("points")
                     .map_or(0, |p| p.split_ascii_whitespace().count() as u64),

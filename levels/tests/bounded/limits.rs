@@ -763,6 +763,16 @@ fn layer_sizes_and_the_total_cell_count_are_bounded() {
         "MAX_CHUNK_COORD",
         MAX_CHUNK_COORD as u64,
     );
+    // The most negative coordinate there is: as far from 0 as any (its
+    // absolute value does not fit an i64).
+    let text = text.replace("99999999", &i64::MIN.to_string());
+    expect_limit(
+        load_tmx("chunk.tmx", &text),
+        "chunk.tmx",
+        "map.layers[0].data.chunk[0].x",
+        "MAX_CHUNK_COORD",
+        MAX_CHUNK_COORD as u64,
+    );
 }
 
 #[test]
