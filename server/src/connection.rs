@@ -25,7 +25,7 @@
 //! once with [`CloseCode::ProtocolViolation`]. Nothing here panics on
 //! input or buffers more than the bounded queues and windows.
 
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -37,14 +37,14 @@ use ledge_shared::protocol::{
 use tokio::sync::{mpsc, watch};
 use tracing::{debug, info, warn, Instrument};
 
-use crate::admission::{Admission, Refusal, Ticket};
+use crate::admission::{Refusal, Ticket};
 use crate::config::Limits;
 use crate::link::{Acceptor, ControlSend, Gone, Incoming, Link, Received, Receiver, Transport};
 use crate::metrics::{Channel, ClientBytes, DropReason, KickLabel, KickReason, Metrics};
 use crate::ratelimit::TokenBucket;
 use crate::room::{self, ClientLink, JoinError, Outbound, PlayerInbox, RoomHandle};
-use crate::rooms::Rooms;
-use crate::sessions::Sessions;
+use crate::shared::Shared;
+use crate::shutdown::stopped;
 
 /// Largest control frame a client may send: every valid client message is
 /// far smaller (a chat line is at most 256 bytes).
@@ -74,27 +74,6 @@ const LEAVE_LINGER: Duration = Duration::from_millis(500);
 const KICK_LINGER: Duration = Duration::from_millis(250);
 /// How long each client gets to receive `Notice{Shutdown}`.
 pub const SHUTDOWN_LINGER: Duration = Duration::from_secs(1);
-
-/// What every connection task shares.
-#[derive(Debug)]
-pub struct Shared {
-    /// The open rooms.
-    pub rooms: Rooms,
-    /// Sessions, for resuming a lost connection's player.
-    pub sessions: Sessions,
-    /// The level bundle clients download ([`ClientControl::GetLevel`]).
-    pub level_bundle: Arc<Vec<u8>>,
-    /// Metrics.
-    pub metrics: Arc<Metrics>,
-    /// Per-client limits.
-    pub limits: Limits,
-    /// The next player id.
-    pub next_player: AtomicU32,
-    /// Who may connect, and the pending pool ([`crate::admission`]).
-    pub admission: Arc<Admission>,
-    /// Turns true when the server shuts down.
-    pub shutdown: watch::Receiver<bool>,
-}
 
 /// Counts an open connection (the `connections` gauges) while it lives.
 struct OpenGuard<'a>(&'a Shared, Transport);
@@ -181,6 +160,8 @@ enum End {
 /// Ends the player's membership however the session ends: a lost
 /// connection keeps the player for a resume ([`Sessions::lose`]), any
 /// other end removes it from its room; its metric series go either way.
+///
+/// [`Sessions::lose`]: crate::sessions::Sessions::lose
 struct Membership<'a> {
     room: RoomHandle,
     player_id: PlayerId,
@@ -225,7 +206,7 @@ async fn session(
             shared.metrics.evicted_on(transport);
             return Err(evicted());
         }
-        () = crate::server::stopped(&mut shutdown) => {
+        () = stopped(&mut shutdown) => {
             return Err(End::Close(CloseCode::ServerShutdown, "server shutting down".into()))
         }
     };
@@ -607,7 +588,7 @@ impl Client<'_> {
         }
         loop {
             let step = tokio::select! {
-                () = crate::server::stopped(shutdown) => Err(Ending::Shutdown),
+                () = stopped(shutdown) => Err(Ending::Shutdown),
                 received = recv.next() => match received {
                     Received::Stream(bytes) => {
                         let n = bytes.len();

@@ -612,7 +612,7 @@ pub async fn serve(
 ) {
     loop {
         tokio::select! {
-            () = crate::server::stopped(&mut stop) => break,
+            () = crate::shutdown::stopped(&mut stop) => break,
             accepted = listener.accept() => match accepted {
                 Ok((stream, peer)) => {
                     let answer = tokio::time::timeout(REQUEST_TIMEOUT, respond(stream, &registry));

@@ -18,7 +18,7 @@ use tracing::{debug, error, info, warn};
 use crate::admission::{Admission, Refusal, Verdict};
 use crate::cert::{CertError, Identity};
 use crate::config::{ConfigError, ServerConfig};
-use crate::connection::{self, Shared, SHUTDOWN_LINGER};
+use crate::connection::{self, SHUTDOWN_LINGER};
 use crate::fingerprint::Fingerprint;
 use crate::levels::{self, LevelLoadError};
 use crate::link::Incoming;
@@ -27,6 +27,8 @@ use crate::record::Recorder;
 use crate::room::RoomConfig;
 use crate::rooms::Rooms;
 use crate::sessions::Sessions;
+use crate::shared::Shared;
+use crate::shutdown::{stopped, ShutdownHandle};
 use crate::snapshots::DEFAULT_HISTORY;
 use crate::tls::{self, TlsError};
 use crate::web::files::{WebRoot, WebRootError};
@@ -114,12 +116,6 @@ fn bind_hint(option: &str, addr: SocketAddr, error: &std::io::Error) -> String {
         }
         _ => change,
     }
-}
-
-/// Resolves once the shutdown flag is true (at once if it already is, or if
-/// the sender is gone).
-pub(crate) async fn stopped(flag: &mut watch::Receiver<bool>) {
-    let _ = flag.wait_for(|&stop| stop).await;
 }
 
 /// Decides on a new QUIC or WebTransport connection
@@ -264,18 +260,6 @@ pub struct Server {
     recorders: Vec<Recorder>,
     /// The web port and WebTransport (`--web-bind`), if on.
     web: Option<WebParts>,
-}
-
-/// Asks a running server to shut down gracefully. Cloneable; any clone works.
-#[derive(Debug, Clone)]
-pub struct ShutdownHandle(watch::Sender<bool>);
-
-impl ShutdownHandle {
-    /// Requests shutdown: every client gets `Notice{Shutdown}`, connections
-    /// close with [`CloseCode::ServerShutdown`] and [`Server::run`] returns.
-    pub fn shutdown(&self) {
-        self.0.send_replace(true);
-    }
 }
 
 impl Server {
