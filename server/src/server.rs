@@ -18,7 +18,7 @@ use wtransport::endpoint::IncomingSession;
 
 use crate::admission::{Admission, Refusal, Ticket, Verdict};
 use crate::cert::{CertError, Identity};
-use crate::config::{ConfigError, ServerConfig};
+use crate::config::{ConfigError, ServerConfig, WebConfig};
 use crate::connection::{self, SHUTDOWN_LINGER};
 use crate::fingerprint::Fingerprint;
 use crate::levels::{self, LevelLoadError};
@@ -32,6 +32,7 @@ use crate::shared::Shared;
 use crate::shutdown::{stopped, ShutdownHandle};
 use crate::snapshots::DEFAULT_HISTORY;
 use crate::tls::{self, TlsError};
+use crate::web::certs::CertLife;
 use crate::web::files::{WebRoot, WebRootError};
 use crate::web::webtransport::{self as wt, WebCerts, WebTransportError};
 use crate::web::{self, WebState};
@@ -238,6 +239,88 @@ impl std::fmt::Debug for WebTransportParts {
     }
 }
 
+/// How to make a [`ServerError::Bind`] of an I/O error for `addr`, set by
+/// `option`.
+fn bind_error(
+    addr: SocketAddr,
+    option: &'static str,
+) -> impl Fn(std::io::Error) -> ServerError + Copy {
+    move |source| ServerError::Bind {
+        addr,
+        option,
+        source,
+    }
+}
+
+/// Binds the metrics listener (`--metrics-bind`): the listener and its real
+/// address.
+fn bind_metrics(addr: SocketAddr) -> Result<(tokio::net::TcpListener, SocketAddr), ServerError> {
+    let listener = metrics::bind(addr).map_err(bind_error(addr, "--metrics-bind"))?;
+    let bound = listener
+        .local_addr()
+        .map_err(bind_error(addr, "--metrics-bind"))?;
+    Ok((listener, bound))
+}
+
+/// Binds the web port (`--web-bind`), loads the page's directory and binds
+/// WebTransport if on.
+fn bind_web(w: &WebConfig, idle_timeout: Duration) -> Result<WebParts, ServerError> {
+    let listener = web::bind(w.bind).map_err(bind_error(w.bind, "--web-bind"))?;
+    let addr = listener
+        .local_addr()
+        .map_err(bind_error(w.bind, "--web-bind"))?;
+    let root = WebRoot::load(&w.root)?;
+    if let Some(missing) = root.missing() {
+        warn!("{missing}; / answers 503 until then");
+    }
+    let webtransport = match w.webtransport {
+        Some(mut bind) => {
+            // The same port number as the web port by default.
+            if bind.port() == 0 && w.webtransport == Some(w.bind) {
+                bind.set_port(addr.port());
+            }
+            Some(bind_webtransport(bind, idle_timeout, w.cert_life)?)
+        }
+        None => None,
+    };
+    Ok(WebParts {
+        listener,
+        addr,
+        root,
+        webtransport,
+    })
+}
+
+/// Binds WebTransport's endpoint at `bind` with its first certificates.
+fn bind_webtransport(
+    bind: SocketAddr,
+    idle_timeout: Duration,
+    cert_life: CertLife,
+) -> Result<WebTransportParts, ServerError> {
+    let settings = wt::Settings {
+        bind,
+        idle_timeout,
+        cert_life,
+    };
+    let (endpoint, certs) = wt::bind(&settings).map_err(|e| match e {
+        wt::BindError::Setup(e) => ServerError::WebTransport(e),
+        wt::BindError::Io(source) => ServerError::Bind {
+            addr: bind,
+            option: "--webtransport-bind",
+            source,
+        },
+    })?;
+    let addr = endpoint
+        .local_addr()
+        .map_err(bind_error(bind, "--webtransport-bind"))?;
+    Ok(WebTransportParts {
+        endpoint,
+        certs,
+        settings,
+        addr,
+    })
+}
+
 /// A bound, not yet running server.
 ///
 /// `bind` then `run`; keep a [`ShutdownHandle`] to stop it. Tests bind to
@@ -265,7 +348,8 @@ pub struct Server {
 
 impl Server {
     /// Checks the configuration, loads the level, loads or creates the
-    /// certificate and binds the QUIC endpoint (and the metrics listener).
+    /// certificate and binds the QUIC endpoint (and the metrics listener,
+    /// the web port and WebTransport, when on).
     ///
     /// Must be called inside a tokio runtime (the sockets register with it).
     pub fn bind(config: ServerConfig) -> Result<Server, ServerError> {
@@ -292,76 +376,15 @@ impl Server {
             info!(dir = %config.cert_dir.display(), "generated a new self-signed certificate");
         }
         let quic = tls::server_config(&identity, config.idle_timeout)?;
-        let bind_err = |addr, option| {
-            move |source| ServerError::Bind {
-                addr,
-                option,
-                source,
-            }
-        };
-        let udp = bind_err(config.bind, "--bind");
+        let udp = bind_error(config.bind, "--bind");
         let endpoint = ledge_quic::packets::server_endpoint(quic, config.bind).map_err(udp)?;
         let local_addr = endpoint.local_addr().map_err(udp)?;
-        let metrics_listener = match config.metrics_bind {
-            Some(addr) => {
-                let listener = metrics::bind(addr).map_err(bind_err(addr, "--metrics-bind"))?;
-                let bound = listener
-                    .local_addr()
-                    .map_err(bind_err(addr, "--metrics-bind"))?;
-                Some((listener, bound))
-            }
-            None => None,
-        };
-        let web = match &config.web {
-            Some(w) => {
-                let listener = web::bind(w.bind).map_err(bind_err(w.bind, "--web-bind"))?;
-                let addr = listener
-                    .local_addr()
-                    .map_err(bind_err(w.bind, "--web-bind"))?;
-                let root = WebRoot::load(&w.root)?;
-                if let Some(missing) = root.missing() {
-                    warn!("{missing}; / answers 503 until then");
-                }
-                let webtransport = match w.webtransport {
-                    Some(mut bind) => {
-                        // The same port number as the web port by default.
-                        if bind.port() == 0 && w.webtransport == Some(w.bind) {
-                            bind.set_port(addr.port());
-                        }
-                        let settings = wt::Settings {
-                            bind,
-                            idle_timeout: config.idle_timeout,
-                            cert_life: w.cert_life,
-                        };
-                        let (endpoint, certs) = wt::bind(&settings).map_err(|e| match e {
-                            wt::BindError::Setup(e) => ServerError::WebTransport(e),
-                            wt::BindError::Io(source) => ServerError::Bind {
-                                addr: bind,
-                                option: "--webtransport-bind",
-                                source,
-                            },
-                        })?;
-                        let addr = endpoint
-                            .local_addr()
-                            .map_err(bind_err(bind, "--webtransport-bind"))?;
-                        Some(WebTransportParts {
-                            endpoint,
-                            certs,
-                            settings,
-                            addr,
-                        })
-                    }
-                    None => None,
-                };
-                Some(WebParts {
-                    listener,
-                    addr,
-                    root,
-                    webtransport,
-                })
-            }
-            None => None,
-        };
+        let metrics_listener = config.metrics_bind.map(bind_metrics).transpose()?;
+        let web = config
+            .web
+            .as_ref()
+            .map(|w| bind_web(w, config.idle_timeout))
+            .transpose()?;
         let (metrics, registry) = Metrics::new();
         let recorders = match config.record_ticks {
             Some(limit) => {
