@@ -24,9 +24,9 @@ use agones::Sdk;
 use tokio::sync::{mpsc, watch};
 use tracing::{debug, info, warn};
 
-use crate::connection::Shared;
 use crate::fleet::{Call, Fleet, FleetConfig, ROOMS};
-use crate::server::ShutdownHandle;
+use crate::shared::Shared;
+use crate::shutdown::ShutdownHandle;
 
 /// Time between two polls of the fleet logic.
 pub const POLL: Duration = Duration::from_millis(250);

@@ -25,26 +25,27 @@
 //! once with [`CloseCode::ProtocolViolation`]. Nothing here panics on
 //! input or buffers more than the bounded queues and windows.
 
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use ledge_shared::protocol::{
     check_version, write_frame, ClientControl, CloseCode, FrameDecoder, InputPacket, Message,
-    NoticeKind, PlayerId, ProtocolError, RejectReason, ServerControl, SessionToken,
+    NoticeKind, PlayerId, ProtocolError, RejectReason, ServerControl, SessionToken, Welcome,
     PROTOCOL_VERSION,
 };
 use tokio::sync::{mpsc, watch};
+use tokio::task::JoinHandle;
 use tracing::{debug, info, warn, Instrument};
 
-use crate::admission::{Admission, Refusal, Ticket};
+use crate::admission::{Refusal, Ticket};
 use crate::config::Limits;
 use crate::link::{Acceptor, ControlSend, Gone, Incoming, Link, Received, Receiver, Transport};
 use crate::metrics::{Channel, ClientBytes, DropReason, KickLabel, KickReason, Metrics};
 use crate::ratelimit::TokenBucket;
 use crate::room::{self, ClientLink, JoinError, Outbound, PlayerInbox, RoomHandle};
-use crate::rooms::Rooms;
-use crate::sessions::Sessions;
+use crate::shared::Shared;
+use crate::shutdown::stopped;
 
 /// Largest control frame a client may send: every valid client message is
 /// far smaller (a chat line is at most 256 bytes).
@@ -74,27 +75,6 @@ const LEAVE_LINGER: Duration = Duration::from_millis(500);
 const KICK_LINGER: Duration = Duration::from_millis(250);
 /// How long each client gets to receive `Notice{Shutdown}`.
 pub const SHUTDOWN_LINGER: Duration = Duration::from_secs(1);
-
-/// What every connection task shares.
-#[derive(Debug)]
-pub struct Shared {
-    /// The open rooms.
-    pub rooms: Rooms,
-    /// Sessions, for resuming a lost connection's player.
-    pub sessions: Sessions,
-    /// The level bundle clients download ([`ClientControl::GetLevel`]).
-    pub level_bundle: Arc<Vec<u8>>,
-    /// Metrics.
-    pub metrics: Arc<Metrics>,
-    /// Per-client limits.
-    pub limits: Limits,
-    /// The next player id.
-    pub next_player: AtomicU32,
-    /// Who may connect, and the pending pool ([`crate::admission`]).
-    pub admission: Arc<Admission>,
-    /// Turns true when the server shuts down.
-    pub shutdown: watch::Receiver<bool>,
-}
 
 /// Counts an open connection (the `connections` gauges) while it lives.
 struct OpenGuard<'a>(&'a Shared, Transport);
@@ -181,6 +161,8 @@ enum End {
 /// Ends the player's membership however the session ends: a lost
 /// connection keeps the player for a resume ([`Sessions::lose`]), any
 /// other end removes it from its room; its metric series go either way.
+///
+/// [`Sessions::lose`]: crate::sessions::Sessions::lose
 struct Membership<'a> {
     room: RoomHandle,
     player_id: PlayerId,
@@ -205,6 +187,8 @@ impl Drop for Membership<'_> {
     }
 }
 
+/// Serves a connected client: its hello, then a listing or a seat in a
+/// room, then its messages until the session ends.
 async fn session(
     connection: &Link,
     acceptor: Acceptor,
@@ -214,88 +198,23 @@ async fn session(
 ) -> Result<(), End> {
     let mut shutdown = shared.shutdown.clone();
     let transport = connection.transport();
-    let (mut send, mut recv, hello, mut decoder) = tokio::select! {
-        handshake = tokio::time::timeout_at(deadline, handshake(acceptor, shared)) => {
-            handshake.map_err(|_| {
-                shared.metrics.refused_on(transport, Refusal::HelloTimeout);
-                End::Close(CloseCode::Timeout, "no hello in time".into())
-            })??
-        }
-        () = ticket.evicted() => {
-            shared.metrics.evicted_on(transport);
-            return Err(evicted());
-        }
-        () = crate::server::stopped(&mut shutdown) => {
-            return Err(End::Close(CloseCode::ServerShutdown, "server shutting down".into()))
-        }
-    };
-    if !ticket.join() {
-        shared.metrics.evicted_on(transport);
-        return Err(evicted());
-    }
-
+    let (mut send, mut recv, hello, mut decoder) =
+        await_hello(transport, acceptor, shared, ticket, deadline, &mut shutdown).await?;
     let first = match hello {
         Ok(first) => first,
-        Err(reason) => {
-            reject(&mut send, &reason).await;
-            return Err(End::Close(CloseCode::Rejected, reason.to_string()));
-        }
+        Err(reason) => return Err(rejected(&mut send, reason).await),
     };
     if let ClientControl::ListRooms { version } = first {
         return list_rooms(&mut send, shared, version).await;
     }
-    let (version, name, wanted_room) = first.as_hello().expect("handshake returns a hello");
-    let rejection = if check_version(version).is_err() {
-        Some(RejectReason::ProtocolVersion {
-            server: PROTOCOL_VERSION,
-            client: version,
-        })
-    } else if *shutdown.borrow() {
-        Some(RejectReason::ShuttingDown)
-    } else {
-        None
-    };
-    if let Some(reason) = rejection {
-        reject(&mut send, &reason).await;
-        return Err(End::Close(CloseCode::Rejected, reason.to_string()));
+    let (version, _, _) = first.as_hello().expect("handshake returns a hello");
+    if let Some(reason) = refusal(version, &shutdown) {
+        return Err(rejected(&mut send, reason).await);
     }
 
     let (control, queue) = mpsc::channel(CONTROL_QUEUE);
-    let link = |player_id: PlayerId| ClientLink {
-        link: connection.clone(),
-        control: control.clone(),
-        bytes: shared.metrics.client(player_id.0),
-    };
-    // A resumed session gets its player back; an unknown or expired token
-    // (or a player gone meanwhile) joins as new.
-    let resumed = match first.resume_token() {
-        Some(token) => match shared.sessions.find(&token, Instant::now()) {
-            Some(parked) => parked
-                .room
-                .rejoin(parked.player_id, link(parked.player_id))
-                .await
-                .map(|joined| (parked.room, joined, token)),
-            None => None,
-        },
-        None => None,
-    };
-    let (room, mut joined, token) = match resumed {
-        Some(resumed) => {
-            shared.metrics.sessions_resumed.inc();
-            resumed
-        }
-        None => {
-            let player_id = PlayerId(shared.next_player.fetch_add(1, Ordering::Relaxed));
-            match join(shared, wanted_room, player_id, name, link(player_id)).await {
-                Ok((room, joined)) => (room, joined, shared.sessions.new_token()),
-                Err(reason) => {
-                    shared.metrics.forget_client(player_id.0);
-                    reject(&mut send, &reason).await;
-                    return Err(End::Close(CloseCode::Rejected, reason.to_string()));
-                }
-            }
-        }
-    };
+    let (room, mut joined, token) =
+        take_seat(connection, shared, &first, &control, &mut send).await?;
     let player_id = joined.welcome.player_id;
     let bytes = shared.metrics.client(player_id.0);
     shared
@@ -310,13 +229,7 @@ async fn session(
         shared,
         lost: false,
     };
-    let mut frame = Vec::new();
-    write_frame(&ServerControl::Welcome(joined.welcome), &mut frame)
-        .map_err(|e| End::Close(CloseCode::ProtocolViolation, format!("welcome: {e}")))?;
-    send.write_all(&frame)
-        .await
-        .map_err(|e| End::Closed(e.to_string()))?;
-    shared.metrics.sent(&bytes, Channel::Stream, frame.len());
+    send_welcome(&mut send, joined.welcome, &shared.metrics, &bytes).await?;
 
     let writer = tokio::spawn(write_control(
         send,
@@ -342,8 +255,146 @@ async fn session(
     if let Some(download) = client.download.take() {
         download.abort();
     }
-    // Say goodbye on the stream, then let the writer flush it (bounded).
-    let (notice, linger) = match &ending {
+    membership.lost = matches!(ending, Ending::Lost(_));
+    say_goodbye(&ending, &client.control, writer).await;
+    ending.into_result(&shared.metrics)
+}
+
+/// Waits for the client's first message, within the hello deadline unless
+/// it is evicted from the pending pool or the server stops first; then
+/// takes the connection out of the pending pool.
+async fn await_hello(
+    transport: Transport,
+    acceptor: Acceptor,
+    shared: &Shared,
+    ticket: &mut Ticket,
+    deadline: tokio::time::Instant,
+    shutdown: &mut watch::Receiver<bool>,
+) -> Result<(ControlSend, Receiver, Hello, FrameDecoder), End> {
+    let received = tokio::select! {
+        handshake = tokio::time::timeout_at(deadline, handshake(acceptor, shared)) => {
+            handshake.map_err(|_| {
+                shared.metrics.refused_on(transport, Refusal::HelloTimeout);
+                End::Close(CloseCode::Timeout, "no hello in time".into())
+            })??
+        }
+        () = ticket.evicted() => {
+            shared.metrics.evicted_on(transport);
+            return Err(evicted());
+        }
+        () = stopped(shutdown) => {
+            return Err(End::Close(CloseCode::ServerShutdown, "server shutting down".into()))
+        }
+    };
+    if !ticket.join() {
+        shared.metrics.evicted_on(transport);
+        return Err(evicted());
+    }
+    Ok(received)
+}
+
+/// Why a valid hello is turned away: another protocol version, or a server
+/// shutting down.
+fn refusal(version: u32, shutdown: &watch::Receiver<bool>) -> Option<RejectReason> {
+    if check_version(version).is_err() {
+        Some(RejectReason::ProtocolVersion {
+            server: PROTOCOL_VERSION,
+            client: version,
+        })
+    } else if *shutdown.borrow() {
+        Some(RejectReason::ShuttingDown)
+    } else {
+        None
+    }
+}
+
+/// A room, its seat and the session token for this connection.
+type Seat = (RoomHandle, room::Joined, SessionToken);
+
+/// Seats the client: its player back if it resumes, else a new player in
+/// the room it asked for (or the least full one); rejects it if there is
+/// no place.
+async fn take_seat(
+    connection: &Link,
+    shared: &Shared,
+    hello: &ClientControl,
+    control: &mpsc::Sender<Outbound>,
+    send: &mut ControlSend,
+) -> Result<Seat, End> {
+    let (_, name, wanted_room) = hello.as_hello().expect("handshake returns a hello");
+    let link = |player_id: PlayerId| ClientLink {
+        link: connection.clone(),
+        control: control.clone(),
+        bytes: shared.metrics.client(player_id.0),
+    };
+    match resume(shared, hello.resume_token(), &link).await {
+        Some(resumed) => {
+            shared.metrics.sessions_resumed.inc();
+            Ok(resumed)
+        }
+        None => join_new(shared, wanted_room, name, &link, send).await,
+    }
+}
+
+/// The player a resume token names, back in its room over this
+/// connection; `None` for no token, an unknown or expired one, or a player
+/// gone meanwhile (the client then joins as new).
+async fn resume(
+    shared: &Shared,
+    token: Option<SessionToken>,
+    link: impl Fn(PlayerId) -> ClientLink,
+) -> Option<Seat> {
+    let token = token?;
+    let parked = shared.sessions.find(&token, Instant::now())?;
+    parked
+        .room
+        .rejoin(parked.player_id, link(parked.player_id))
+        .await
+        .map(|joined| (parked.room, joined, token))
+}
+
+/// Joins as a new player (a new id and session token), or rejects the
+/// client and forgets the id's metric series.
+async fn join_new(
+    shared: &Shared,
+    wanted: Option<&str>,
+    name: &str,
+    link: impl Fn(PlayerId) -> ClientLink,
+    send: &mut ControlSend,
+) -> Result<Seat, End> {
+    let player_id = PlayerId(shared.next_player.fetch_add(1, Ordering::Relaxed));
+    match join(shared, wanted, player_id, name, link(player_id)).await {
+        Ok((room, joined)) => Ok((room, joined, shared.sessions.new_token())),
+        Err(reason) => {
+            shared.metrics.forget_client(player_id.0);
+            Err(rejected(send, reason).await)
+        }
+    }
+}
+
+/// Writes the `Welcome` on the control stream directly, before the writer
+/// task starts, so it comes before anything the room queued (the roster).
+async fn send_welcome(
+    send: &mut ControlSend,
+    welcome: Welcome,
+    metrics: &Metrics,
+    bytes: &ClientBytes,
+) -> Result<(), End> {
+    let mut frame = Vec::new();
+    write_frame(&ServerControl::Welcome(welcome), &mut frame)
+        .map_err(|e| End::Close(CloseCode::ProtocolViolation, format!("welcome: {e}")))?;
+    send.write_all(&frame)
+        .await
+        .map_err(|e| End::Closed(e.to_string()))?;
+    metrics.sent(bytes, Channel::Stream, frame.len());
+    Ok(())
+}
+
+/// Says goodbye on the stream (a notice when shutting down or kicking),
+/// then lets the writer flush it, for at most the ending's linger: nothing
+/// for a lost connection.
+async fn say_goodbye(ending: &Ending, control: &mpsc::Sender<Outbound>, writer: JoinHandle<()>) {
+    let (notice, linger) = match ending {
         Ending::Left => (None, LEAVE_LINGER),
         Ending::Shutdown => (Some(NoticeKind::Shutdown), SHUTDOWN_LINGER),
         Ending::Kick { notice, .. } => (
@@ -354,41 +405,20 @@ async fn session(
         ),
         Ending::Lost(_) => (None, Duration::ZERO),
     };
-    membership.lost = matches!(ending, Ending::Lost(_));
-    if !linger.is_zero() {
-        let goodbye = async {
-            if let Some(kind) = notice {
-                let mut frame = Vec::new();
-                if write_frame(&ServerControl::Notice { kind }, &mut frame).is_ok() {
-                    let _ = client.control.send(Outbound::Frame(frame)).await;
-                }
+    if linger.is_zero() {
+        return;
+    }
+    let goodbye = async {
+        if let Some(kind) = notice {
+            let mut frame = Vec::new();
+            if write_frame(&ServerControl::Notice { kind }, &mut frame).is_ok() {
+                let _ = control.send(Outbound::Frame(frame)).await;
             }
-            let _ = client.control.send(Outbound::Finish).await;
-            let _ = writer.await;
-        };
-        let _ = tokio::time::timeout(linger, goodbye).await;
-    }
-    match ending {
-        Ending::Left => Ok(()),
-        Ending::Shutdown => Err(End::Close(
-            CloseCode::ServerShutdown,
-            "server shutting down".into(),
-        )),
-        Ending::Kick {
-            code,
-            reason,
-            detail,
-            ..
-        } => {
-            shared
-                .metrics
-                .kicks
-                .get_or_create(&KickLabel { reason })
-                .inc();
-            Err(End::Close(code, detail))
         }
-        Ending::Lost(e) => Err(End::Closed(e)),
-    }
+        let _ = control.send(Outbound::Finish).await;
+        let _ = writer.await;
+    };
+    let _ = tokio::time::timeout(linger, goodbye).await;
 }
 
 /// Joins the wanted room (opening it if need be), or the least full one
@@ -422,8 +452,7 @@ async fn list_rooms(send: &mut ControlSend, shared: &Shared, version: u32) -> Re
             server: PROTOCOL_VERSION,
             client: version,
         };
-        reject(send, &reason).await;
-        return Err(End::Close(CloseCode::Rejected, reason.to_string()));
+        return Err(rejected(send, reason).await);
     }
     let rooms = ServerControl::Rooms {
         rooms: shared.rooms.list(),
@@ -534,6 +563,28 @@ enum Ending {
 }
 
 impl Ending {
+    /// The session's result: `Ok` for a leave, else how the connection
+    /// ends; a kick is counted.
+    fn into_result(self, metrics: &Metrics) -> Result<(), End> {
+        match self {
+            Ending::Left => Ok(()),
+            Ending::Shutdown => Err(End::Close(
+                CloseCode::ServerShutdown,
+                "server shutting down".into(),
+            )),
+            Ending::Kick {
+                code,
+                reason,
+                detail,
+                ..
+            } => {
+                metrics.kicks.get_or_create(&KickLabel { reason }).inc();
+                Err(End::Close(code, detail))
+            }
+            Ending::Lost(e) => Err(End::Closed(e)),
+        }
+    }
+
     /// The connection ended under the session: the client closing it on
     /// purpose (it quit) is a leave; a timeout or reset is a loss, and the
     /// player is kept for a resume.
@@ -607,7 +658,7 @@ impl Client<'_> {
         }
         loop {
             let step = tokio::select! {
-                () = crate::server::stopped(shutdown) => Err(Ending::Shutdown),
+                () = stopped(shutdown) => Err(Ending::Shutdown),
                 received = recv.next() => match received {
                     Received::Stream(bytes) => {
                         let n = bytes.len();
@@ -830,6 +881,13 @@ async fn write_control(
     if let Some((code, reason)) = close {
         connection.close(code, &reason);
     }
+}
+
+/// Sends a `Reject` (waiting briefly until the client has it) and gives
+/// the session's end for it.
+async fn rejected(send: &mut ControlSend, reason: RejectReason) -> End {
+    reject(send, &reason).await;
+    End::Close(CloseCode::Rejected, reason.to_string())
 }
 
 /// Sends a `Reject` and waits (briefly) until the client has it.

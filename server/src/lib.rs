@@ -19,6 +19,9 @@
 //! * [`rooms`]: the open rooms, opened by name up to the cap, closed when
 //!   idle;
 //! * [`sessions`]: players kept after a lost connection, for a resume;
+//! * [`shutdown`]: the shutdown signal, its handle and the wait for it;
+//! * [`shared`]: the state every connection task shares (rooms, sessions,
+//!   metrics, admission, the shutdown flag);
 //! * [`record`]: optional match recording (inputs, joins, hashes per tick);
 //! * [`admission`]: which new connections are taken on (per address, the
 //!   pending pool and its eviction, Retry under load);
@@ -57,10 +60,13 @@ pub mod room;
 pub mod rooms;
 pub mod server;
 pub mod sessions;
+pub mod shared;
+pub mod shutdown;
 pub mod snapshots;
 pub mod tls;
 pub mod web;
 
 pub use config::ServerConfig;
 pub use fingerprint::Fingerprint;
-pub use server::{Server, ServerError, ShutdownHandle};
+pub use server::{Server, ServerError};
+pub use shutdown::ShutdownHandle;

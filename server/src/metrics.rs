@@ -260,9 +260,21 @@ fn size_histogram() -> Histogram {
 }
 
 impl Metrics {
-    /// New metrics, registered in a new registry.
+    /// New metrics, registered in a new registry (with the prefix `ledge`,
+    /// in the order they are exposed).
     pub fn new() -> (Arc<Metrics>, Registry) {
-        let m = Metrics {
+        let m = Metrics::unregistered();
+        let mut r = Registry::with_prefix("ledge");
+        m.register_rooms(&mut r);
+        m.register_connections(&mut r);
+        m.register_traffic(&mut r);
+        m.register_faults_and_timing(&mut r);
+        (Arc::new(m), r)
+    }
+
+    /// Every metric at zero, in no registry yet.
+    fn unregistered() -> Metrics {
+        Metrics {
             tick_duration: Family::new_with_constructor(tick_histogram as fn() -> Histogram),
             missed_ticks: Family::default(),
             players: Family::default(),
@@ -295,162 +307,180 @@ impl Metrics {
             kicks: Family::default(),
             tick_duration_fine: Histogram::new(fine_buckets()),
             tick_lateness: Histogram::new(fine_buckets()),
-        };
-        let mut r = Registry::with_prefix("ledge");
+        }
+    }
+
+    /// Registers the rooms' metrics: tick times, players, sessions, level
+    /// downloads.
+    fn register_rooms(&self, r: &mut Registry) {
         r.register(
             "tick_duration_seconds",
             "Time to run one tick (inputs, simulation step, snapshots)",
-            m.tick_duration.clone(),
+            self.tick_duration.clone(),
         );
         r.register(
             "missed_ticks",
             "Ticks skipped because the tick loop fell too far behind",
-            m.missed_ticks.clone(),
+            self.missed_ticks.clone(),
         );
-        r.register("players", "Players in the room", m.players.clone());
-        r.register("rooms", "Open rooms", m.rooms.clone());
+        r.register("players", "Players in the room", self.players.clone());
+        r.register("rooms", "Open rooms", self.rooms.clone());
         r.register(
             "sessions_resumed",
             "Sessions resumed after a lost connection",
-            m.sessions_resumed.clone(),
+            self.sessions_resumed.clone(),
         );
         r.register(
             "sessions_expired",
             "Lost players removed after the reconnect grace time",
-            m.sessions_expired.clone(),
+            self.sessions_expired.clone(),
         );
         r.register(
             "level_downloads",
             "Level bundle downloads started (resumed ones included)",
-            m.level_downloads.clone(),
+            self.level_downloads.clone(),
         );
         r.register(
             "level_downloads_completed",
             "Level bundle downloads sent to their end",
-            m.level_downloads_completed.clone(),
+            self.level_downloads_completed.clone(),
         );
         r.register(
             "level_download_bytes",
             "Level bundle bytes sent",
-            m.level_download_bytes.clone(),
+            self.level_download_bytes.clone(),
         );
+    }
+
+    /// Registers the connections' metrics (open, refused, pending), and
+    /// zeroes the per-transport gauges so every transport has a series.
+    fn register_connections(&self, r: &mut Registry) {
         r.register(
             "connections",
             "Open QUIC connections",
-            m.connections.clone(),
+            self.connections.clone(),
         );
         r.register(
             "connections_refused",
             "Connections refused, or closed before their hello, by reason",
-            m.connections_refused.clone(),
+            self.connections_refused.clone(),
         );
         r.register(
             "retries",
             "New connections sent a QUIC Retry to validate their address",
-            m.retries.clone(),
+            self.retries.clone(),
         );
         r.register(
             "transport_connections",
             "Open connections (in their handshake or joined) by transport",
-            m.transport_connections.clone(),
+            self.transport_connections.clone(),
         );
         r.register(
             "transport_connections_opened",
             "Connections admitted by transport",
-            m.transport_connections_opened.clone(),
+            self.transport_connections_opened.clone(),
         );
         r.register(
             "transport_connections_refused",
             "Connections refused, or closed before their hello, by transport and reason",
-            m.transport_connections_refused.clone(),
+            self.transport_connections_refused.clone(),
         );
         for transport in Transport::ALL {
-            m.transport_connections
+            self.transport_connections
                 .get_or_create(&TransportLabel { transport })
                 .set(0);
         }
         r.register(
             "pending_connections",
             "Connections not yet past their hello",
-            m.pending_connections.clone(),
+            self.pending_connections.clone(),
         );
+    }
+
+    /// Registers the traffic metrics: bytes per client and channel, UDP
+    /// datagrams, snapshots.
+    fn register_traffic(&self, r: &mut Registry) {
         r.register(
             "client_bytes_in",
             "Bytes received from a connected player",
-            m.client_bytes_in.clone(),
+            self.client_bytes_in.clone(),
         );
         r.register(
             "client_bytes_out",
             "Bytes sent to a connected player",
-            m.client_bytes_out.clone(),
+            self.client_bytes_out.clone(),
         );
         r.register(
             "bytes_in",
             "Bytes received from all clients",
-            m.bytes_in.clone(),
+            self.bytes_in.clone(),
         );
         r.register(
             "bytes_out",
             "Bytes sent to all clients",
-            m.bytes_out.clone(),
+            self.bytes_out.clone(),
         );
         r.register(
             "wire_datagrams_in",
             "UDP datagrams received from native QUIC players, sampled each second",
-            m.wire_datagrams_in.clone(),
+            self.wire_datagrams_in.clone(),
         );
         r.register(
             "wire_bytes_in",
             "UDP payload bytes received from native QUIC players, sampled each second",
-            m.wire_bytes_in.clone(),
+            self.wire_bytes_in.clone(),
         );
         r.register(
             "wire_datagrams_out",
             "UDP datagrams sent to native QUIC players, sampled each second",
-            m.wire_datagrams_out.clone(),
+            self.wire_datagrams_out.clone(),
         );
         r.register(
             "wire_bytes_out",
             "UDP payload bytes sent to native QUIC players, sampled each second",
-            m.wire_bytes_out.clone(),
+            self.wire_bytes_out.clone(),
         );
         r.register(
             "snapshots_skipped",
             "Snapshots not sent to a quiet client because they would change nothing for it",
-            m.snapshots_skipped.clone(),
+            self.snapshots_skipped.clone(),
         );
         r.register(
             "snapshot_bytes",
             "Encoded snapshot sizes",
-            m.snapshot_bytes.clone(),
+            self.snapshot_bytes.clone(),
         );
+    }
+
+    /// Registers what went wrong (missing inputs, drops, malformed
+    /// messages, kicks) and the fine tick timings.
+    fn register_faults_and_timing(&self, r: &mut Registry) {
         r.register(
             "input_starvation",
             "Ticks a player's input had not arrived (the previous one was repeated)",
-            m.input_starvation.clone(),
+            self.input_starvation.clone(),
         );
-        r.register("dropped_messages", "Messages dropped", m.dropped.clone());
+        r.register("dropped_messages", "Messages dropped", self.dropped.clone());
         r.register(
             "malformed_messages",
             "Messages that failed to decode",
-            m.malformed.clone(),
+            self.malformed.clone(),
         );
         r.register(
             "kicks",
             "Clients disconnected for misbehaving",
-            m.kicks.clone(),
+            self.kicks.clone(),
         );
         r.register(
             "tick_duration_fine_seconds",
             "Time to run one tick, all rooms, in fine buckets (4.4 % apart)",
-            m.tick_duration_fine.clone(),
+            self.tick_duration_fine.clone(),
         );
         r.register(
             "tick_lateness_seconds",
             "How late the tick loop woke after a tick's deadline, all rooms",
-            m.tick_lateness.clone(),
+            self.tick_lateness.clone(),
         );
-        (Arc::new(m), r)
     }
 
     /// Adds what a connection put through its socket since `seen` (its
@@ -612,7 +642,7 @@ pub async fn serve(
 ) {
     loop {
         tokio::select! {
-            () = crate::server::stopped(&mut stop) => break,
+            () = crate::shutdown::stopped(&mut stop) => break,
             accepted = listener.accept() => match accepted {
                 Ok((stream, peer)) => {
                     let answer = tokio::time::timeout(REQUEST_TIMEOUT, respond(stream, &registry));

@@ -11,14 +11,15 @@ use ledge_shared::game::{Game, GameError};
 use ledge_shared::level::Level;
 use ledge_shared::protocol::{CloseCode, LevelOffer, DEFAULT_INPUT_REDUNDANCY};
 use prometheus_client::registry::Registry;
-use tokio::sync::watch;
-use tokio::task::JoinSet;
+use tokio::sync::{mpsc, watch};
+use tokio::task::{JoinHandle, JoinSet};
 use tracing::{debug, error, info, warn};
+use wtransport::endpoint::IncomingSession;
 
-use crate::admission::{Admission, Refusal, Verdict};
+use crate::admission::{Admission, Refusal, Ticket, Verdict};
 use crate::cert::{CertError, Identity};
-use crate::config::{ConfigError, ServerConfig};
-use crate::connection::{self, Shared, SHUTDOWN_LINGER};
+use crate::config::{ConfigError, ServerConfig, WebConfig};
+use crate::connection::{self, SHUTDOWN_LINGER};
 use crate::fingerprint::Fingerprint;
 use crate::levels::{self, LevelLoadError};
 use crate::link::Incoming;
@@ -27,8 +28,11 @@ use crate::record::Recorder;
 use crate::room::RoomConfig;
 use crate::rooms::Rooms;
 use crate::sessions::Sessions;
+use crate::shared::Shared;
+use crate::shutdown::{stopped, ShutdownHandle};
 use crate::snapshots::DEFAULT_HISTORY;
 use crate::tls::{self, TlsError};
+use crate::web::certs::CertLife;
 use crate::web::files::{WebRoot, WebRootError};
 use crate::web::webtransport::{self as wt, WebCerts, WebTransportError};
 use crate::web::{self, WebState};
@@ -114,12 +118,6 @@ fn bind_hint(option: &str, addr: SocketAddr, error: &std::io::Error) -> String {
         }
         _ => change,
     }
-}
-
-/// Resolves once the shutdown flag is true (at once if it already is, or if
-/// the sender is gone).
-pub(crate) async fn stopped(flag: &mut watch::Receiver<bool>) {
-    let _ = flag.wait_for(|&stop| stop).await;
 }
 
 /// Decides on a new QUIC or WebTransport connection
@@ -241,6 +239,88 @@ impl std::fmt::Debug for WebTransportParts {
     }
 }
 
+/// How to make a [`ServerError::Bind`] of an I/O error for `addr`, set by
+/// `option`.
+fn bind_error(
+    addr: SocketAddr,
+    option: &'static str,
+) -> impl Fn(std::io::Error) -> ServerError + Copy {
+    move |source| ServerError::Bind {
+        addr,
+        option,
+        source,
+    }
+}
+
+/// Binds the metrics listener (`--metrics-bind`): the listener and its real
+/// address.
+fn bind_metrics(addr: SocketAddr) -> Result<(tokio::net::TcpListener, SocketAddr), ServerError> {
+    let listener = metrics::bind(addr).map_err(bind_error(addr, "--metrics-bind"))?;
+    let bound = listener
+        .local_addr()
+        .map_err(bind_error(addr, "--metrics-bind"))?;
+    Ok((listener, bound))
+}
+
+/// Binds the web port (`--web-bind`), loads the page's directory and binds
+/// WebTransport if on.
+fn bind_web(w: &WebConfig, idle_timeout: Duration) -> Result<WebParts, ServerError> {
+    let listener = web::bind(w.bind).map_err(bind_error(w.bind, "--web-bind"))?;
+    let addr = listener
+        .local_addr()
+        .map_err(bind_error(w.bind, "--web-bind"))?;
+    let root = WebRoot::load(&w.root)?;
+    if let Some(missing) = root.missing() {
+        warn!("{missing}; / answers 503 until then");
+    }
+    let webtransport = match w.webtransport {
+        Some(mut bind) => {
+            // The same port number as the web port by default.
+            if bind.port() == 0 && w.webtransport == Some(w.bind) {
+                bind.set_port(addr.port());
+            }
+            Some(bind_webtransport(bind, idle_timeout, w.cert_life)?)
+        }
+        None => None,
+    };
+    Ok(WebParts {
+        listener,
+        addr,
+        root,
+        webtransport,
+    })
+}
+
+/// Binds WebTransport's endpoint at `bind` with its first certificates.
+fn bind_webtransport(
+    bind: SocketAddr,
+    idle_timeout: Duration,
+    cert_life: CertLife,
+) -> Result<WebTransportParts, ServerError> {
+    let settings = wt::Settings {
+        bind,
+        idle_timeout,
+        cert_life,
+    };
+    let (endpoint, certs) = wt::bind(&settings).map_err(|e| match e {
+        wt::BindError::Setup(e) => ServerError::WebTransport(e),
+        wt::BindError::Io(source) => ServerError::Bind {
+            addr: bind,
+            option: "--webtransport-bind",
+            source,
+        },
+    })?;
+    let addr = endpoint
+        .local_addr()
+        .map_err(bind_error(bind, "--webtransport-bind"))?;
+    Ok(WebTransportParts {
+        endpoint,
+        certs,
+        settings,
+        addr,
+    })
+}
+
 /// A bound, not yet running server.
 ///
 /// `bind` then `run`; keep a [`ShutdownHandle`] to stop it. Tests bind to
@@ -266,21 +346,10 @@ pub struct Server {
     web: Option<WebParts>,
 }
 
-/// Asks a running server to shut down gracefully. Cloneable; any clone works.
-#[derive(Debug, Clone)]
-pub struct ShutdownHandle(watch::Sender<bool>);
-
-impl ShutdownHandle {
-    /// Requests shutdown: every client gets `Notice{Shutdown}`, connections
-    /// close with [`CloseCode::ServerShutdown`] and [`Server::run`] returns.
-    pub fn shutdown(&self) {
-        self.0.send_replace(true);
-    }
-}
-
 impl Server {
     /// Checks the configuration, loads the level, loads or creates the
-    /// certificate and binds the QUIC endpoint (and the metrics listener).
+    /// certificate and binds the QUIC endpoint (and the metrics listener,
+    /// the web port and WebTransport, when on).
     ///
     /// Must be called inside a tokio runtime (the sockets register with it).
     pub fn bind(config: ServerConfig) -> Result<Server, ServerError> {
@@ -307,76 +376,15 @@ impl Server {
             info!(dir = %config.cert_dir.display(), "generated a new self-signed certificate");
         }
         let quic = tls::server_config(&identity, config.idle_timeout)?;
-        let bind_err = |addr, option| {
-            move |source| ServerError::Bind {
-                addr,
-                option,
-                source,
-            }
-        };
-        let udp = bind_err(config.bind, "--bind");
+        let udp = bind_error(config.bind, "--bind");
         let endpoint = ledge_quic::packets::server_endpoint(quic, config.bind).map_err(udp)?;
         let local_addr = endpoint.local_addr().map_err(udp)?;
-        let metrics_listener = match config.metrics_bind {
-            Some(addr) => {
-                let listener = metrics::bind(addr).map_err(bind_err(addr, "--metrics-bind"))?;
-                let bound = listener
-                    .local_addr()
-                    .map_err(bind_err(addr, "--metrics-bind"))?;
-                Some((listener, bound))
-            }
-            None => None,
-        };
-        let web = match &config.web {
-            Some(w) => {
-                let listener = web::bind(w.bind).map_err(bind_err(w.bind, "--web-bind"))?;
-                let addr = listener
-                    .local_addr()
-                    .map_err(bind_err(w.bind, "--web-bind"))?;
-                let root = WebRoot::load(&w.root)?;
-                if let Some(missing) = root.missing() {
-                    warn!("{missing}; / answers 503 until then");
-                }
-                let webtransport = match w.webtransport {
-                    Some(mut bind) => {
-                        // The same port number as the web port by default.
-                        if bind.port() == 0 && w.webtransport == Some(w.bind) {
-                            bind.set_port(addr.port());
-                        }
-                        let settings = wt::Settings {
-                            bind,
-                            idle_timeout: config.idle_timeout,
-                            cert_life: w.cert_life,
-                        };
-                        let (endpoint, certs) = wt::bind(&settings).map_err(|e| match e {
-                            wt::BindError::Setup(e) => ServerError::WebTransport(e),
-                            wt::BindError::Io(source) => ServerError::Bind {
-                                addr: bind,
-                                option: "--webtransport-bind",
-                                source,
-                            },
-                        })?;
-                        let addr = endpoint
-                            .local_addr()
-                            .map_err(bind_err(bind, "--webtransport-bind"))?;
-                        Some(WebTransportParts {
-                            endpoint,
-                            certs,
-                            settings,
-                            addr,
-                        })
-                    }
-                    None => None,
-                };
-                Some(WebParts {
-                    listener,
-                    addr,
-                    root,
-                    webtransport,
-                })
-            }
-            None => None,
-        };
+        let metrics_listener = config.metrics_bind.map(bind_metrics).transpose()?;
+        let web = config
+            .web
+            .as_ref()
+            .map(|w| bind_web(w, config.idle_timeout))
+            .transpose()?;
         let (metrics, registry) = Metrics::new();
         let recorders = match config.record_ticks {
             Some(limit) => {
@@ -492,199 +500,310 @@ impl Server {
             ..
         } = self;
         let mut stop = shutdown.subscribe();
-
-        let template = RoomConfig {
-            name: String::new(),
-            tick_rate: config.tick_rate,
-            snapshot_interval: config.snapshot_interval(),
-            max_players: config.max_players,
-            max_catch_up: config.max_catch_up,
-            input_window: config.tick_rate.max(32) as usize,
-            input_redundancy: DEFAULT_INPUT_REDUNDANCY,
-            history: DEFAULT_HISTORY,
-            level_id: levels::level_id(&level),
-            level_hash: level.content_hash(),
-            level: level_offer,
-            record: None,
-            idle_kick: config.idle_kick,
-        };
-        let level_id = template.level_id.clone();
-        let rooms = Rooms::new(
-            Game::with_config(&level, config.game_config())?,
-            template,
-            config.max_rooms as usize,
-            metrics.clone(),
-        );
-        for i in 1..=config.rooms {
-            let record = recorders.get(i as usize - 1).cloned();
-            rooms.open_permanent(format!("room-{i}"), record);
-        }
+        let rooms = open_rooms(&config, &level, level_offer, &recorders, metrics.clone())?;
         let metrics_task = metrics_listener.map(|(listener, addr)| {
             info!(%addr, "serving metrics at /metrics");
             tokio::spawn(metrics::serve(listener, registry, stop.clone()))
         });
-        let level_bytes = bytes::Bytes::from(Vec::clone(&level_bundle));
         let shared = Arc::new(Shared {
             rooms,
             sessions: Sessions::new(config.reconnect_grace),
             level_bundle,
-            metrics: metrics.clone(),
+            metrics,
             limits: config.limits,
             next_player: AtomicU32::new(1),
             admission: Admission::new(config.admission, config.max_connections),
             shutdown: stop.clone(),
         });
-
-        // Under Agones: the sidecar must answer before anything else; the
-        // fleet logic then says Ready with the rooms open.
         #[cfg(feature = "agones")]
-        let agones_task = match config.agones {
-            Some(fleet) => Some(
-                crate::agones::start(
-                    fleet,
-                    fingerprint.to_string(),
-                    shared.clone(),
-                    stop.clone(),
-                    ShutdownHandle(shutdown.clone()),
-                )
-                .await
-                .map_err(|e| ServerError::Agones(e.to_string()))?,
-            ),
-            None => None,
-        };
+        let agones_task = join_fleet(&config, fingerprint, &shared, &stop, &shutdown).await?;
         #[cfg(not(feature = "agones"))]
         let _ = fingerprint;
         info!(
             %local_addr,
-            level = %level_id,
+            level = %levels::level_id(&level),
             level_bundle_bytes = level_offer.size,
             rooms = config.rooms,
             tick_rate = config.tick_rate,
             snapshot_interval = config.snapshot_interval(),
             "listening"
         );
-        // Browsers: the web port's task hands admitted WebSockets to this
-        // loop; WebTransport sessions are accepted here like QUIC ones.
-        let (accepted_tx, mut accepted) = tokio::sync::mpsc::channel::<web::Accepted>(64);
-        let mut web_tasks = Vec::new();
-        let mut webtransport = None;
-        if let Some(w) = web {
-            let wt_port = w
-                .webtransport
-                .as_ref()
-                .map(|t| (t.addr.port(), t.certs.clone()));
-            if let Some(t) = &w.webtransport {
-                info!(
-                    addr = %t.addr,
-                    cert_sha256 = %crate::Fingerprint(t.certs.current().sha256),
-                    "WebTransport sessions at {}",
-                    crate::link::webtransport::PATH
-                );
-                web_tasks.push(tokio::spawn(wt::rotate(
-                    t.endpoint.clone(),
-                    t.certs.clone(),
-                    t.settings.clone(),
-                    stop.clone(),
-                )));
-                webtransport = Some(t.endpoint.clone());
-            }
-            info!(addr = %w.addr, files = w.root.len(), "serving browsers (the page, /web.json, /ws)");
-            let state = Arc::new(WebState {
-                shared: shared.clone(),
-                root: w.root,
-                level_hex: level_offer.hex(),
-                level: level_bytes,
-                webtransport: wt_port,
-                accepted: accepted_tx,
-                idle_timeout: config.idle_timeout,
-            });
-            web_tasks.push(tokio::spawn(web::serve(w.listener, state, stop.clone())));
-        } else {
-            drop(accepted_tx);
-        }
-        let wt_accept = |endpoint: &Option<Arc<wt::Endpoint>>| {
-            let endpoint = endpoint.clone();
-            async move {
-                match endpoint {
-                    Some(e) => e.accept().await,
-                    None => std::future::pending().await,
-                }
-            }
+        // Browsers: the web port's task hands admitted WebSockets to the
+        // accept loop; WebTransport sessions are accepted there like QUIC
+        // ones.
+        let (accepted_tx, accepted) = mpsc::channel::<web::Accepted>(64);
+        let browsers = serve_browsers(web, &shared, level_offer, &config, accepted_tx, &stop);
+        let mut serving = Serving {
+            endpoint,
+            webtransport: browsers.webtransport,
+            accepted,
+            shared,
+            connections: JoinSet::new(),
         };
-        let mut connections = JoinSet::new();
+        serving.accept_until_stopped(&mut stop).await;
+        serving.drain().await;
+        serving.close_endpoints().await;
+        for task in browsers.tasks {
+            let _ = task.await;
+        }
+        #[cfg(feature = "agones")]
+        if let Some(thread) = agones_task {
+            // It sees `stop` and ends within a poll.
+            let _ = tokio::task::spawn_blocking(move || thread.join()).await;
+        }
+        stop_rooms(serving.shared).await;
+        if let Some(task) = metrics_task {
+            let _ = task.await;
+        }
+        drop(shutdown);
+        info!("stopped");
+        Ok(())
+    }
+}
+
+/// Makes the rooms from the configuration and level, and opens the
+/// permanent ones (`room-1` ..), each with its recorder if recording.
+fn open_rooms(
+    config: &ServerConfig,
+    level: &Level,
+    level_offer: LevelOffer,
+    recorders: &[Recorder],
+    metrics: Arc<Metrics>,
+) -> Result<Rooms, ServerError> {
+    let template = RoomConfig {
+        name: String::new(),
+        tick_rate: config.tick_rate,
+        snapshot_interval: config.snapshot_interval(),
+        max_players: config.max_players,
+        max_catch_up: config.max_catch_up,
+        input_window: config.tick_rate.max(32) as usize,
+        input_redundancy: DEFAULT_INPUT_REDUNDANCY,
+        history: DEFAULT_HISTORY,
+        level_id: levels::level_id(level),
+        level_hash: level.content_hash(),
+        level: level_offer,
+        record: None,
+        idle_kick: config.idle_kick,
+    };
+    let rooms = Rooms::new(
+        Game::with_config(level, config.game_config())?,
+        template,
+        config.max_rooms as usize,
+        metrics,
+    );
+    for i in 1..=config.rooms {
+        let record = recorders.get(i as usize - 1).cloned();
+        rooms.open_permanent(format!("room-{i}"), record);
+    }
+    Ok(rooms)
+}
+
+/// Under Agones: waits for the SDK sidecar, which must answer before
+/// anything else, and starts the driver; the fleet logic then says Ready
+/// with the rooms open.
+#[cfg(feature = "agones")]
+async fn join_fleet(
+    config: &ServerConfig,
+    fingerprint: Fingerprint,
+    shared: &Arc<Shared>,
+    stop: &watch::Receiver<bool>,
+    shutdown: &watch::Sender<bool>,
+) -> Result<Option<std::thread::JoinHandle<()>>, ServerError> {
+    let Some(fleet) = config.agones else {
+        return Ok(None);
+    };
+    let thread = crate::agones::start(
+        fleet,
+        fingerprint.to_string(),
+        shared.clone(),
+        stop.clone(),
+        ShutdownHandle(shutdown.clone()),
+    )
+    .await
+    .map_err(|e| ServerError::Agones(e.to_string()))?;
+    Ok(Some(thread))
+}
+
+/// The tasks serving browsers, and the WebTransport endpoint whose
+/// sessions the accept loop takes.
+struct Browsers {
+    tasks: Vec<JoinHandle<()>>,
+    webtransport: Option<Arc<wt::Endpoint>>,
+}
+
+/// Starts serving browsers if the web port is on: WebTransport's
+/// certificate rotation and the web port itself, which hands admitted
+/// WebSockets to `accepted`.
+fn serve_browsers(
+    web: Option<WebParts>,
+    shared: &Arc<Shared>,
+    level_offer: LevelOffer,
+    config: &ServerConfig,
+    accepted: mpsc::Sender<web::Accepted>,
+    stop: &watch::Receiver<bool>,
+) -> Browsers {
+    let mut browsers = Browsers {
+        tasks: Vec::new(),
+        webtransport: None,
+    };
+    let Some(w) = web else {
+        return browsers;
+    };
+    let wt_port = w
+        .webtransport
+        .as_ref()
+        .map(|t| (t.addr.port(), t.certs.clone()));
+    if let Some(t) = &w.webtransport {
+        info!(
+            addr = %t.addr,
+            cert_sha256 = %crate::Fingerprint(t.certs.current().sha256),
+            "WebTransport sessions at {}",
+            crate::link::webtransport::PATH
+        );
+        browsers.tasks.push(tokio::spawn(wt::rotate(
+            t.endpoint.clone(),
+            t.certs.clone(),
+            t.settings.clone(),
+            stop.clone(),
+        )));
+        browsers.webtransport = Some(t.endpoint.clone());
+    }
+    info!(addr = %w.addr, files = w.root.len(), "serving browsers (the page, /web.json, /ws)");
+    let state = Arc::new(WebState {
+        shared: shared.clone(),
+        root: w.root,
+        level_hex: level_offer.hex(),
+        level: bytes::Bytes::from(Vec::clone(&shared.level_bundle)),
+        webtransport: wt_port,
+        accepted,
+        idle_timeout: config.idle_timeout,
+    });
+    browsers
+        .tasks
+        .push(tokio::spawn(web::serve(w.listener, state, stop.clone())));
+    browsers
+}
+
+/// The next WebTransport session, or never when WebTransport is off.
+async fn next_webtransport(endpoint: Option<Arc<wt::Endpoint>>) -> IncomingSession {
+    match endpoint {
+        Some(e) => e.accept().await,
+        None => std::future::pending().await,
+    }
+}
+
+/// What the accept loop, and the shutdown after it, work on.
+struct Serving {
+    endpoint: quinn::Endpoint,
+    /// The WebTransport endpoint, when it is on.
+    webtransport: Option<Arc<wt::Endpoint>>,
+    /// WebSockets admitted and upgraded by the web port.
+    accepted: mpsc::Receiver<web::Accepted>,
+    shared: Arc<Shared>,
+    /// One task per connection.
+    connections: JoinSet<()>,
+}
+
+impl Serving {
+    /// Admits new connections and sweeps every [`SWEEP`] until shutdown is
+    /// requested (or the endpoint closes).
+    async fn accept_until_stopped(&mut self, stop: &mut watch::Receiver<bool>) {
         let mut sweep = tokio::time::interval(SWEEP);
         let mut refusals = RefusalLog::default();
         loop {
             tokio::select! {
                 // `shutdown` lives until the end of `run`, so this never errs.
-                () = stopped(&mut stop) => break,
-                _ = sweep.tick() => {
-                    let now = Instant::now();
-                    for lost in shared.sessions.expire(now) {
-                        info!(player = %lost.player_id, room = %lost.room.name(), "reconnect grace over; the player leaves");
-                        metrics.sessions_expired.inc();
-                        lost.room.leave(lost.player_id, lost.generation);
-                    }
-                    shared.rooms.close_idle(now);
-                    metrics.pending_connections.set(shared.admission.pending() as i64);
-                    refusals.warn(now);
-                }
-                incoming = endpoint.accept() => match incoming {
-                    Some(incoming) => {
-                        admit(Incoming::Quic(incoming), &shared, &mut connections, &mut refusals)
-                    }
+                () = stopped(stop) => break,
+                _ = sweep.tick() => self.sweep(&mut refusals),
+                incoming = self.endpoint.accept() => match incoming {
+                    Some(incoming) => admit(
+                        Incoming::Quic(incoming),
+                        &self.shared,
+                        &mut self.connections,
+                        &mut refusals,
+                    ),
                     None => break,
                 },
-                incoming = wt_accept(&webtransport) => {
-                    admit(Incoming::WebTransport(incoming), &shared, &mut connections, &mut refusals)
-                }
-                Some((incoming, ticket)) = accepted.recv() => {
-                    connections.spawn(connection::serve(incoming, ticket, shared.clone()));
-                }
-                Some(done) = connections.join_next(), if !connections.is_empty() => {
+                incoming = next_webtransport(self.webtransport.clone()) => admit(
+                    Incoming::WebTransport(incoming),
+                    &self.shared,
+                    &mut self.connections,
+                    &mut refusals,
+                ),
+                Some((incoming, ticket)) = self.accepted.recv() => self.serve(incoming, ticket),
+                Some(done) = self.connections.join_next(), if !self.connections.is_empty() => {
                     if let Err(e) = done {
                         error!("connection task failed: {e}");
                     }
                 }
             }
         }
+    }
 
+    /// Removes lost players past the reconnect grace time and closes idle
+    /// rooms; refreshes the pending gauge and warns of refusals.
+    fn sweep(&self, refusals: &mut RefusalLog) {
+        let now = Instant::now();
+        let metrics = &self.shared.metrics;
+        for lost in self.shared.sessions.expire(now) {
+            info!(player = %lost.player_id, room = %lost.room.name(), "reconnect grace over; the player leaves");
+            metrics.sessions_expired.inc();
+            lost.room.leave(lost.player_id, lost.generation);
+        }
+        self.shared.rooms.close_idle(now);
+        metrics
+            .pending_connections
+            .set(self.shared.admission.pending() as i64);
+        refusals.warn(now);
+    }
+
+    /// Serves a WebSocket the web port admitted and upgraded.
+    fn serve(&mut self, incoming: Incoming, ticket: Ticket) {
+        self.connections
+            .spawn(connection::serve(incoming, ticket, self.shared.clone()));
+    }
+
+    /// Waits (bounded) for the connection tasks, which see the same signal:
+    /// each sends `Notice{Shutdown}` and closes with `ServerShutdown`.
+    /// Newcomers are refused meanwhile; tasks still running are aborted.
+    async fn drain(&mut self) {
         info!(
-            clients = connections.len(),
+            clients = self.connections.len(),
             "shutting down: notifying clients"
         );
-        // Connection tasks see the same signal: each sends Notice{Shutdown}
-        // and closes with ServerShutdown.
         let drained = tokio::time::timeout(SHUTDOWN_GRACE + SHUTDOWN_LINGER, async {
             loop {
                 tokio::select! {
-                    done = connections.join_next() => if done.is_none() { break },
+                    done = self.connections.join_next() => if done.is_none() { break },
                     // Newcomers are refused at once rather than left waiting.
-                    Some(incoming) = endpoint.accept() => incoming.refuse(),
-                    incoming = wt_accept(&webtransport) => incoming.refuse(),
+                    Some(incoming) = self.endpoint.accept() => incoming.refuse(),
+                    incoming = next_webtransport(self.webtransport.clone()) => incoming.refuse(),
                     // Upgraded meanwhile: told the server is shutting down.
-                    Some((incoming, ticket)) = accepted.recv() => {
-                        connections.spawn(connection::serve(incoming, ticket, shared.clone()));
-                    }
+                    Some((incoming, ticket)) = self.accepted.recv() => self.serve(incoming, ticket),
                 }
             }
         })
         .await;
         if drained.is_err() {
             warn!("connection tasks still running after the grace period; aborting them");
-            connections.shutdown().await;
+            self.connections.shutdown().await;
         }
-        endpoint.close(
+    }
+
+    /// Closes the QUIC endpoint, then WebTransport's, and waits (bounded)
+    /// for each to go idle.
+    async fn close_endpoints(&self) {
+        self.endpoint.close(
             CloseCode::ServerShutdown.to_u32().into(),
             b"server shutting down",
         );
-        if tokio::time::timeout(SHUTDOWN_GRACE, endpoint.wait_idle())
+        if tokio::time::timeout(SHUTDOWN_GRACE, self.endpoint.wait_idle())
             .await
             .is_err()
         {
             warn!("endpoint not idle after {SHUTDOWN_GRACE:?}");
         }
-        if let Some(endpoint) = &webtransport {
+        if let Some(endpoint) = &self.webtransport {
             endpoint.close(
                 wtransport::VarInt::from_u32(CloseCode::ServerShutdown.to_u32()),
                 b"server shutting down",
@@ -696,27 +815,18 @@ impl Server {
                 warn!("WebTransport endpoint not idle after {SHUTDOWN_GRACE:?}");
             }
         }
-        for task in web_tasks {
-            let _ = task.await;
+    }
+}
+
+/// Stops the rooms and waits for their tasks. A room stops once its last
+/// handle is gone, so the shared state (whose sessions hold handles) goes
+/// first.
+async fn stop_rooms(shared: Arc<Shared>) {
+    let room_tasks = shared.rooms.close_all();
+    drop(shared);
+    for task in room_tasks {
+        if let Err(e) = task.await {
+            error!("room task failed: {e}");
         }
-        #[cfg(feature = "agones")]
-        if let Some(thread) = agones_task {
-            // It sees `stop` and ends within a poll.
-            let _ = tokio::task::spawn_blocking(move || thread.join()).await;
-        }
-        // Rooms stop once their last handle is gone.
-        let room_tasks = shared.rooms.close_all();
-        drop(shared);
-        for task in room_tasks {
-            if let Err(e) = task.await {
-                error!("room task failed: {e}");
-            }
-        }
-        if let Some(task) = metrics_task {
-            let _ = task.await;
-        }
-        drop(shutdown);
-        info!("stopped");
-        Ok(())
     }
 }

@@ -36,9 +36,9 @@ use tokio::task::JoinSet;
 use tracing::{debug, warn};
 
 use crate::admission::{Refusal, Ticket, Verdict};
-use crate::connection::Shared;
 use crate::link::websocket::{self, Upgraded};
 use crate::link::{Incoming, Transport};
+use crate::shared::Shared;
 use files::WebRoot;
 use webtransport::WebCerts;
 
@@ -247,7 +247,7 @@ pub async fn serve(listener: TcpListener, state: Arc<WebState>, mut stop: watch:
     let mut connections = JoinSet::new();
     loop {
         let permit = tokio::select! {
-            () = crate::server::stopped(&mut stop) => break,
+            () = crate::shutdown::stopped(&mut stop) => break,
             permit = slots.clone().acquire_owned() => match permit {
                 Ok(permit) => permit,
                 Err(_) => break,
@@ -255,7 +255,7 @@ pub async fn serve(listener: TcpListener, state: Arc<WebState>, mut stop: watch:
             Some(_) = connections.join_next(), if !connections.is_empty() => continue,
         };
         let (stream, peer) = tokio::select! {
-            () = crate::server::stopped(&mut stop) => break,
+            () = crate::shutdown::stopped(&mut stop) => break,
             accepted = listener.accept() => match accepted {
                 Ok(accepted) => accepted,
                 Err(e) => {

@@ -151,7 +151,7 @@ pub async fn rotate(
             .duration_since(SystemTime::now())
             .unwrap_or(Duration::ZERO);
         tokio::select! {
-            () = crate::server::stopped(&mut stop) => return,
+            () = crate::shutdown::stopped(&mut stop) => return,
             () = tokio::time::sleep(wait) => {}
         }
         let now = SystemTime::now();
