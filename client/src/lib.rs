@@ -68,4 +68,3 @@ pub use net::session::{JoinOptions, SessionEvent, SessionState, SessionStats, Sn
 #[cfg(not(target_arch = "wasm32"))]
 pub use net::trust::{connect_trusted, dial_trusted, list_rooms_trusted, Trust};
 pub use view::{EntityDraw, Facing, FrameView, NetStats, PlayerDraw};
-

@@ -39,7 +39,10 @@ use super::entities::{
     check_coord_field, is_polygon_name, place_box, px_to_units, PlacedEntity, PlacedPolygon,
     PropValue,
 };
-use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
+use crate::assemble::{assemble, GridLayer};
+use crate::error::LevelError;
+use crate::loaded::LoadedLevel;
+use crate::options::{LoadOptions, MAX_LEVEL_TILES};
 use ledge_shared::tilemap::Tile;
 
 pub use self::model::{
@@ -1070,7 +1073,7 @@ pub fn load_str(
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let mut loaded = super::assemble(file, name, grids, entities, options)?;
+    let mut loaded = assemble(file, name, grids, entities, options)?;
     loaded.warnings.splice(0..0, warnings);
     loaded.art = art;
     Ok(loaded)

@@ -94,7 +94,7 @@ impl LevelSettings {
     /// Reads and checks a settings file.
     pub fn load(path: &Path) -> Result<Self, LevelError> {
         let file = path.display().to_string();
-        let bytes = crate::read_bytes_capped(path, MAX_SETTINGS_BYTES)?;
+        let bytes = crate::read::read_bytes_capped(path, MAX_SETTINGS_BYTES)?;
         let text = String::from_utf8(bytes).map_err(|e| LevelError::Syntax {
             file: file.clone(),
             field: format!("byte {}", e.utf8_error().valid_up_to()),

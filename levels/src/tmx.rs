@@ -45,7 +45,10 @@ use super::entities::{
     check_coord_field, place_box, px_to_units, PlacedEntity, PlacedPolygon, PropValue,
 };
 use super::mapping::normalize;
-use super::{GridLayer, LevelError, LoadOptions, LoadedLevel, MAX_LEVEL_TILES};
+use crate::assemble::{assemble, GridLayer};
+use crate::error::LevelError;
+use crate::loaded::LoadedLevel;
+use crate::options::{LoadOptions, MAX_LEVEL_TILES};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::shape::MAX_POLYGON_VERTICES;
 use ledge_shared::tilemap::Tile;
@@ -69,7 +72,7 @@ impl Reader {
             Some(t) if path == self.main => t,
             t => {
                 self.text = t;
-                super::read_bytes(path)?
+                crate::read::read_bytes(path)?
             }
         };
         crate::limits::check_tmx_resource(&mut self.budget, path, bytes)
@@ -406,7 +409,7 @@ impl Conv<'_> {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let mut loaded = super::assemble(self.file, name, grids, entities, self.options)?;
+        let mut loaded = assemble(self.file, name, grids, entities, self.options)?;
         let notes = std::mem::take(self.notes.get_mut());
         loaded.warnings.splice(0..0, notes.lines(self.file));
         Ok(loaded)

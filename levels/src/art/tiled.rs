@@ -433,7 +433,7 @@ impl<'m> Build<'m> {
         if let Ok(meta) = std::fs::metadata(&path) {
             check_image_bytes(self.file, &format!("{field} (image {name:?})"), meta.len())?;
         }
-        let added = crate::read_bytes(&path).and_then(|bytes| {
+        let added = crate::read::read_bytes(&path).and_then(|bytes| {
             let trans = img.transparent_colour.map(|c| [c.red, c.green, c.blue]);
             self.images
                 .add(self.file, field, key.clone(), name, trans, bytes)

@@ -13,6 +13,7 @@
 //! direct call into quinn, with no extra task, copy or allocation per
 //! datagram.
 
+mod outcome;
 pub mod quic;
 pub mod websocket;
 pub mod webtransport;
@@ -20,12 +21,10 @@ pub mod webtransport;
 use std::net::SocketAddr;
 
 use bytes::Bytes;
-use ledge_shared::protocol::web::WebError;
 use ledge_shared::protocol::CloseCode;
 use prometheus_client::encoding::{EncodeLabelValue, LabelValueEncoder};
 
-/// Bytes read from a control stream at a time.
-pub const READ_CHUNK: usize = 4096;
+pub use outcome::{DatagramError, Gone, Received, READ_CHUNK};
 
 /// Which transport a connection uses (a metric label).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -60,42 +59,6 @@ impl EncodeLabelValue for Transport {
     fn encode(&self, encoder: &mut LabelValueEncoder) -> Result<(), std::fmt::Error> {
         std::fmt::Write::write_str(encoder, self.as_str())
     }
-}
-
-/// How a connection went away under a session.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Gone {
-    /// The peer closed it on purpose (it quit): a leave.
-    Closed(String),
-    /// Timed out, reset, or broken: a loss (the player is kept for a resume).
-    Lost(String),
-}
-
-impl std::fmt::Display for Gone {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Gone::Closed(why) | Gone::Lost(why) => f.write_str(why),
-        }
-    }
-}
-
-/// What a [`Receiver`] got next.
-#[derive(Debug)]
-pub enum Received {
-    /// The next bytes of the control stream.
-    Stream(Bytes),
-    /// The client finished its control stream.
-    StreamEnd,
-    /// One datagram.
-    Datagram(Bytes),
-    /// A malformed transport message (WebSocket only): dropped, counted
-    /// and struck like malformed input.
-    Malformed(WebError),
-    /// The transport cannot go on (WebSocket: a message over the limit):
-    /// closed at once with [`CloseCode::ProtocolViolation`].
-    Broken(String),
-    /// The connection is gone.
-    Gone(Gone),
 }
 
 /// A new connection before its transport handshake.
@@ -296,15 +259,6 @@ impl Receiver {
             Receiver::WebSocket(reader) => reader.next(true).await,
         }
     }
-}
-
-/// Why a datagram was not sent.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum DatagramError {
-    /// The connection is gone.
-    Lost,
-    /// The transport refused it (too large, its buffer full, ...).
-    Failed(String),
 }
 
 /// UDP totals of a connection: datagrams and their payload bytes (QUIC

@@ -2,7 +2,7 @@
 
 use ledge_shared::protocol::CloseCode;
 
-use super::{Gone, Received, READ_CHUNK};
+use super::outcome::{Gone, Received, READ_CHUNK};
 
 /// Longest close reason sent, bytes: it must fit one packet.
 const MAX_CLOSE_REASON: usize = 200;

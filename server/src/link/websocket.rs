@@ -21,7 +21,7 @@ use ledge_shared::protocol::web::{self, Tag, WebMessage};
 use ledge_shared::protocol::CloseCode;
 use tokio::sync::{mpsc, oneshot, Notify};
 
-use super::{DatagramError, Gone, Received};
+use super::outcome::{DatagramError, Gone, Received};
 
 /// Largest snapshot datagram sent on a WebSocket: what every QUIC path
 /// takes, so a browser sees the same datagrams as a native client.

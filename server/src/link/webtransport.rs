@@ -11,7 +11,7 @@ use wtransport::endpoint::IncomingSession;
 use wtransport::error::{ConnectionError, StreamReadError};
 use wtransport::VarInt;
 
-use super::{Gone, Received, READ_CHUNK};
+use super::outcome::{Gone, Received, READ_CHUNK};
 
 /// The path of ledge sessions (`https://HOST:PORT/ledge`); others are
 /// refused with 404.
