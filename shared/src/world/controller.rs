@@ -10,9 +10,10 @@ use crate::input::Buttons;
 use glam::IVec2;
 use serde::{Deserialize, Serialize};
 
-use super::body::{Body, BodyId};
+use super::body::Body;
+use super::error::BuildError;
 use super::hash::Fnv1a;
-use super::BuildError;
+use super::id::BodyId;
 
 /// Tuning of the top-down [`Mover`], in units per tick (per tick for speeds,
 /// per tick per tick for `accel` and `brake`). Each axis is independent.
