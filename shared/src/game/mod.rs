@@ -81,8 +81,10 @@
 //! the future exactly.
 
 mod config;
+mod entity;
 mod path;
 mod polygon_ground;
+mod rect;
 mod rules;
 pub mod spawn;
 pub mod state;
@@ -91,6 +93,7 @@ pub use config::{
     CarryMode, GameConfig, PlayerConfig, PlayerShape, FOOT_HEIGHT, FOOT_INSET,
     MAX_RESPAWN_DELAY_TICKS,
 };
+pub use entity::EntityType;
 pub use path::PathSchedule;
 pub use state::{kind, ENTITY_ID_BASE, RUN_ID_BASE};
 
@@ -102,6 +105,7 @@ use crate::shape::{Aabb, ConvexPolygon};
 use crate::tilemap::Tilemap;
 use crate::world::hash::Fnv1a;
 use crate::world::{BodyDesc, BodyId, ColliderDesc, OneWay, Sides, World, TILEMAP_LAYER};
+use entity::Ent;
 use glam::IVec2;
 use state::{coin_flags, platform_flags, walker_flags, PlayerState, RunState, RUN_MAX};
 use thiserror::Error;
@@ -240,66 +244,6 @@ pub enum GameEvent {
     },
 }
 
-/// The type of a level entity, for drawing ([`EntityView`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum EntityType {
-    /// A player spawn point.
-    Spawn,
-    /// A static block.
-    Block,
-    /// A static convex polygon solid: its view's box holds the polygon (the
-    /// level's [`EntityKind::PolygonBlock`] has the vertices). The walker
-    /// ledge test and the drop-through test do not look at it.
-    PolygonBlock,
-    /// A moving platform.
-    Platform,
-    /// A walker enemy.
-    Walker,
-    /// A springboard.
-    Springboard,
-    /// A coin.
-    Coin,
-    /// A checkpoint.
-    Checkpoint,
-    /// A goal.
-    Goal,
-    /// A hazard volume.
-    Hazard,
-}
-
-impl EntityType {
-    /// The type of a level entity of kind `kind`.
-    fn of(kind: &EntityKind) -> Self {
-        match kind {
-            EntityKind::PlayerSpawn => EntityType::Spawn,
-            EntityKind::Block => EntityType::Block,
-            EntityKind::PolygonBlock { .. } => EntityType::PolygonBlock,
-            EntityKind::MovingPlatform { .. } => EntityType::Platform,
-            EntityKind::Walker { .. } => EntityType::Walker,
-            EntityKind::Springboard { .. } => EntityType::Springboard,
-            EntityKind::Coin => EntityType::Coin,
-            EntityKind::Checkpoint => EntityType::Checkpoint,
-            EntityKind::Goal => EntityType::Goal,
-            EntityKind::Hazard => EntityType::Hazard,
-        }
-    }
-
-    /// Its kind byte ([`kind`]).
-    pub fn code(self) -> u8 {
-        match self {
-            EntityType::Spawn => kind::SPAWN,
-            EntityType::Block | EntityType::PolygonBlock => kind::BLOCK,
-            EntityType::Platform => kind::PLATFORM,
-            EntityType::Walker => kind::WALKER,
-            EntityType::Springboard => kind::SPRINGBOARD,
-            EntityType::Coin => kind::COIN,
-            EntityType::Checkpoint => kind::CHECKPOINT,
-            EntityType::Goal => kind::GOAL,
-            EntityType::Hazard => kind::HAZARD,
-        }
-    }
-}
-
 /// A level entity as it is now, for drawing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EntityView {
@@ -355,26 +299,6 @@ pub struct PlayerView {
     /// Sides its box touched during the last step (a view of the world's
     /// per-tick scratch: not part of the state, empty after a restore).
     pub sides: Sides,
-}
-
-/// One level entity at run time.
-#[derive(Debug, Clone)]
-struct Ent {
-    ty: EntityType,
-    /// Centre in the level (a platform's first node).
-    pos: IVec2,
-    half: IVec2,
-    body: Option<BodyId>,
-    /// Walker speed or springboard strength.
-    param: i32,
-    path: Option<PathSchedule>,
-    one_way: bool,
-    /// Walker: not defeated.
-    alive: bool,
-    /// Walker: walking direction, -1 or 1.
-    dir: i32,
-    /// Coin: who picked it up.
-    collector: Option<u32>,
 }
 
 /// One player at run time.

@@ -4,40 +4,16 @@
 use glam::IVec2;
 
 use super::config::{CarryMode, PlayerConfig};
+use super::entity::EntityType;
 use super::polygon_ground::{PolygonSolid, SLOPE_RUN, TOUCH};
+use super::rect::Rect;
 use super::state::{PlayerState, RunState, RUN_MAX};
-use super::{EntityType, Game, GameEvent, HurtCause, Player, ENTITY_ID_BASE};
+use super::{Game, GameEvent, HurtCause, Player, ENTITY_ID_BASE};
 use crate::fixed::MAX_SPEED;
 use crate::input::Buttons;
 use crate::protocol::PlayerId;
 use crate::tilemap::{ContactFlags, Tile, TileContact, Tilemap};
 use crate::world::{BodyId, Event, Sides};
-
-/// A box by its edges, in `i64` units.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Rect {
-    pub(super) l: i64,
-    pub(super) t: i64,
-    pub(super) r: i64,
-    pub(super) b: i64,
-}
-
-impl Rect {
-    pub(super) fn new(centre: IVec2, half: IVec2) -> Self {
-        let (c, h) = (centre.as_i64vec2(), half.as_i64vec2());
-        Rect {
-            l: c.x - h.x,
-            t: c.y - h.y,
-            r: c.x + h.x,
-            b: c.y + h.y,
-        }
-    }
-
-    /// Interiors overlap.
-    pub(super) fn overlaps(&self, o: &Rect) -> bool {
-        self.l < o.r && o.l < self.r && self.t < o.b && o.t < self.b
-    }
-}
 
 /// Horizontal speed after one tick of `dir` (-1, 0, 1) from `vx`.
 fn run(vx: i32, dir: i32, accel: i32, brake: i32, max: i32) -> i32 {
