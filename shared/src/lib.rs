@@ -13,7 +13,9 @@
 //! * [`input`]: the buttons a player sends each tick;
 //! * [`tilemap`]: tile grids with slopes and one-way tiles, by direct lookup;
 //! * [`protocol`]: versioned wire messages and delta-compressed snapshots;
-//! * [`level`]: the level data model, editor loaders, the default level;
+//! * [`level`]: the level data model (tilemap, entities, bot route) and
+//!   what a level uses; the editor importers (OGMO, Tiled) and the default
+//!   level are in the `ledge-levels` crate, not here;
 //! * [`game`]: the platformer rules over the world (what the server runs);
 //! * [`scene`]: built-in scenes (the warm-up room).
 #![deny(missing_docs)]

@@ -72,48 +72,18 @@ macro_rules! multiversioned {
     };
 }
 
+mod bounds;
 mod order;
 pub mod standard;
 mod strips;
 mod sweep;
 
+pub use bounds::Bounds;
+
 use glam::IVec2;
 use order::{Buffers, Keyed, Parts};
 use strips::{Levels, Strips};
 use sweep::Sink;
-
-/// An integer axis-aligned box by its corners, in units: the closed set from
-/// `min` to `max` (`min <= max` on both axes).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct Bounds {
-    /// Smallest corner (left, top).
-    pub min: IVec2,
-    /// Largest corner (right, bottom).
-    pub max: IVec2,
-}
-
-impl Bounds {
-    /// The box with corners `min` and `max`.
-    #[inline]
-    pub const fn new(min: IVec2, max: IVec2) -> Self {
-        Self { min, max }
-    }
-
-    /// The box of size `size` whose smallest corner is `min`.
-    #[inline]
-    pub fn from_min_size(min: IVec2, size: IVec2) -> Self {
-        Self {
-            min,
-            max: min + size,
-        }
-    }
-
-    /// Whether the interiors overlap (positive overlap on both axes).
-    #[inline]
-    pub fn overlaps(&self, o: &Bounds) -> bool {
-        self.min.x < o.max.x && o.min.x < self.max.x && self.min.y < o.max.y && o.min.y < self.max.y
-    }
-}
 
 /// The minimum translation vector that moves `a` out of `b`, when their
 /// interiors overlap.

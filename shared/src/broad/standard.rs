@@ -8,7 +8,7 @@
 //! reversing a velocity component that would take it out of the world. All
 //! values are whole pixels expressed in units ([`UNITS_PER_PX`]).
 
-use super::Bounds;
+use super::bounds::Bounds;
 use crate::fixed::{px, UNITS_PER_PX};
 use glam::IVec2;
 

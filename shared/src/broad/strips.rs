@@ -21,7 +21,7 @@
 //! (`while minx[k] < x`) stops at the end of its strip with no index test,
 //! and fixed blocks of [`BLOCK`] entries can be read anywhere in a strip.
 
-use super::Bounds;
+use super::bounds::Bounds;
 use core::ops::Range;
 use wide::i32x4;
 

@@ -81,8 +81,10 @@
 //! the future exactly.
 
 mod config;
+mod entity;
 mod path;
 mod polygon_ground;
+mod rect;
 mod rules;
 pub mod spawn;
 pub mod state;
@@ -91,17 +93,19 @@ pub use config::{
     CarryMode, GameConfig, PlayerConfig, PlayerShape, FOOT_HEIGHT, FOOT_INSET,
     MAX_RESPAWN_DELAY_TICKS,
 };
+pub use entity::EntityType;
 pub use path::PathSchedule;
 pub use state::{kind, ENTITY_ID_BASE, RUN_ID_BASE};
 
 use crate::fixed::{check_coord, check_speed};
 use crate::input::Buttons;
-use crate::level::{EntityKind, Level};
+use crate::level::{EntityDef, EntityKind, Level};
 use crate::protocol::{is_replicated, EntityState, PlayerId, StateSnapshot};
 use crate::shape::{Aabb, ConvexPolygon};
 use crate::tilemap::Tilemap;
 use crate::world::hash::Fnv1a;
 use crate::world::{BodyDesc, BodyId, ColliderDesc, OneWay, Sides, World, TILEMAP_LAYER};
+use entity::Ent;
 use glam::IVec2;
 use state::{coin_flags, platform_flags, walker_flags, PlayerState, RunState, RUN_MAX};
 use thiserror::Error;
@@ -240,50 +244,6 @@ pub enum GameEvent {
     },
 }
 
-/// The type of a level entity, for drawing ([`EntityView`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum EntityType {
-    /// A player spawn point.
-    Spawn,
-    /// A static block.
-    Block,
-    /// A static convex polygon solid: its view's box holds the polygon (the
-    /// level's [`EntityKind::PolygonBlock`] has the vertices). The walker
-    /// ledge test and the drop-through test do not look at it.
-    PolygonBlock,
-    /// A moving platform.
-    Platform,
-    /// A walker enemy.
-    Walker,
-    /// A springboard.
-    Springboard,
-    /// A coin.
-    Coin,
-    /// A checkpoint.
-    Checkpoint,
-    /// A goal.
-    Goal,
-    /// A hazard volume.
-    Hazard,
-}
-
-impl EntityType {
-    /// Its kind byte ([`kind`]).
-    pub fn code(self) -> u8 {
-        match self {
-            EntityType::Spawn => kind::SPAWN,
-            EntityType::Block | EntityType::PolygonBlock => kind::BLOCK,
-            EntityType::Platform => kind::PLATFORM,
-            EntityType::Walker => kind::WALKER,
-            EntityType::Springboard => kind::SPRINGBOARD,
-            EntityType::Coin => kind::COIN,
-            EntityType::Checkpoint => kind::CHECKPOINT,
-            EntityType::Goal => kind::GOAL,
-            EntityType::Hazard => kind::HAZARD,
-        }
-    }
-}
-
 /// A level entity as it is now, for drawing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EntityView {
@@ -341,26 +301,6 @@ pub struct PlayerView {
     pub sides: Sides,
 }
 
-/// One level entity at run time.
-#[derive(Debug, Clone)]
-struct Ent {
-    ty: EntityType,
-    /// Centre in the level (a platform's first node).
-    pos: IVec2,
-    half: IVec2,
-    body: Option<BodyId>,
-    /// Walker speed or springboard strength.
-    param: i32,
-    path: Option<PathSchedule>,
-    one_way: bool,
-    /// Walker: not defeated.
-    alive: bool,
-    /// Walker: walking direction, -1 or 1.
-    dir: i32,
-    /// Coin: who picked it up.
-    collector: Option<u32>,
-}
-
 /// One player at run time.
 #[derive(Debug, Clone, Copy)]
 struct Player {
@@ -415,20 +355,30 @@ impl Game {
 
     /// Builds the game for `level` with `config`.
     pub fn with_config(level: &Level, config: GameConfig) -> Result<Self, GameError> {
+        let mut g = Self::empty(level, config)?;
+        for (i, def) in level.entities.iter().enumerate() {
+            g.add_entity(level, i, def)?;
+        }
+        if g.spawns.is_empty() {
+            return Err(GameError::NoSpawn(level.name.clone()));
+        }
+        g.find_spawn_spots();
+        Ok(g)
+    }
+
+    /// The game for `level` with `config` before its entities: the world with
+    /// the level's tilemap, no entity, no player.
+    fn empty(level: &Level, config: GameConfig) -> Result<Self, GameError> {
         config.player.validate().map_err(GameError::BadConfig)?;
         let mut world = World::new(config.sim).map_err(|e| GameError::BadConfig(e.to_string()))?;
         world.set_tilemap(level.tilemap.clone());
-        let bad = |i: usize, m: String| GameError::BadLevel {
-            level: level.name.clone(),
-            message: format!("entity {i}: {m}"),
-        };
         if level.entities.len() >= (1 << 15) - 1 {
             return Err(GameError::BadLevel {
                 level: level.name.clone(),
                 message: format!("{} entities; at most 32766", level.entities.len()),
             });
         }
-        let mut g = Game {
+        Ok(Game {
             config,
             name: level.name.clone(),
             world,
@@ -453,126 +403,133 @@ impl Game {
             fall_y: level
                 .bounds()
                 .map_or(i32::MAX, |(_, hi)| hi.y.saturating_add(FALL_MARGIN)),
+        })
+    }
+
+    /// Adds entity `i` of `level`, `def`: checks it, builds its body and
+    /// collider if it has one, and files it in its type's list.
+    fn add_entity(&mut self, level: &Level, i: usize, def: &EntityDef) -> Result<(), GameError> {
+        let bad = |m: String| bad_entity(level, i, m);
+        let half = def.size / 2;
+        for v in [def.pos.x, def.pos.y] {
+            check_coord("entity position", v as i64).map_err(|e| bad(e.to_string()))?;
+        }
+        let ty = EntityType::of(&def.kind);
+        let needs_box = ty != EntityType::Spawn;
+        let shape = if needs_box {
+            Some(Aabb::new(half).map_err(|e| bad(format!("size {}: {e}", def.size)))?)
+        } else {
+            None
         };
-        for (i, def) in level.entities.iter().enumerate() {
-            let half = def.size / 2;
-            for v in [def.pos.x, def.pos.y] {
-                check_coord("entity position", v as i64).map_err(|e| bad(i, e.to_string()))?;
+        let mut e = Ent {
+            ty,
+            pos: def.pos,
+            half,
+            body: None,
+            param: 0,
+            path: None,
+            one_way: false,
+            alive: true,
+            dir: -1,
+            collector: None,
+        };
+        self.build_entity(level, i, def, shape, &mut e)?;
+        self.ents.push(e);
+        Ok(())
+    }
+
+    /// The part of [`Game::add_entity`] that depends on the entity's kind:
+    /// its body and collider (box `shape`, or its polygon), parameters, and
+    /// the list it goes in.
+    fn build_entity(
+        &mut self,
+        level: &Level,
+        i: usize,
+        def: &EntityDef,
+        shape: Option<Aabb>,
+        e: &mut Ent,
+    ) -> Result<(), GameError> {
+        let bad = |m: String| bad_entity(level, i, m);
+        let build = |r: Result<BodyId, crate::world::BuildError>| r.map_err(|x| bad(x.to_string()));
+        match &def.kind {
+            EntityKind::PlayerSpawn => self.spawns.push(i),
+            EntityKind::Block => {
+                let b = build(self.world.add_body(BodyDesc::fixed(def.pos)))?;
+                let c = ColliderDesc::solid(shape.expect("box")).layers(LAYER_SOLID, u32::MAX);
+                self.world
+                    .add_collider(b, c)
+                    .map_err(|x| bad(x.to_string()))?;
+                e.body = Some(b);
             }
-            let ty = match def.kind {
-                EntityKind::PlayerSpawn => EntityType::Spawn,
-                EntityKind::Block => EntityType::Block,
-                EntityKind::PolygonBlock { .. } => EntityType::PolygonBlock,
-                EntityKind::MovingPlatform { .. } => EntityType::Platform,
-                EntityKind::Walker { .. } => EntityType::Walker,
-                EntityKind::Springboard { .. } => EntityType::Springboard,
-                EntityKind::Coin => EntityType::Coin,
-                EntityKind::Checkpoint => EntityType::Checkpoint,
-                EntityKind::Goal => EntityType::Goal,
-                EntityKind::Hazard => EntityType::Hazard,
-            };
-            let needs_box = ty != EntityType::Spawn;
-            let shape = if needs_box {
-                Some(Aabb::new(half).map_err(|e| bad(i, format!("size {}: {e}", def.size)))?)
-            } else {
-                None
-            };
-            let mut e = Ent {
-                ty,
-                pos: def.pos,
-                half,
-                body: None,
-                param: 0,
-                path: None,
-                one_way: false,
-                alive: true,
-                dir: -1,
-                collector: None,
-            };
-            let build =
-                |r: Result<BodyId, crate::world::BuildError>| r.map_err(|x| bad(i, x.to_string()));
-            match &def.kind {
-                EntityKind::PlayerSpawn => g.spawns.push(i),
-                EntityKind::Block => {
-                    let b = build(g.world.add_body(BodyDesc::fixed(def.pos)))?;
-                    let c = ColliderDesc::solid(shape.expect("box")).layers(LAYER_SOLID, u32::MAX);
-                    g.world
-                        .add_collider(b, c)
-                        .map_err(|x| bad(i, x.to_string()))?;
-                    e.body = Some(b);
-                }
-                EntityKind::PolygonBlock { vertices } => {
-                    let poly = ConvexPolygon::new(vertices)
-                        .map_err(|x| bad(i, format!("polygon: {x}")))?;
-                    let b = build(g.world.add_body(BodyDesc::fixed(def.pos)))?;
-                    let c = ColliderDesc::solid(poly).layers(LAYER_SOLID, u32::MAX);
-                    g.world
-                        .add_collider(b, c)
-                        .map_err(|x| bad(i, x.to_string()))?;
-                    g.polygons
-                        .push(polygon_ground::PolygonSolid::new(b, def.pos, &poly));
-                    e.body = Some(b);
-                }
-                EntityKind::MovingPlatform { motion, one_way } => {
-                    let path = PathSchedule::new(motion).map_err(|m| bad(i, m))?;
-                    let b = build(g.world.add_body(BodyDesc::kinematic(path.at(0))))?;
-                    let mut c =
-                        ColliderDesc::solid(shape.expect("box")).layers(LAYER_SOLID, u32::MAX);
-                    if *one_way {
-                        c = c.one_way(OneWay::Up);
-                    }
-                    g.world
-                        .add_collider(b, c)
-                        .map_err(|x| bad(i, x.to_string()))?;
-                    e.pos = path.at(0);
-                    e.body = Some(b);
-                    e.path = Some(path);
-                    e.one_way = *one_way;
-                    g.platforms.push(i);
-                }
-                EntityKind::Walker { speed } => {
-                    check_speed("walker speed", *speed as i64)
-                        .map_err(|x| bad(i, x.to_string()))?;
-                    let b = build(g.world.add_body(BodyDesc::dynamic(def.pos)))?;
-                    let c = ColliderDesc::solid(shape.expect("box"))
-                        .layers(LAYER_WALKER, LAYER_SOLID | TILEMAP_LAYER);
-                    g.world
-                        .add_collider(b, c)
-                        .map_err(|x| bad(i, x.to_string()))?;
-                    g.world
-                        .set_rider(b, true)
-                        .map_err(|x| bad(i, x.to_string()))?;
-                    e.body = Some(b);
-                    e.param = speed.abs();
-                    g.walkers.push(i);
-                }
-                EntityKind::Springboard { strength } => {
-                    check_speed("springboard strength", *strength as i64)
-                        .map_err(|x| bad(i, x.to_string()))?;
-                    e.param = strength.abs();
-                    g.springs.push(i);
-                }
-                EntityKind::Coin => g.coins.push(i),
-                EntityKind::Checkpoint => g.checkpoints.push(i),
-                EntityKind::Goal => g.goals.push(i),
-                EntityKind::Hazard => g.hazards.push(i),
+            EntityKind::PolygonBlock { vertices } => {
+                let poly =
+                    ConvexPolygon::new(vertices).map_err(|x| bad(format!("polygon: {x}")))?;
+                let b = build(self.world.add_body(BodyDesc::fixed(def.pos)))?;
+                let c = ColliderDesc::solid(poly).layers(LAYER_SOLID, u32::MAX);
+                self.world
+                    .add_collider(b, c)
+                    .map_err(|x| bad(x.to_string()))?;
+                self.polygons
+                    .push(polygon_ground::PolygonSolid::new(b, def.pos, &poly));
+                e.body = Some(b);
             }
-            g.ents.push(e);
+            EntityKind::MovingPlatform { motion, one_way } => {
+                let path = PathSchedule::new(motion).map_err(bad)?;
+                let b = build(self.world.add_body(BodyDesc::kinematic(path.at(0))))?;
+                let mut c = ColliderDesc::solid(shape.expect("box")).layers(LAYER_SOLID, u32::MAX);
+                if *one_way {
+                    c = c.one_way(OneWay::Up);
+                }
+                self.world
+                    .add_collider(b, c)
+                    .map_err(|x| bad(x.to_string()))?;
+                e.pos = path.at(0);
+                e.body = Some(b);
+                e.path = Some(path);
+                e.one_way = *one_way;
+                self.platforms.push(i);
+            }
+            EntityKind::Walker { speed } => {
+                check_speed("walker speed", *speed as i64).map_err(|x| bad(x.to_string()))?;
+                let b = build(self.world.add_body(BodyDesc::dynamic(def.pos)))?;
+                let c = ColliderDesc::solid(shape.expect("box"))
+                    .layers(LAYER_WALKER, LAYER_SOLID | TILEMAP_LAYER);
+                self.world
+                    .add_collider(b, c)
+                    .map_err(|x| bad(x.to_string()))?;
+                self.world
+                    .set_rider(b, true)
+                    .map_err(|x| bad(x.to_string()))?;
+                e.body = Some(b);
+                e.param = speed.abs();
+                self.walkers.push(i);
+            }
+            EntityKind::Springboard { strength } => {
+                check_speed("springboard strength", *strength as i64)
+                    .map_err(|x| bad(x.to_string()))?;
+                e.param = strength.abs();
+                self.springs.push(i);
+            }
+            EntityKind::Coin => self.coins.push(i),
+            EntityKind::Checkpoint => self.checkpoints.push(i),
+            EntityKind::Goal => self.goals.push(i),
+            EntityKind::Hazard => self.hazards.push(i),
         }
-        if g.spawns.is_empty() {
-            return Err(GameError::NoSpawn(level.name.clone()));
-        }
+        Ok(())
+    }
+
+    /// Where players stand at each spawn ([`spawn`]), once every entity is in.
+    fn find_spawn_spots(&mut self) {
         let ground = spawn::Ground {
-            map: g.tilemap(),
-            ents: &g.ents,
-            half: g.config.player.half,
+            map: self.tilemap(),
+            ents: &self.ents,
+            half: self.config.player.half,
         };
-        g.spawn_spots = g
+        self.spawn_spots = self
             .spawns
             .iter()
-            .map(|&i| ground.spots(g.stand_in(&g.ents[i])))
+            .map(|&i| ground.spots(self.stand_in(&self.ents[i])))
             .collect();
-        Ok(g)
     }
 
     /// The configuration.
@@ -895,112 +852,144 @@ impl Game {
     /// ignored (platforms follow the tick). Join and leave events not yet
     /// reported are dropped. Nothing changes on error.
     pub fn restore(&mut self, snapshot: &StateSnapshot) -> Result<(), GameError> {
-        let bad = |m: String| GameError::BadSnapshot(m);
-        snapshot.validate().map_err(|e| bad(e.to_string()))?;
-        let mut players: Vec<(PlayerId, &EntityState, PlayerState)> = Vec::new();
-        // Run records, ascending by player id like `players`.
-        let mut runs: Vec<(PlayerId, RunState)> = Vec::new();
-        let mut found = vec![None::<&EntityState>; self.ents.len()];
+        snapshot
+            .validate()
+            .map_err(|e| bad_snapshot(e.to_string()))?;
+        let read = self.read_snapshot(snapshot)?;
+        // Valid: apply.
+        self.restore_players(read.players, read.runs)?;
+        self.restore_entities(&read.found);
+        self.tick = snapshot.tick;
+        self.place_platforms();
+        self.events.clear();
+        self.pending.clear();
+        Ok(())
+    }
+
+    /// Reads every record of `snapshot` and checks it against this game (the
+    /// first error in record order, then the checks across records);
+    /// changes nothing.
+    fn read_snapshot<'s>(&self, snapshot: &'s StateSnapshot) -> Result<Restored<'s>, GameError> {
+        let mut read = Restored {
+            players: Vec::new(),
+            runs: Vec::new(),
+            found: vec![None; self.ents.len()],
+        };
         for e in &snapshot.entities {
             if e.id >= RUN_ID_BASE {
-                if e.kind != kind::RUN {
-                    return Err(bad(format!(
-                        "entity {} has kind {}, not a run record",
-                        e.id, e.kind
-                    )));
-                }
-                let run = RunState::from_entity(e)
-                    .map_err(|m| bad(format!("run record {}: {m}", e.id)))?;
-                runs.push((PlayerId(e.id - RUN_ID_BASE), run));
+                read.runs.push((PlayerId(e.id - RUN_ID_BASE), read_run(e)?));
                 continue;
             }
-            for (what, v) in [("x", e.pos.x), ("y", e.pos.y)] {
-                check_coord("position", v as i64)
-                    .map_err(|x| bad(format!("entity {}: {what}: {x}", e.id)))?;
-            }
-            for v in [e.vel.x, e.vel.y] {
-                check_speed("velocity", v as i64)
-                    .map_err(|x| bad(format!("entity {}: {x}", e.id)))?;
-            }
+            check_motion(e)?;
             if e.id < ENTITY_ID_BASE {
-                if e.kind != kind::PLAYER {
-                    return Err(bad(format!(
-                        "entity {} has kind {}, not a player",
-                        e.id, e.kind
-                    )));
-                }
-                let st = PlayerState::unpack(e.flags, e.aux).ok_or_else(|| {
-                    bad(format!("player {}: unknown flag bits {:#x}", e.id, e.flags))
-                })?;
-                if st.dead > self.config.player.respawn_delay_ticks {
-                    return Err(bad(format!(
-                        "player {}: dead for {} more ticks, the delay is {}",
-                        e.id, st.dead, self.config.player.respawn_delay_ticks
-                    )));
-                }
-                if st.checkpoint != 0 {
-                    let ok = self
-                        .ents
-                        .get(st.checkpoint as usize - 1)
-                        .is_some_and(|c| c.ty == EntityType::Checkpoint);
-                    if !ok {
-                        return Err(bad(format!(
-                            "player {}: no checkpoint {}",
-                            e.id,
-                            st.checkpoint - 1
-                        )));
-                    }
-                }
-                players.push((PlayerId(e.id), e, st));
+                read.players.push((PlayerId(e.id), e, self.read_player(e)?));
                 continue;
             }
-            let i = (e.id - ENTITY_ID_BASE) as usize;
-            let Some(ent) = self.ents.get(i) else {
-                return Err(bad(format!("no entity {}", e.id)));
-            };
-            if e.kind != ent.ty.code() {
-                return Err(bad(format!(
-                    "entity {} has kind {}, expected {}",
-                    e.id,
-                    e.kind,
-                    ent.ty.code()
-                )));
-            }
-            match ent.ty {
-                EntityType::Platform => {}
-                EntityType::Walker | EntityType::Coin => found[i] = Some(e),
-                _ => return Err(bad(format!("entity {} has no state", e.id))),
+            if let Some(i) = self.read_entity(e)? {
+                read.found[i] = Some(e);
             }
         }
+        self.check_complete(&read)?;
+        Ok(read)
+    }
+
+    /// The state in player record `e`, checked against the configuration
+    /// and the level's checkpoints.
+    fn read_player(&self, e: &EntityState) -> Result<PlayerState, GameError> {
+        if e.kind != kind::PLAYER {
+            return Err(bad_snapshot(format!(
+                "entity {} has kind {}, not a player",
+                e.id, e.kind
+            )));
+        }
+        let st = PlayerState::unpack(e.flags, e.aux).ok_or_else(|| {
+            bad_snapshot(format!("player {}: unknown flag bits {:#x}", e.id, e.flags))
+        })?;
+        if st.dead > self.config.player.respawn_delay_ticks {
+            return Err(bad_snapshot(format!(
+                "player {}: dead for {} more ticks, the delay is {}",
+                e.id, st.dead, self.config.player.respawn_delay_ticks
+            )));
+        }
+        if st.checkpoint != 0 {
+            let ok = self
+                .ents
+                .get(st.checkpoint as usize - 1)
+                .is_some_and(|c| c.ty == EntityType::Checkpoint);
+            if !ok {
+                return Err(bad_snapshot(format!(
+                    "player {}: no checkpoint {}",
+                    e.id,
+                    st.checkpoint - 1
+                )));
+            }
+        }
+        Ok(st)
+    }
+
+    /// Checks record `e` of a level entity against the level: the index of
+    /// the entity whose state it holds (a walker or a coin), or `None` for
+    /// a platform's (ignored: platforms follow the tick).
+    fn read_entity(&self, e: &EntityState) -> Result<Option<usize>, GameError> {
+        let i = (e.id - ENTITY_ID_BASE) as usize;
+        let Some(ent) = self.ents.get(i) else {
+            return Err(bad_snapshot(format!("no entity {}", e.id)));
+        };
+        if e.kind != ent.ty.code() {
+            return Err(bad_snapshot(format!(
+                "entity {} has kind {}, expected {}",
+                e.id,
+                e.kind,
+                ent.ty.code()
+            )));
+        }
+        match ent.ty {
+            EntityType::Platform => Ok(None),
+            EntityType::Walker | EntityType::Coin => Ok(Some(i)),
+            _ => Err(bad_snapshot(format!("entity {} has no state", e.id))),
+        }
+    }
+
+    /// The checks across records: every walker and coin has a record; one
+    /// run record per player (both lists ascend by id), finished exactly
+    /// when the player is.
+    fn check_complete(&self, read: &Restored<'_>) -> Result<(), GameError> {
         for &i in self.walkers.iter().chain(&self.coins) {
-            if found[i].is_none() {
-                return Err(bad(format!(
+            if read.found[i].is_none() {
+                return Err(bad_snapshot(format!(
                     "entity {} is missing",
                     ENTITY_ID_BASE + i as u32
                 )));
             }
         }
-        // One run record per player (both lists ascend by id), finished
-        // exactly when the player is.
+        let (players, runs) = (&read.players, &read.runs);
         if runs.len() != players.len() {
-            return Err(bad(format!(
+            return Err(bad_snapshot(format!(
                 "{} run records for {} players",
                 runs.len(),
                 players.len()
             )));
         }
-        for ((id, _, st), (rid, run)) in players.iter().zip(&runs) {
+        for ((id, _, st), (rid, run)) in players.iter().zip(runs) {
             if id != rid {
-                return Err(bad(format!("player {id} has no run record")));
+                return Err(bad_snapshot(format!("player {id} has no run record")));
             }
             if st.won != (run.order != 0) {
-                return Err(bad(format!(
+                return Err(bad_snapshot(format!(
                     "player {id}: the won flag and the run's finishing order disagree"
                 )));
             }
         }
-        // Valid: apply. Players first: drop those not in the snapshot, add
-        // the new ones, then set every state.
+        Ok(())
+    }
+
+    /// Applies the snapshot's players: drops those not in it, adds the new
+    /// ones, then sets every state.
+    fn restore_players(
+        &mut self,
+        players: Vec<(PlayerId, &EntityState, PlayerState)>,
+        runs: Vec<(PlayerId, RunState)>,
+    ) -> Result<(), GameError> {
         let old: Vec<Player> = std::mem::take(&mut self.players);
         let mut kept = Vec::with_capacity(players.len());
         for p in old {
@@ -1032,6 +1021,11 @@ impl Game {
                 restart: false,
             });
         }
+        Ok(())
+    }
+
+    /// Applies the walker and coin records, `found[i]` for entity `i`.
+    fn restore_entities(&mut self, found: &[Option<&EntityState>]) {
         for (i, e) in found.iter().enumerate() {
             let Some(e) = e else { continue };
             let body = self.ents[i].body;
@@ -1056,11 +1050,6 @@ impl Game {
                 _ => {}
             }
         }
-        self.tick = snapshot.tick;
-        self.place_platforms();
-        self.events.clear();
-        self.pending.clear();
-        Ok(())
     }
 
     /// Sets a body's position and velocity (both validated by the caller).
@@ -1116,4 +1105,53 @@ impl Game {
         self.tick += 1;
         &self.events
     }
+}
+
+/// A snapshot's records, read and checked by [`Game::restore`] before it
+/// changes anything.
+struct Restored<'s> {
+    /// Player records with their state, in snapshot order (ascending by id).
+    players: Vec<(PlayerId, &'s EntityState, PlayerState)>,
+    /// Run records, ascending by player id like `players`.
+    runs: Vec<(PlayerId, RunState)>,
+    /// The record of each walker and coin, by entity index.
+    found: Vec<Option<&'s EntityState>>,
+}
+
+/// The error for a snapshot that does not describe the game.
+fn bad_snapshot(m: String) -> GameError {
+    GameError::BadSnapshot(m)
+}
+
+/// The error for entity `i` of `level`.
+fn bad_entity(level: &Level, i: usize, m: String) -> GameError {
+    GameError::BadLevel {
+        level: level.name.clone(),
+        message: format!("entity {i}: {m}"),
+    }
+}
+
+/// The run in run record `e`.
+fn read_run(e: &EntityState) -> Result<RunState, GameError> {
+    if e.kind != kind::RUN {
+        return Err(bad_snapshot(format!(
+            "entity {} has kind {}, not a run record",
+            e.id, e.kind
+        )));
+    }
+    RunState::from_entity(e).map_err(|m| bad_snapshot(format!("run record {}: {m}", e.id)))
+}
+
+/// Checks the position and velocity of record `e` against the numeric
+/// bounds.
+fn check_motion(e: &EntityState) -> Result<(), GameError> {
+    for (what, v) in [("x", e.pos.x), ("y", e.pos.y)] {
+        check_coord("position", v as i64)
+            .map_err(|x| bad_snapshot(format!("entity {}: {what}: {x}", e.id)))?;
+    }
+    for v in [e.vel.x, e.vel.y] {
+        check_speed("velocity", v as i64)
+            .map_err(|x| bad_snapshot(format!("entity {}: {x}", e.id)))?;
+    }
+    Ok(())
 }

@@ -4,40 +4,16 @@
 use glam::IVec2;
 
 use super::config::{CarryMode, PlayerConfig};
+use super::entity::EntityType;
 use super::polygon_ground::{PolygonSolid, SLOPE_RUN, TOUCH};
+use super::rect::Rect;
 use super::state::{PlayerState, RunState, RUN_MAX};
-use super::{EntityType, Game, GameEvent, HurtCause, Player, ENTITY_ID_BASE};
+use super::{Game, GameEvent, HurtCause, Player, ENTITY_ID_BASE};
 use crate::fixed::MAX_SPEED;
 use crate::input::Buttons;
 use crate::protocol::PlayerId;
 use crate::tilemap::{ContactFlags, Tile, TileContact, Tilemap};
 use crate::world::{BodyId, Event, Sides};
-
-/// A box by its edges, in `i64` units.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Rect {
-    pub(super) l: i64,
-    pub(super) t: i64,
-    pub(super) r: i64,
-    pub(super) b: i64,
-}
-
-impl Rect {
-    pub(super) fn new(centre: IVec2, half: IVec2) -> Self {
-        let (c, h) = (centre.as_i64vec2(), half.as_i64vec2());
-        Rect {
-            l: c.x - h.x,
-            t: c.y - h.y,
-            r: c.x + h.x,
-            b: c.y + h.y,
-        }
-    }
-
-    /// Interiors overlap.
-    pub(super) fn overlaps(&self, o: &Rect) -> bool {
-        self.l < o.r && o.l < self.r && self.t < o.b && o.t < self.b
-    }
-}
 
 /// Horizontal speed after one tick of `dir` (-1, 0, 1) from `vx`.
 fn run(vx: i32, dir: i32, accel: i32, brake: i32, max: i32) -> i32 {
@@ -394,22 +370,50 @@ impl Game {
 
     /// The rules after the physics step, for live player `i`.
     fn live_player_after(&mut self, i: usize) {
-        let cfg = self.config.player;
         let mut p = self.players[i];
-        let id = p.id;
-        let body = self.world.body(p.body).expect("player body");
-        let (mut pos, mut vel, mut sides) = (body.pos(), body.vel(), body.sides());
-        let disp = body.displacement();
-        let pushed = body.pushed();
-        let carrier = body.carrier();
-        let dropping = body.drops_through();
-
-        if self.squished.contains(&p.body.0) {
-            self.die(&mut p, HurtCause::Squished);
+        let mut m = self.moved(p.body);
+        if let Some(cause) = self.fatal_touch(p.body, m.pos) {
+            self.die(&mut p, cause);
             self.players[i] = p;
             return;
         }
-        let hazard = if self.in_hazard_tile.contains(&p.body.0) {
+        self.polygon_faces(p.body, &mut m);
+        stop_at_surfaces(&mut p.st, &mut m);
+        self.ground_snap(&p, &mut m);
+        self.carry_off(&mut m);
+        let r = Rect::new(m.pos, self.config.player.half);
+        if !self.stomp_or_hurt(&mut p, &r, &mut m) {
+            self.players[i] = p;
+            return;
+        }
+        self.springboards(&mut p, &r, &mut m);
+        self.collect(&mut p, &r);
+        self.settle(&mut p, &m);
+        self.players[i] = p;
+    }
+
+    /// Reads the player body `body` as the physics step left it.
+    fn moved(&self, body: BodyId) -> Moved {
+        let b = self.world.body(body).expect("player body");
+        Moved {
+            pos: b.pos(),
+            vel: b.vel(),
+            sides: b.sides(),
+            disp: b.displacement(),
+            pushed: b.pushed(),
+            carrier: b.carrier(),
+            dropping: b.drops_through(),
+            grounded: false,
+        }
+    }
+
+    /// What kills player body `body` at `pos` before any other rule: being
+    /// squished, then a hazard tile, falling out, a hazard entity.
+    fn fatal_touch(&self, body: BodyId, pos: IVec2) -> Option<HurtCause> {
+        let cfg = self.config.player;
+        if self.squished.contains(&body.0) {
+            Some(HurtCause::Squished)
+        } else if self.in_hazard_tile.contains(&body.0) {
             Some(HurtCause::HazardTile)
         } else if pos.y - cfg.half.y > self.fall_y {
             Some(HurtCause::Fell)
@@ -419,80 +423,77 @@ impl Game {
                 .iter()
                 .find(|&&h| Rect::new(self.ents[h].pos, self.ents[h].half).overlaps(&r))
                 .map(|&h| HurtCause::Hazard(ENTITY_ID_BASE + h as u32))
-        };
-        if let Some(cause) = hazard {
-            self.die(&mut p, cause);
-            self.players[i] = p;
+        }
+    }
+
+    /// Polygon faces: a walkable one holds the player like a tile slope
+    /// (ground, no slide), a steeper one is a wall.
+    fn polygon_faces(&mut self, body: BodyId, m: &mut Moved) {
+        if self.polygons.is_empty() || m.carrier.is_some() {
             return;
         }
-
-        // Polygon faces: a walkable one holds the player like a tile slope
-        // (ground, no slide), a steeper one is a wall.
-        if !self.polygons.is_empty() && carrier.is_none() {
-            if let Some(pc) = self.polygon_contacts(p.body, pos, disp, pushed, sides) {
-                sides = pc.sides;
-                if let Some((shift, v)) = pc.unslide {
-                    if self.tiles_clear(pos + shift, cfg.half, disp + shift, dropping) {
-                        self.world
-                            .shift(p.body, shift)
-                            .expect("unslide within bounds");
-                        pos += shift;
-                        vel = v;
-                    }
-                }
+        let Some(pc) = self.polygon_contacts(body, m.pos, m.disp, m.pushed, m.sides) else {
+            return;
+        };
+        m.sides = pc.sides;
+        if let Some((shift, v)) = pc.unslide {
+            let half = self.config.player.half;
+            if self.tiles_clear(m.pos + shift, half, m.disp + shift, m.dropping) {
+                self.world
+                    .shift(body, shift)
+                    .expect("unslide within bounds");
+                m.pos += shift;
+                m.vel = v;
             }
         }
+    }
 
-        let s = &mut p.st;
-        // A ceiling stops the rise; a wall stops the run.
-        if sides.contains(Sides::TOP) {
-            vel.y = vel.y.max(0);
-            s.hold = 0;
+    /// Ground snap: walking down a slope (or off a small step) keeps a
+    /// grounded player on the ground instead of launching it.
+    fn ground_snap(&mut self, p: &Player, m: &mut Moved) {
+        if m.grounded || !p.st.grounded || m.vel.y < 0 || m.dropping || m.carrier.is_some() {
+            return;
         }
-        if (sides.contains(Sides::LEFT) && vel.x < 0) || (sides.contains(Sides::RIGHT) && vel.x > 0)
-        {
-            vel.x = 0;
+        let cfg = self.config.player;
+        let map = self.world.tilemap().expect("a game's world has a tilemap");
+        let mut drop = snap_drop(
+            map,
+            m.pos,
+            cfg.half,
+            cfg.snap_distance,
+            &mut self.tile_scratch,
+        );
+        if !self.polygons.is_empty() {
+            drop = self.polygon_snap(m.pos, drop);
         }
-        let mut grounded = sides.contains(Sides::BOTTOM);
-
-        // Ground snap: walking down a slope (or off a small step) keeps a
-        // grounded player on the ground instead of launching it.
-        if !grounded && s.grounded && vel.y >= 0 && !dropping && carrier.is_none() {
-            let map = self.world.tilemap().expect("a game's world has a tilemap");
-            let mut drop = snap_drop(
-                map,
-                pos,
-                cfg.half,
-                cfg.snap_distance,
-                &mut self.tile_scratch,
-            );
-            if !self.polygons.is_empty() {
-                drop = self.polygon_snap(pos, drop);
+        if let Some(d) = drop {
+            if d != 0 {
+                self.world
+                    .shift(p.body, IVec2::new(0, d))
+                    .expect("snap within bounds");
             }
-            if let Some(d) = drop {
-                if d != 0 {
-                    self.world
-                        .shift(p.body, IVec2::new(0, d))
-                        .expect("snap within bounds");
-                }
-                pos.y += d;
-                vel.y = 0;
-                grounded = true;
-            }
+            m.pos.y += d;
+            m.vel.y = 0;
+            m.grounded = true;
         }
+    }
 
-        // Leaving a platform keeps (some of) its velocity.
-        if let (Some(c), false) = (carrier, grounded) {
+    /// Leaving a platform keeps (some of) its velocity.
+    fn carry_off(&self, m: &mut Moved) {
+        if let (Some(c), false) = (m.carrier, m.grounded) {
             let pv = self.body_vel(c);
-            match cfg.carry_mode {
-                CarryMode::Add => vel += pv,
-                CarryMode::AddUpOnly => vel.y += pv.y.min(0),
+            match self.config.player.carry_mode {
+                CarryMode::Add => m.vel += pv,
+                CarryMode::AddUpOnly => m.vel.y += pv.y.min(0),
                 CarryMode::None => {}
             }
         }
+    }
 
-        // Enemies: land on the head from above to stomp, else get hurt.
-        let r = Rect::new(pos, cfg.half);
+    /// Enemies: land on the head from above to stomp, else get hurt; false
+    /// when the player (box `r`) died of it.
+    fn stomp_or_hurt(&mut self, p: &mut Player, r: &Rect, m: &mut Moved) -> bool {
+        let cfg = self.config.player;
         for k in 0..self.walkers.len() {
             let w = self.walkers[k];
             let e = &self.ents[w];
@@ -504,57 +505,67 @@ impl Game {
                 .body(e.body.expect("walker body"))
                 .expect("walker body");
             let wr = Rect::new(wb.pos(), e.half);
-            if !wr.overlaps(&r) {
+            if !wr.overlaps(r) {
                 continue;
             }
-            let start_bottom = r.b - disp.y as i64;
+            let start_bottom = r.b - m.disp.y as i64;
             let start_top = wr.t - wb.displacement().y as i64;
-            let falling = disp.y > wb.displacement().y;
+            let falling = m.disp.y > wb.displacement().y;
             let enemy = ENTITY_ID_BASE + w as u32;
             if falling && start_bottom <= start_top + cfg.stomp_tolerance as i64 {
                 self.defeat(w);
                 let s = &mut p.st;
                 if s.jump_held {
-                    vel.y = -cfg.jump_speed;
+                    m.vel.y = -cfg.jump_speed;
                     s.hold = cfg.jump_hold_ticks;
                 } else {
-                    vel.y = -cfg.stomp_bounce_speed;
+                    m.vel.y = -cfg.stomp_bounce_speed;
                     s.hold = 0;
                 }
                 s.coyote = 0;
-                grounded = false;
-                self.events.push(GameEvent::Stomped { player: id, enemy });
+                m.grounded = false;
+                self.events.push(GameEvent::Stomped {
+                    player: p.id,
+                    enemy,
+                });
             } else {
-                self.die(&mut p, HurtCause::Enemy(enemy));
-                self.players[i] = p;
-                return;
+                self.die(p, HurtCause::Enemy(enemy));
+                return false;
             }
         }
+        true
+    }
 
-        // Springboards launch once per touch.
+    /// Springboards launch once per touch (of the player's box `r`).
+    fn springboards(&mut self, p: &mut Player, r: &Rect, m: &mut Moved) {
         let spring = self
             .springs
             .iter()
             .copied()
-            .find(|&k| Rect::new(self.ents[k].pos, self.ents[k].half).overlaps(&r));
+            .find(|&k| Rect::new(self.ents[k].pos, self.ents[k].half).overlaps(r));
         if let Some(k) = spring {
             if !p.st.on_spring {
-                vel.y = -self.ents[k].param;
+                m.vel.y = -self.ents[k].param;
                 p.st.hold = 0;
                 p.st.coyote = 0;
-                grounded = false;
+                m.grounded = false;
                 self.events.push(GameEvent::Launched {
-                    player: id,
+                    player: p.id,
                     springboard: ENTITY_ID_BASE + k as u32,
                 });
             }
         }
         p.st.on_spring = spring.is_some();
+    }
 
+    /// Coins, checkpoints and goals the player's box `r` touches, in that
+    /// order.
+    fn collect(&mut self, p: &mut Player, r: &Rect) {
+        let id = p.id;
         for k in 0..self.coins.len() {
             let c = self.coins[k];
             let e = &self.ents[c];
-            if e.collector.is_none() && Rect::new(e.pos, e.half).overlaps(&r) {
+            if e.collector.is_none() && Rect::new(e.pos, e.half).overlaps(r) {
                 self.ents[c].collector = Some(id.0);
                 let total = self.coins_of(id);
                 self.events.push(GameEvent::CoinPicked {
@@ -567,7 +578,7 @@ impl Game {
         for k in 0..self.checkpoints.len() {
             let c = self.checkpoints[k];
             let e = &self.ents[c];
-            if p.st.checkpoint as usize != c + 1 && Rect::new(e.pos, e.half).overlaps(&r) {
+            if p.st.checkpoint as usize != c + 1 && Rect::new(e.pos, e.half).overlaps(r) {
                 p.st.checkpoint = (c + 1) as u16;
                 self.events.push(GameEvent::Checkpoint {
                     player: id,
@@ -579,7 +590,7 @@ impl Game {
             && self
                 .goals
                 .iter()
-                .any(|&k| Rect::new(self.ents[k].pos, self.ents[k].half).overlaps(&r))
+                .any(|&k| Rect::new(self.ents[k].pos, self.ents[k].half).overlaps(r))
         {
             p.st.won = true;
             p.run.order = self.next_order();
@@ -589,17 +600,49 @@ impl Game {
                 place: self.place_of(p.run.order),
             });
         }
-
-        let s = &mut p.st;
-        if grounded {
-            s.coyote = cfg.coyote_ticks;
-        }
-        s.grounded = grounded;
-        self.world
-            .set_velocity(p.body, clamp_speed(vel))
-            .expect("clamped player speed");
-        self.players[i] = p;
     }
+
+    /// Coyote time and the grounded flag from this tick, and the velocity
+    /// the rules leave on the body.
+    fn settle(&mut self, p: &mut Player, m: &Moved) {
+        let s = &mut p.st;
+        if m.grounded {
+            s.coyote = self.config.player.coyote_ticks;
+        }
+        s.grounded = m.grounded;
+        self.world
+            .set_velocity(p.body, clamp_speed(m.vel))
+            .expect("clamped player speed");
+    }
+}
+
+/// A live player's body after the physics step, as the rules after it read
+/// and change it ([`Game::live_player_after`]).
+struct Moved {
+    pos: IVec2,
+    vel: IVec2,
+    sides: Sides,
+    disp: IVec2,
+    pushed: IVec2,
+    carrier: Option<BodyId>,
+    dropping: bool,
+    /// Standing on something this tick (set by [`stop_at_surfaces`], then
+    /// by the snap, stomps and springboards).
+    grounded: bool,
+}
+
+/// A ceiling stops the rise; a wall stops the run; a floor grounds.
+fn stop_at_surfaces(s: &mut PlayerState, m: &mut Moved) {
+    if m.sides.contains(Sides::TOP) {
+        m.vel.y = m.vel.y.max(0);
+        s.hold = 0;
+    }
+    if (m.sides.contains(Sides::LEFT) && m.vel.x < 0)
+        || (m.sides.contains(Sides::RIGHT) && m.vel.x > 0)
+    {
+        m.vel.x = 0;
+    }
+    m.grounded = m.sides.contains(Sides::BOTTOM);
 }
 
 /// What this tick's polygon contacts change for a player

@@ -26,8 +26,8 @@
 
 use glam::IVec2;
 
-use super::rules::Rect;
-use super::{Ent, EntityType};
+use super::entity::{Ent, EntityType};
+use super::rect::Rect;
 use crate::fixed::UNITS_PER_PX;
 use crate::tilemap::{ContactFlags, TileContact, Tilemap};
 

@@ -4,20 +4,9 @@ use crate::fixed::{check_coord, check_speed, MAX_COORD};
 use glam::IVec2;
 use serde::{Deserialize, Serialize};
 
-use super::BuildError;
+pub use super::id::BodyId;
 
-/// A body's index in its world: creation order, except that
-/// [`super::World::add_body`] reuses the lowest slot freed by
-/// [`super::World::remove_body`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-pub struct BodyId(pub u32);
-
-impl BodyId {
-    /// The world's tilemap, as the other body of a tile contact (in
-    /// [`super::Event`]s and [`super::ContactRecord`]s). No real body has
-    /// this id.
-    pub const TILEMAP: BodyId = BodyId(u32::MAX);
-}
+use super::error::BuildError;
 
 /// How a body takes part in the simulation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -218,6 +207,14 @@ pub(crate) fn validate_velocity(kind: BodyKind, vel: IVec2) -> Result<(), BuildE
     Ok(())
 }
 
+/// Most sweeps of one body in one substep (a slide continues after a hit;
+/// see `sweep`).
+pub(crate) const MAX_SWEEPS: usize = 3;
+
+/// The surfaces a body's last sweep hit (`(other collider, normal)`), for
+/// the sweep's "reported once" rule: kept in [`Body`], filled by `sweep`.
+pub(crate) type Rest = [Option<(u32, IVec2)>; MAX_SWEEPS];
+
 /// A body's state.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Body {
@@ -250,7 +247,7 @@ pub struct Body {
     /// The surfaces its last sweep hit, `(other collider, normal)`: a hit
     /// at time 0 on one of them (resting against it and still pushing) is
     /// not reported again.
-    pub(crate) swept_rest: super::sweep::Rest,
+    pub(crate) swept_rest: Rest,
 }
 
 impl Body {
@@ -270,7 +267,7 @@ impl Body {
             carrier: None,
             swept: false,
             sweep_response: SweepResponse::Slide,
-            swept_rest: [None; super::sweep::MAX_SWEEPS],
+            swept_rest: [None; MAX_SWEEPS],
         }
     }
 

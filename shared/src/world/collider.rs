@@ -5,19 +5,10 @@ use crate::shape::{Aabb, Circle, ConvexPolygon, Obb, Point, Segment, Shape, Shap
 use glam::IVec2;
 use serde::{Deserialize, Serialize};
 
-use super::body::BodyId;
+pub use super::id::ColliderId;
 
-/// A collider's index in its world, in creation order (stable for the world's
-/// life, never reused; also the tie-breaker that makes every ordering
-/// deterministic).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-pub struct ColliderId(pub u32);
-
-impl ColliderId {
-    /// The world's tilemap, as the other collider of a tile contact. No real
-    /// collider has this id.
-    pub const TILEMAP: ColliderId = ColliderId(u32::MAX);
-}
+use super::error::BuildError;
+use super::id::BodyId;
 
 /// Whether a collider blocks or only reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -193,11 +184,11 @@ impl ColliderDesc {
     }
 
     /// Checks the offset against the bounds.
-    pub(crate) fn validate(&self) -> Result<(), super::BuildError> {
+    pub(crate) fn validate(&self) -> Result<(), BuildError> {
         check_extent("collider offset x", self.offset.x as i64)?;
         check_extent("collider offset y", self.offset.y as i64)?;
         if self.one_way.is_some() && self.mode == ColliderMode::Trigger {
-            return Err(super::BuildError::OneWayTrigger);
+            return Err(BuildError::OneWayTrigger);
         }
         Ok(())
     }

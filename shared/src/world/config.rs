@@ -11,7 +11,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::BuildError;
+use super::error::BuildError;
 use crate::fixed::{px, MAX_SPEED};
 
 /// Most substeps or restitution passes a configuration may ask for.

@@ -4,8 +4,8 @@
 use crate::query::Proximity;
 use glam::IVec2;
 
-use super::body::BodyId;
-use super::collider::{ColliderId, Colliders, OneWay};
+use super::collider::{Colliders, OneWay};
+use super::id::{BodyId, ColliderId};
 
 /// Re-runs the narrow phase for one pair, given the two *body* positions:
 /// `fn(colliders, index of A in its set, body pos of A, index of B, body pos of B)`.

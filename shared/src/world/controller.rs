@@ -1,18 +1,23 @@
 //! Controllers: turn one player's buttons into a body's velocity, once per
 //! tick, before anything moves. Input slot `i` of [`super::World::step`]
-//! drives controller `i`.
+//! drives controller `i` (a missing input is no button held); removing a
+//! body drops its controllers and moves the later ones down one slot.
 //!
-//! Only the top-down [`Mover`] exists so far (the warm-up room); the
-//! platformer controller will be another variant of [`Controller`].
+//! The only controller is the top-down [`Mover`] (the warm-up room of
+//! [`crate::scene`], the seeded [`super::scenes`]). The platformer is not a
+//! controller: [`crate::game`] sets its player bodies' velocities by its own
+//! rules before and after each [`super::World::step`], which it runs with
+//! no inputs.
 
 use crate::fixed::MAX_SPEED;
 use crate::input::Buttons;
 use glam::IVec2;
 use serde::{Deserialize, Serialize};
 
-use super::body::{Body, BodyId};
+use super::body::Body;
+use super::error::BuildError;
 use super::hash::Fnv1a;
-use super::BuildError;
+use super::id::BodyId;
 
 /// Tuning of the top-down [`Mover`], in units per tick (per tick for speeds,
 /// per tick per tick for `accel` and `brake`). Each axis is independent.

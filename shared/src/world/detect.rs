@@ -42,11 +42,12 @@ use crate::shape::{Aabb, Circle, ConvexPolygon, Obb, Point, Segment, ShapeKind};
 use crate::tilemap::{ContactFlags, Tile, TileContact, TileShape, Tilemap};
 use glam::IVec2;
 
-use super::body::{Body, BodyId, BodyKind};
+use super::body::{Body, BodyKind};
 use super::collider::{ColliderData, Colliders, Stored};
 use super::config::BroadPhaseKind;
 use super::contact::{ContactKind, ContactRecord, End, RecheckFn};
-use super::layout::{Layout, Slot, GONE};
+use super::id::{BodyId, TILEMAP_LAYER, TILEMAP_TAG};
+use super::layout::{Layout, Slot, TileShapeRef, GONE};
 
 /// Clears `out` and fills it with every overlapping pair that matters
 /// (brute force):
@@ -675,13 +676,6 @@ fn slot_end(id: u32, s: &Slot) -> End {
     }
 }
 
-/// The layer bit of the world's tilemap: a collider interacts with tiles when
-/// its `mask` has this bit (the default mask has every bit).
-pub const TILEMAP_LAYER: u32 = 1 << 31;
-
-/// The tag tile contacts report for the tilemap end (in events).
-pub const TILEMAP_TAG: u16 = u16::MAX;
-
 /// The tile query flags of a body.
 #[inline]
 pub(crate) fn tile_flags(b: &Body) -> ContactFlags {
@@ -746,10 +740,6 @@ pub(crate) fn detect_tiles(
         }
     }
 }
-
-/// A non-box collider the tilemap is asked about: `(collider id, kind,
-/// index in its kind's set)`.
-pub(crate) type TileShapeRef = (u32, ShapeKind, u32);
 
 /// Whether a collider is asked about tiles: solid, of a dynamic body, mask
 /// with [`TILEMAP_LAYER`].

@@ -3,7 +3,7 @@
 use crate::fixed::BoundsError;
 use thiserror::Error;
 
-use super::body::BodyId;
+use super::id::BodyId;
 
 /// A body, collider, controller or configuration the world refuses.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]

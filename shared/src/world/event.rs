@@ -3,8 +3,8 @@
 use glam::IVec2;
 use serde::{Deserialize, Serialize};
 
-use super::body::{BodyId, Sides};
-use super::collider::ColliderId;
+use super::body::Sides;
+use super::id::{BodyId, ColliderId};
 
 /// Something that happened during a tick.
 ///

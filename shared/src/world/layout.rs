@@ -13,7 +13,7 @@ use glam::IVec2;
 use super::body::{Body, BodyKind};
 use super::collider::{Colliders, OneWay};
 use super::config::Pipeline;
-use super::detect::{TileShapeRef, TILEMAP_LAYER};
+use super::id::TILEMAP_LAYER;
 
 /// What a scene uses: shape kinds, tilemap features, one-way colliders,
 /// triggers, moving platforms and riders. [`super::World::features`]
@@ -80,6 +80,10 @@ pub(crate) struct Slot {
     pub one_way: Option<OneWay>,
     pub tag: u16,
 }
+
+/// A non-box collider the tilemap is asked about: `(collider id, kind,
+/// index in its kind's set)`.
+pub(crate) type TileShapeRef = (u32, ShapeKind, u32);
 
 /// [`Slot::index`] of a removed collider.
 pub(crate) const GONE: u32 = u32::MAX;

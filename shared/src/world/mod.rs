@@ -61,6 +61,9 @@
 //!   trigger logging without triggers, and re-detection after a
 //!   restitution pass only around the bodies the pass moved. Same results,
 //!   bit for bit, as [`Pipeline::General`].
+//! * `id`: [`BodyId`], [`ColliderId`] and the tilemap's stand-ins for them
+//!   ([`TILEMAP_LAYER`], [`TILEMAP_TAG`]), the bottom layer every part
+//!   names;
 //! * [`body`]: static, kinematic and dynamic bodies, touched [`Sides`];
 //! * [`collider`]: shapes attached to bodies, one `Vec` per shape kind;
 //! * [`contact`]: the element of the single, reused contact buffer;
@@ -90,20 +93,21 @@ mod detect;
 mod error;
 pub mod event;
 pub mod hash;
+mod id;
 mod layout;
 mod presets;
 mod restitute;
 pub mod scenes;
 mod sweep;
 
-pub use body::{Body, BodyDesc, BodyId, BodyKind, Sides, SweepResponse};
-pub use collider::{AnyShape, ColliderDesc, ColliderId, ColliderMode, ColliderView, OneWay};
+pub use body::{Body, BodyDesc, BodyKind, Sides, SweepResponse};
+pub use collider::{AnyShape, ColliderDesc, ColliderMode, ColliderView, OneWay};
 pub use config::{BroadPhaseKind, Pipeline, SimConfig, SweepMode, MAX_THREADS};
 pub use contact::{ContactKind, ContactRecord};
 pub use controller::{Controller, Mover, MoverConfig};
-pub use detect::{TILEMAP_LAYER, TILEMAP_TAG};
 pub use error::BuildError;
 pub use event::Event;
+pub use id::{BodyId, ColliderId, TILEMAP_LAYER, TILEMAP_TAG};
 pub use layout::SceneFeatures;
 pub use restitute::ONE_WAY_SLOP;
 

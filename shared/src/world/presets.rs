@@ -2,7 +2,7 @@
 //! `exact`. Their measured cost and accuracy are in `docs/TRADEOFFS.md`
 //! (`ledge-sim tradeoff`).
 
-use super::{SimConfig, SweepMode};
+use super::config::{SimConfig, SweepMode};
 
 impl SimConfig {
     /// The cheapest configuration that still plays well: one substep and two

@@ -54,25 +54,19 @@ use crate::shape::{Aabb, Circle, ConvexPolygon, Obb, Point, Segment, ShapeKind};
 use crate::tilemap::{ContactFlags, Tilemap};
 use glam::{I64Vec2, IVec2};
 
-use super::body::{Body, BodyId, BodyKind, Sides, SweepResponse};
-use super::collider::{ColliderId, Colliders, Stored};
+use super::body::{Body, BodyKind, Rest, Sides, SweepResponse, MAX_SWEEPS};
+use super::collider::{Colliders, Stored};
 use super::config::{BroadPhaseKind, SweepMode};
-use super::detect::{tile_flags, TILEMAP_LAYER, TILEMAP_TAG};
+use super::detect::tile_flags;
 use super::event::{Event, Logs};
+use super::id::{BodyId, ColliderId, TILEMAP_LAYER, TILEMAP_TAG};
 use super::layout::{Layout, Slot, GONE};
-
-/// Most sweeps of one body in one substep (a slide continues after a hit).
-pub(crate) const MAX_SWEEPS: usize = 3;
 
 /// Most pieces a diagonal path is cut into for the static query.
 pub(crate) const MAX_CHUNKS: i64 = 64;
 
 /// Shortest side, in units, of a piece of a diagonal path (256 px).
 const CHUNK: i64 = 1 << 16;
-
-/// The surfaces a body's last sweep hit (`(other collider, normal)`), for
-/// the "reported once" rule.
-pub(crate) type Rest = [Option<(u32, IVec2)>; MAX_SWEEPS];
 
 /// What the sweeps need besides the bodies, kept between ticks.
 #[derive(Debug, Clone, Default)]

@@ -1,6 +1,7 @@
 //! The simulation's integration tests in one binary (one link step; every
 //! file a module). Allocation tests count per thread with one counting
-//! allocator (`counting_alloc`).
+//! allocator (`counting_alloc`). The tile suites share their helpers
+//! (`tile_kit`).
 
 #[global_allocator]
 static GLOBAL: counting_alloc::Counting = counting_alloc::Counting;
@@ -27,6 +28,7 @@ mod runs;
 mod spawn_spread;
 mod stability;
 mod sweep;
+mod tile_kit;
 mod tilemap;
 mod tilemap_shapes;
 mod tilemap_sizes;

@@ -3,8 +3,8 @@
 //! running over slopes without leaving the ground.
 
 use crate::platformer_kit;
+use crate::tile_kit::run_hills;
 
-use glam::IVec2;
 use ledge_shared::game::{GameConfig, GameEvent, PlayerConfig};
 use ledge_shared::level::EntityKind;
 use ledge_shared::world::Sides;
@@ -282,68 +282,10 @@ fn down_and_jump_drops_through_a_one_way_tile() {
     assert!(s.saw(jumped));
 }
 
-/// Flat, a 45 degree hill two tiles high, flat, a 22.5 degree hill one tile
-/// high, flat; floor top at row 11.
-const HILLS: [&str; 12] = [
-    "##############################",
-    "#............................#",
-    "#............................#",
-    "#............................#",
-    "#............................#",
-    "#............................#",
-    "#............................#",
-    "#............................#",
-    "#............................#",
-    "#...../##\\...................#",
-    "#..../####\\.....ab##cd.......#",
-    "##############################",
-];
-
-/// Runs over the hills at `speed` from column `from` to column `to`,
-/// checking every tick that the player is grounded with its foot on the
-/// surface.
-fn run_hills(speed: i32, from: i32, to: i32) {
-    let cfg = GameConfig {
-        player: PlayerConfig {
-            max_run_speed: speed,
-            run_accel: speed.min(40),
-            snap_distance: 1024.max(speed + 256),
-            ..PlayerConfig::default()
-        },
-        ..GameConfig::default()
-    };
-    let lv = level(&HILLS, vec![ent(EntityKind::PlayerSpawn, from, 10)]);
-    let mut s = Sim::with(&lv, cfg);
-    s.land(10);
-    let b = if to > from { RIGHT } else { LEFT };
-    let map = s.game.tilemap().clone();
-    let mut ticks = 0;
-    let mut min_bottom = s.bottom();
-    while (s.pos().x - (to * T + T / 2)) * (to - from).signum() < 0 {
-        s.step(b);
-        ticks += 1;
-        let v = s.view();
-        let foot = IVec2::new(v.pos.x, v.pos.y + v.half.y);
-        assert!(
-            v.grounded,
-            "speed {speed}: airborne at {foot} after {ticks} ticks"
-        );
-        assert_eq!(
-            map.ground_below(foot, 0),
-            Some(foot.y),
-            "speed {speed}: foot {foot} not on the surface after {ticks} ticks"
-        );
-        min_bottom = min_bottom.min(foot.y);
-        assert!(ticks < 100_000);
-    }
-    // It did go over the 45 degree hill (two tiles up).
-    assert_eq!(min_bottom, 9 * T, "speed {speed}");
-}
-
 #[test]
 fn running_over_45_and_22_5_degree_slopes_never_leaves_the_ground() {
     for speed in [64, 256, 640, 1000, 1536] {
-        run_hills(speed, 2, 26);
-        run_hills(speed, 26, 2);
+        run_hills(T, 10, speed, 2, 26);
+        run_hills(T, 10, speed, 26, 2);
     }
 }

@@ -9,10 +9,10 @@
 
 use glam::IVec2;
 use ledge_shared::fixed::{px, MAX_COORD};
-use ledge_shared::tilemap::{ContactFlags, Slope, Tile, TileContact, Tilemap, TilemapError};
-use std::cmp::Reverse;
+use ledge_shared::tilemap::{ContactFlags, Slope, Tile, Tilemap, TilemapError};
 
 use crate::platformer_kit;
+use crate::tile_kit::{col_x, resolve, resolved, row_y, run, slide};
 use platformer_kit::map_at;
 
 /// 16 px tiles.
@@ -35,121 +35,10 @@ fn map(origin: IVec2, rows: &[&str]) -> Tilemap {
     map_at(origin, T, rows)
 }
 
-/// World x of column `c`'s left edge, y of row `r`'s top edge.
-fn col_x(m: &Tilemap, c: i32) -> i32 {
-    m.origin().x + c * T
-}
-fn row_y(m: &Tilemap, r: i32) -> i32 {
-    m.origin().y + r * T
-}
-
-/// One restitution pass, the way the world will run it: contacts sorted by
-/// MTV length, largest first (stable), each re-checked at the current
-/// position before it is applied, and no push against this tick's pushes on
-/// an axis. `start` is the position at the start of the tick. Returns the
-/// total push.
-fn resolve(
-    m: &Tilemap,
-    pos: &mut IVec2,
-    half: IVec2,
-    start: IVec2,
-    flags: ContactFlags,
-    buf: &mut Vec<TileContact>,
-) -> IVec2 {
-    buf.clear();
-    m.box_contacts(*pos, half, *pos - start, flags, buf);
-    buf.sort_by_key(|c| Reverse(c.mtv.x.abs() + c.mtv.y.abs()));
-    let mut pushed = IVec2::ZERO;
-    for c in buf.iter() {
-        if c.is_trigger() {
-            continue;
-        }
-        let Some(now) = m.tile_contact(c.tile, *pos, half, *pos - start, flags) else {
-            continue;
-        };
-        let mut d = now.mtv;
-        if d.x.signum() * pushed.x.signum() < 0 {
-            d.x = 0;
-        }
-        if d.y.signum() * pushed.y.signum() < 0 {
-            d.y = 0;
-        }
-        *pos += d;
-        pushed += d;
-    }
-    pushed
-}
-
-/// Whether no solid contact is left at `pos` (reusing `buf`): true after
-/// every [`resolve`] in these scenes.
-fn resolved(
-    m: &Tilemap,
-    pos: IVec2,
-    half: IVec2,
-    start: IVec2,
-    flags: ContactFlags,
-    buf: &mut Vec<TileContact>,
-) -> bool {
-    buf.clear();
-    m.box_contacts(pos, half, pos - start, flags, buf);
-    buf.iter().all(|c| c.is_trigger())
-}
-
 /// Speeds in units per tick, from 1 unit to 3 px.
 const SPEEDS: [i32; 18] = [
     1, 2, 3, 7, 64, 127, 128, 129, 255, 256, 257, 300, 511, 512, 513, 640, 767, 768,
 ];
-
-/// Slides a box along a flat run of tiles: `along` is the unit direction of
-/// travel, `into` the unit direction towards the surface (pressed by `press`
-/// units each tick), `surface` the surface line's coordinate along `into`
-/// (x for walls, y for floors and ceilings) and `seam` a tile seam crossed
-/// along the way. At every subpixel offset and every speed, the box must
-/// advance exactly `speed` each tick and stay exactly on the surface line,
-/// with nothing left overlapping.
-fn slide(m: &Tilemap, half: IVec2, along: IVec2, into: IVec2, surface: i32, seam: i32, press: i32) {
-    let mut buf = Vec::new();
-    let flags = ContactFlags::default();
-    // Distance from the box centre to its leading edge and to the surface.
-    let reach = (half * along.abs()).x + (half * along.abs()).y;
-    let to_surface = (half * into.abs()).x + (half * into.abs()).y;
-    let dot = |a: IVec2, b: IVec2| a.x * b.x + a.y * b.y;
-    for speed in SPEEDS {
-        // Offsets 0..min(speed, 256): runs from these cross the seam at every
-        // relative position, so at every subpixel offset.
-        for sub in 0..speed.min(256) {
-            // The leading edge starts 2 * speed + sub before the seam, moving
-            // towards it; run until the trailing edge is well past it.
-            let lead =
-                dot(IVec2::splat(seam), along.abs()) - dot(along, along.abs()) * (2 * speed + sub);
-            let centre_along = lead - dot(along, along.abs()) * reach;
-            let centre_into = surface - dot(into, into.abs()) * to_surface;
-            let mut pos = along.abs() * centre_along + into.abs() * centre_into;
-            let ticks = (2 * reach + 4 * speed + 256) / speed + 1;
-            for tick in 0..ticks {
-                let start = pos;
-                pos += along * speed + into * press;
-                // Every contact on its own already points straight out of the
-                // surface: seams are culled, not merely outvoted by the
-                // largest-first order.
-                buf.clear();
-                m.box_contacts(pos, half, pos - start, flags, &mut buf);
-                assert!(
-                    buf.iter().all(|c| c.mtv == -into * press) && buf.is_empty() == (press == 0),
-                    "contacts {buf:?}: speed {speed} sub {sub} tick {tick} half {half} along {along} press {press}"
-                );
-                let pushed = resolve(m, &mut pos, half, start, flags, &mut buf);
-                // (Messages are formatted only on failure.)
-                assert_eq!(pushed, -into * press, "pushed only out of the surface: speed {speed} sub {sub} tick {tick} half {half} along {along} press {press}");
-                assert_eq!(pos - start, along * speed, "advanced exactly the speed: speed {speed} sub {sub} tick {tick} half {half} along {along} press {press}");
-                assert!(
-                    resolved(m, pos, half, start, flags, &mut buf),
-                    "speed {speed} sub {sub} tick {tick} half {half} along {along} press {press}"
-                );
-            }
-        }
-    }
-}
 
 #[test]
 fn floor_seams_never_snag() {
@@ -170,8 +59,8 @@ fn floor_seams_never_snag() {
         let seam = col_x(&m, 5);
         for half in BOXES {
             for press in [0, 1, 150, 768] {
-                slide(&m, half, IVec2::X, IVec2::Y, floor, seam, press);
-                slide(&m, half, -IVec2::X, IVec2::Y, floor, seam, press);
+                slide(&m, half, IVec2::X, IVec2::Y, floor, seam, press, &SPEEDS);
+                slide(&m, half, -IVec2::X, IVec2::Y, floor, seam, press, &SPEEDS);
             }
         }
     }
@@ -195,8 +84,17 @@ fn ceiling_seams_never_snag() {
         let seam = col_x(&m, 5);
         for half in BOXES {
             for press in [0, 1, 150] {
-                slide(&m, half, IVec2::X, -IVec2::Y, ceiling, seam, press);
-                slide(&m, half, -IVec2::X, -IVec2::Y, ceiling, seam, press);
+                slide(&m, half, IVec2::X, -IVec2::Y, ceiling, seam, press, &SPEEDS);
+                slide(
+                    &m,
+                    half,
+                    -IVec2::X,
+                    -IVec2::Y,
+                    ceiling,
+                    seam,
+                    press,
+                    &SPEEDS,
+                );
             }
         }
     }
@@ -213,8 +111,8 @@ fn wall_seams_never_snag() {
         for half in BOXES {
             for press in [0, 1, 150] {
                 for dir in [IVec2::Y, -IVec2::Y] {
-                    slide(&m, half, dir, IVec2::X, right_wall, seam, press);
-                    slide(&m, half, dir, -IVec2::X, left_wall, seam, press);
+                    slide(&m, half, dir, IVec2::X, right_wall, seam, press, &SPEEDS);
+                    slide(&m, half, dir, -IVec2::X, left_wall, seam, press, &SPEEDS);
                 }
             }
         }
@@ -453,28 +351,6 @@ fn one_way_map() -> Tilemap {
             "########",
         ],
     )
-}
-
-/// Runs `ticks` ticks of constant motion `v` with `flags`; returns the
-/// positions after each tick.
-fn run(
-    m: &Tilemap,
-    mut pos: IVec2,
-    half: IVec2,
-    v: IVec2,
-    flags: ContactFlags,
-    ticks: usize,
-) -> Vec<IVec2> {
-    let mut buf = Vec::new();
-    (0..ticks)
-        .map(|_| {
-            let start = pos;
-            pos += v;
-            resolve(m, &mut pos, half, start, flags, &mut buf);
-            assert!(resolved(m, pos, half, start, flags, &mut buf));
-            pos
-        })
-        .collect()
 }
 
 #[test]

@@ -9,12 +9,11 @@ use ledge_shared::query::sweep::sweep_shape_tiles;
 use ledge_shared::query::{contact, Proximity};
 use ledge_shared::shape::{Aabb, Circle, ConvexPolygon, Obb, Segment};
 use ledge_shared::tilemap::{ContactFlags, Slope, Tile, TileRegion, Tilemap};
-use ledge_shared::world::{
-    AnyShape, BodyDesc, BodyId, ColliderDesc, SimConfig, SweepMode, SweepResponse, World,
-};
+use ledge_shared::world::{AnyShape, BodyDesc, BodyId, ColliderDesc, SimConfig, World};
 use proptest::prelude::*;
 
 use crate::platformer_kit;
+use crate::tile_kit::shot;
 use platformer_kit::{map, T};
 
 /// Gravity per tick, in units per tick.
@@ -229,31 +228,6 @@ fn one_way_tiles_hold_from_above_and_let_through_from_below() {
     }
 }
 
-/// A world with a one-tile wall (column 8 of a 16 x 16 map) or a one-way
-/// row (row 8), and a swept projectile that stops at a hit.
-fn shot(shape: AnyShape, start: IVec2, vel: IVec2, one_way: bool) -> (World, BodyId, Tilemap) {
-    let mut tiles = vec![Tile::Empty; 16 * 16];
-    for i in 0..16 {
-        if one_way {
-            tiles[8 * 16 + i] = Tile::OneWay;
-        } else {
-            tiles[i * 16 + 8] = Tile::Solid;
-        }
-    }
-    let m = Tilemap::new(IVec2::ZERO, T, 16, 16, tiles).unwrap();
-    let mut w = World::new(SimConfig {
-        sweep: SweepMode::Flagged,
-        ..SimConfig::default()
-    })
-    .unwrap();
-    w.set_tilemap(m.clone());
-    let b = w.add_body(BodyDesc::dynamic(start).with_vel(vel)).unwrap();
-    w.add_collider(b, ColliderDesc::solid(shape)).unwrap();
-    w.set_swept(b, true).unwrap();
-    w.set_sweep_response(b, SweepResponse::Stop).unwrap();
-    (w, b, m)
-}
-
 fn projectile(kind: u8, size: i32) -> AnyShape {
     match kind {
         0 => Circle::new(size).unwrap().into(),
@@ -276,7 +250,7 @@ proptest! {
         x in T..6 * T,
     ) {
         let shape = projectile(kind, size);
-        let (mut w, b, m) = shot(shape, IVec2::new(x, y), IVec2::new(speed, vy), false);
+        let (mut w, b, m) = shot(shape, T, IVec2::new(x, y), IVec2::new(speed, vy), false);
         w.step(&[]);
         w.step(&[]);
         let p = w.body(b).unwrap().pos();
@@ -301,7 +275,7 @@ proptest! {
         y in T..6 * T,
     ) {
         let shape = projectile(kind, size);
-        let (mut w, b, _) = shot(shape, IVec2::new(x, y), IVec2::new(vx, speed), true);
+        let (mut w, b, _) = shot(shape, T, IVec2::new(x, y), IVec2::new(vx, speed), true);
         w.step(&[]);
         w.step(&[]);
         let p = w.body(b).unwrap().pos();

@@ -1,6 +1,6 @@
 //! A circle against any convex vertex shape, by closest feature.
 
-use super::Proximity;
+use super::proximity::Proximity;
 use crate::fixed::{cmp_mul_u128, dir_order, div_away, len2, perp, wide};
 use crate::shape::Convex;
 use core::cmp::Ordering;

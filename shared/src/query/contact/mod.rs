@@ -30,6 +30,7 @@
 //! vertex the shape's list starts at.
 
 mod circle_convex;
+mod proximity;
 mod sat;
 
 mod aabb_aabb;
@@ -59,38 +60,9 @@ mod testing;
 #[cfg(test)]
 pub(crate) use sat::sat;
 
+pub use proximity::Proximity;
+
 use glam::IVec2;
-
-/// How two placed shapes relate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Proximity {
-    /// A positive gap separates them.
-    Apart,
-    /// They touch with no overlap of interiors (zero gap on some axis).
-    Touching,
-    /// Interiors overlap; moving the first shape by the MTV separates them.
-    Overlapping(IVec2),
-}
-
-impl Proximity {
-    /// The same relation seen from the other shape (MTV negated).
-    #[inline]
-    pub fn reversed(self) -> Self {
-        match self {
-            Proximity::Overlapping(m) => Proximity::Overlapping(-m),
-            p => p,
-        }
-    }
-
-    /// The MTV when overlapping.
-    #[inline]
-    pub fn mtv(self) -> Option<IVec2> {
-        match self {
-            Proximity::Overlapping(m) => Some(m),
-            _ => None,
-        }
-    }
-}
 
 /// Contact test of `Self` against shape `B`.
 pub trait Contact<B> {

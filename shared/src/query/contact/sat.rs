@@ -1,6 +1,6 @@
 //! The separating axis test with an exact minimum translation vector.
 
-use super::Proximity;
+use super::proximity::Proximity;
 use crate::fixed::{cmp_mul_u128, div_away, len2, line_order, wide};
 use crate::shape::Convex;
 use core::cmp::Ordering;
