@@ -486,6 +486,9 @@ impl<'ast> Visit<'ast> for Uses<'_> {
         syn::visit::visit_macro(self, mac);
     }
 
+    /// `pub(super)`, `pub(in crate::x)`: who may see an item, not a use.
+    fn visit_visibility(&mut self, _: &'ast syn::Visibility) {}
+
     fn visit_path(&mut self, path: &'ast syn::Path) {
         let segments: Vec<String> = path.segments.iter().map(|s| s.ident.to_string()).collect();
         if path.leading_colon.is_none() {
@@ -738,8 +741,9 @@ fn the_circle_check_sees_circles_and_only_circles() {
     };
     write(
         "lib.rs",
-        "mod a; mod b; mod c; mod d; pub use a::A; pub use d::D; pub struct R;\n\
+        "mod a; mod b; mod c; mod d; mod e; pub use a::A; pub use d::D; pub struct R;\n\
          pub fn h() -> A { A }\n\
+         fn i() -> e::E { e::E }\n\
          #[cfg(test)] mod t { fn f() -> crate::c::C { crate::c::C } }",
     );
     write(
@@ -751,6 +755,8 @@ fn the_circle_check_sees_circles_and_only_circles() {
     write("c.rs", "pub struct C; pub fn g() { let _ = crate::b::B; }");
     // Only re-exported by the root: a facade, not a circle.
     write("d.rs", "pub struct D; pub fn g() { let _ = crate::h(); }");
+    // Used by the root; `pub(super)` only says who may see it.
+    write("e.rs", "pub(super) struct E;");
     let modules = read_crate(&dir.path().join("lib.rs"));
     let graph = edges(&modules);
     let found = circles(&graph);

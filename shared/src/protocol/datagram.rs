@@ -1,15 +1,12 @@
 //! Unreliable datagrams: inputs (client to server) and snapshots (server to
-//! client), plus the choice between a datagram and the control stream for a
-//! snapshot too large for one.
+//! client). The choice between a datagram and the control stream for a
+//! snapshot too large for one is in [`super::outgoing`].
 
 use serde::{Deserialize, Serialize};
 
 use super::codec::{bytes, Message};
-use super::frame::write_frame;
 use super::snapshot::{decode_delta, encode_delta, peek_delta, StateSnapshot};
-use super::{
-    ProtocolError, ServerControl, MAX_DELTA_LEN, MAX_FRAME, MAX_INPUT_DATAGRAM, MAX_INPUT_HISTORY,
-};
+use super::{ProtocolError, MAX_DELTA_LEN, MAX_FRAME, MAX_INPUT_DATAGRAM, MAX_INPUT_HISTORY};
 use crate::input::Buttons;
 
 /// An [`InputPacket`] as it goes on the wire: the buttons as runs of equal
@@ -263,23 +260,6 @@ impl Snapshot {
         }
         Ok(state)
     }
-
-    /// Encodes the snapshot for sending: as a datagram if it fits
-    /// `max_datagram_size` (`quinn::Connection::max_datagram_size()`; `None`:
-    /// datagrams unavailable), else as a framed
-    /// [`ServerControl::FullState`] for the control stream.
-    pub fn into_outgoing(
-        self,
-        max_datagram_size: Option<usize>,
-    ) -> Result<Outgoing, ProtocolError> {
-        let datagram = self.encode()?;
-        if max_datagram_size.is_some_and(|max| fits(datagram.len(), max)) {
-            return Ok(Outgoing::Datagram(datagram));
-        }
-        let mut frame = Vec::with_capacity(datagram.len() + 8);
-        write_frame(&ServerControl::FullState(self), &mut frame)?;
-        Ok(Outgoing::Control(frame))
-    }
 }
 
 impl Message for Snapshot {
@@ -303,21 +283,4 @@ impl Message for Snapshot {
         }
         Ok(())
     }
-}
-
-/// Whether an encoded message of `len` bytes fits a datagram of at most
-/// `max_datagram_size` bytes.
-#[inline]
-pub fn fits(len: usize, max_datagram_size: usize) -> bool {
-    len <= max_datagram_size
-}
-
-/// An encoded snapshot and where to send it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Outgoing {
-    /// Send these bytes as one unreliable datagram.
-    Datagram(Vec<u8>),
-    /// Write these bytes (a complete frame, length prefix included) to the
-    /// control stream.
-    Control(Vec<u8>),
 }

@@ -24,6 +24,7 @@ mod datagram;
 mod error;
 mod fingerprint;
 mod frame;
+mod outgoing;
 pub mod snapshot;
 mod varint;
 pub mod web;
@@ -36,10 +37,11 @@ pub use control::{
     MAX_CHAT_LEN, MAX_ID_LEN, MAX_LEVEL_BUNDLE, MAX_NAME_LEN, MAX_REASON_LEN, MAX_ROOMS,
     MAX_ROSTER, MAX_SIM_CONFIG_LEN,
 };
-pub use datagram::{fits, input_timing, InputPacket, Outgoing, Snapshot};
+pub use datagram::{input_timing, InputPacket, Snapshot};
 pub use error::ProtocolError;
 pub use fingerprint::{Fingerprint, ParseFingerprintError};
 pub use frame::{write_frame, FrameDecoder, FRAME_HEADER};
+pub use outgoing::{fits, Outgoing};
 pub use snapshot::{
     decode_delta, encode_delta, extrapolate, extrapolates_to, is_replicated, EntityState,
     SnapshotHistory, StateSnapshot,
