@@ -25,28 +25,22 @@
 //!   misbehaving);
 //! * [`time`]: the clock type, native or the browser's;
 //! * [`rng`]: a seedable generator (bots, effects);
-//! * [`audio`]: sound effects, synthesized at start, played through ALSA
-//!   loaded at run time (off, never failing, without it);
-//! * [`cues`]: which sound effects to play, from frame-to-frame changes of
-//!   our player (so rollbacks never replay one);
-//! * [`anim`]: how players look from frame to frame ([`anim::Animator`]:
-//!   run, jump, fall, landing squash, wall slide), and stacked players
-//!   fanned out ([`anim::spread`]);
 //! * [`error`]: what can fail ([`ClientError`]).
 //!
-//! The modules with sockets, threads, files or ALSA (`bot`, and in `net`
+//! Presentation only the window needs (how players look from frame to
+//! frame, the sound effects and their player, which sounds a frame cues)
+//! lives in the front end, not here.
+//!
+//! The modules with sockets, threads or files (`bot`, and in `net`
 //! `background`, `bundle`, `transport`, `trust`, `verifier`, the QUIC
-//! session; the ALSA player) are native only; the rest also builds for
+//! session) are native only; the rest also builds for
 //! `wasm32-unknown-unknown`, for the browser front end.
 //!
 //! `docs/CLIENT.md` describes the design and the figures.
 #![deny(missing_docs)]
 
-pub mod anim;
-pub mod audio;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod bot;
-pub mod cues;
 pub mod error;
 pub mod game;
 pub mod net;

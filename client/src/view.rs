@@ -86,6 +86,25 @@ pub struct PlayerDraw {
 }
 
 impl PlayerDraw {
+    /// A player `id` with a box of `size` centred at `pos` (pixels):
+    /// nameless, still, facing right, airborne, alive, not finished, no
+    /// wall beside it. Set the other fields as needed (front ends' tests
+    /// build their players so, the struct being `#[non_exhaustive]`).
+    pub fn new(id: PlayerId, pos: Vec2, size: Vec2) -> PlayerDraw {
+        PlayerDraw {
+            id,
+            name: None,
+            pos,
+            size,
+            vel: Vec2::ZERO,
+            facing: Facing::Right,
+            grounded: false,
+            won: false,
+            dead: false,
+            wall: None,
+        }
+    }
+
     /// Top-left corner of its box, pixels.
     pub fn top_left(&self) -> Vec2 {
         self.pos - self.size * 0.5

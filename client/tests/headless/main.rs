@@ -1,11 +1,9 @@
-//! The client library's integration tests (no window): sound, cues,
-//! online play, bots. One binary, one link step; every file a module.
+//! The client library's integration tests (no window): online play,
+//! bots. One binary, one link step; every file a module.
 
 #[path = "../common/mod.rs"]
 mod common;
 
-mod audio;
-mod cues;
 mod online_game;
 mod runner_race;
 mod thin_bot;

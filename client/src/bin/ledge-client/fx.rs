@@ -5,7 +5,7 @@
 //!
 //! Effects are cosmetic and frame-driven: they never touch the simulation
 //! and are not part of its state. Our player's effects come from the same
-//! [`Effect`] cues the sound plays ([`ledge_client::cues::Cues`], so a
+//! [`Effect`] cues the sound plays ([`crate::cues::Cues`], so a
 //! rollback never replays one); the other players' deaths, respawns and
 //! finishes from what their drawn state says frame to frame
 //! ([`Fx::watch`]). Ours shake the screen and flash it; theirs do not.
@@ -17,7 +17,7 @@
 
 use std::collections::BTreeMap;
 
-use ledge_client::audio::Effect;
+use crate::audio::Effect;
 use ledge_client::rng::SplitMix64;
 use macroquad::prelude::*;
 

@@ -11,9 +11,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use ledge_client::anim::Animator;
-use ledge_client::audio::{Audio, AudioStatus, Effect};
-use ledge_client::cues::Cues;
+use crate::anim::Animator;
+use crate::audio::{Audio, AudioStatus, Effect};
+use crate::cues::Cues;
 use ledge_client::time::Instant;
 use ledge_client::view::{px2, FrameView, NetStats};
 use ledge_shared::fixed::UNITS_PER_PX;

@@ -31,7 +31,10 @@
 //! Modules, top to bottom (each uses only those below it): the entry
 //! points ([`native`], and `web` in the browser) prepare a [`game_loop::Setup`]; the
 //! [`game_loop`] runs the frames; [`play`], [`keys`], [`hud`], [`render`],
-//! [`fx`], [`shot`] and the rest do one thing each for it; at the bottom
+//! [`fx`], [`shot`] and the rest do one thing each for it, among them the
+//! presentation the headless library leaves out: how players look from
+//! frame to frame ([`anim`]), the sound effects and their player
+//! ([`audio`]), and which of them a frame cues ([`cues`]); at the bottom
 //! the page's glue (`page`, in the browser), gamepads ([`pad`]) and how a run ends
 //! ([`outcome`]).
 
@@ -39,8 +42,11 @@
 // thread, and with them some helpers the native build uses.
 #![cfg_attr(target_arch = "wasm32", allow(dead_code))]
 
+mod anim;
 mod art;
+mod audio;
 mod camera;
+mod cues;
 mod debug;
 mod fx;
 mod game_loop;

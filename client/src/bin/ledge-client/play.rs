@@ -5,8 +5,8 @@
 
 use std::time::Duration;
 
+use crate::anim::{spread, Animator, Pose};
 use glam::IVec2;
-use ledge_client::anim::{spread, Animator, Pose};
 use ledge_client::game::ClientGame;
 use ledge_client::net::NetStatus;
 use ledge_client::time::Instant;
@@ -44,7 +44,7 @@ impl From<&PlayerDraw> for PlayerSprite {
 /// The players of `view` to draw this frame (ours, then the others):
 /// posed by `animator` (advanced by `dt` seconds, the frame's duration)
 /// and, where several stand on one spot, fanned out sideways
-/// (`ledge_client::anim::spread`: ours never moves). Dead players keep
+/// (`crate::anim::spread`: ours never moves). Dead players keep
 /// their place and take no part in the fanning.
 pub fn sprites(
     view: &FrameView,

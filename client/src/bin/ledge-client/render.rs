@@ -4,7 +4,7 @@
 //! layers and tileset images) is drawn by `art.rs`; the tilemap's flat
 //! colours only fill the cells the art does not draw.
 
-use ledge_client::anim::{label_rows, Action, Label, Pose};
+use crate::anim::{label_rows, Action, Label, Pose};
 use ledge_client::view::{EntityType, Facing};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::level::{EntityKind, Level};

@@ -94,7 +94,7 @@ pub struct FxShot<'a> {
     /// The flash's opacity.
     pub flash: f32,
     /// The effects started lately, oldest first.
-    pub recent: &'a [ledge_client::audio::Effect],
+    pub recent: &'a [crate::audio::Effect],
     /// Our player is dead (waiting to respawn).
     pub dead: bool,
 }
@@ -410,7 +410,7 @@ mod tests {
                 particles: 12,
                 shake: 1.5,
                 flash: 0.25,
-                recent: &[ledge_client::audio::Effect::Hurt],
+                recent: &[crate::audio::Effect::Hurt],
                 dead: true,
             },
         };

@@ -14,8 +14,10 @@
 //!   device ([`alsa`]). Dropping the [`Audio`] stops it and joins it,
 //!   waiting at most [`STOP_TIMEOUT`].
 //!
-//! The window maps game events to effects and owns the mute key and the
-//! volume setting; this module only offers the calls.
+//! The window maps game events to effects ([`crate::cues`]) and owns the
+//! mute key and the volume setting; this module only offers the calls. Only
+//! the window plays sound, so it is part of the front end, not of the
+//! headless library.
 
 #[cfg(not(target_arch = "wasm32"))]
 pub mod alsa;
@@ -70,6 +72,7 @@ impl Sounds {
     }
 
     /// The duration of `effect`.
+    #[cfg(test)]
     pub fn duration(&self, effect: Effect) -> Duration {
         Duration::from_secs_f64(self.get(effect).len() as f64 / f64::from(SAMPLE_RATE))
     }
@@ -146,11 +149,13 @@ impl Mixer {
     }
 
     /// How many effects are playing.
+    #[cfg(test)]
     pub fn active(&self) -> usize {
         self.voices.len()
     }
 
     /// The effects playing, oldest first.
+    #[cfg(test)]
     pub fn playing(&self) -> impl Iterator<Item = Effect> + '_ {
         self.voices.iter().map(|v| v.effect)
     }
@@ -208,6 +213,7 @@ pub enum AudioStatus {
 
 impl AudioStatus {
     /// True when effects are played.
+    #[cfg(test)]
     pub fn is_playing(&self) -> bool {
         matches!(self, AudioStatus::Playing { .. })
     }
@@ -372,6 +378,7 @@ impl Audio {
     }
 
     /// The volume, 0.0..=1.0 (1.0 at start).
+    #[cfg(test)]
     pub fn volume(&self) -> f32 {
         f32::from_bits(self.shared.volume.load(Ordering::Relaxed))
     }
@@ -492,3 +499,6 @@ fn mixer_thread(
         }
     }
 }
+
+#[cfg(test)]
+mod tests;

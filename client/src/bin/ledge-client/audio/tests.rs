@@ -1,12 +1,13 @@
-//! Sound: every effect is synthesized and sounds like something, the
-//! synthesizer is deterministic, the mixer limits voices and scales and
-//! saturates correctly, and the client's audio starts (or reports why it
-//! cannot) on a machine without a sound card, without failing or hanging.
+//! Tests of the sound: every effect is synthesized and sounds like
+//! something, the synthesizer is deterministic, the mixer limits voices
+//! and scales and saturates correctly, and the client's audio starts (or
+//! reports why it cannot) on a machine without a sound card, without
+//! failing or hanging.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use ledge_client::audio::{
+use super::{
     alsa, synth, Audio, AudioStatus, Effect, Mixer, Sounds, MAX_VOICES, RETRIGGER_SAMPLES,
     SAMPLE_RATE,
 };

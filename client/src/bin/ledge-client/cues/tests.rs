@@ -1,17 +1,18 @@
-//! Sound cues (`ledge_client::cues`): each from synthetic frames, then from
-//! real games: a run into spikes, a coin, and the same runs with the game
-//! rolled back and replayed every frame (as the predictor does), which must
-//! cue exactly the same.
+//! Tests of the sound cues ([`super::Cues`]): each from synthetic frames,
+//! then from real games: a run into spikes, a coin, and the same runs with
+//! the game rolled back and replayed every frame (as the predictor does),
+//! which must cue exactly the same.
 
 use glam::IVec2;
-use ledge_client::audio::Effect;
-use ledge_client::cues::{Cues, REPEAT_TICKS};
 use ledge_shared::game::{EntityType, EntityView, Game, GameConfig, GameEvent, PlayerView};
 use ledge_shared::input::Buttons;
 use ledge_shared::level::{EntityDef, EntityKind, Level};
 use ledge_shared::protocol::PlayerId;
 use ledge_shared::tilemap::{Tile, Tilemap};
 use ledge_shared::world::Sides;
+
+use super::{Cues, REPEAT_TICKS};
+use crate::audio::Effect;
 
 const P1: PlayerId = PlayerId(1);
 /// One tile, units.

@@ -207,11 +207,6 @@ pub fn open(name: &str) -> Result<Alsa, AlsaError> {
 }
 
 impl Alsa {
-    /// The library's file name.
-    pub fn name(&self) -> &str {
-        &self.name
-    }
-
     /// Sends ALSA's error messages raised on the calling thread to the log
     /// (debug level) instead of stderr. A no-op if the library lacks
     /// `snd_lib_error_set_local`.

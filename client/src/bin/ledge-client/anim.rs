@@ -4,10 +4,11 @@
 //! it fell). Cosmetic only: nothing here feeds back into the simulation,
 //! and the box it collides with stays the box in [`PlayerDraw`].
 //!
-//! Pure and headless (no window), so it is tested here; the `ledge-client`
-//! front end draws the [`Pose`]s. Everything is driven by the frame's
-//! `dt` in seconds (exponential easing, timers), so the result does not
-//! depend on the frame rate.
+//! Only the window shows it, so it is part of the front end, not of the
+//! headless library; pure (no drawing here), so it is tested without a
+//! window, and [`crate::render`] draws the [`Pose`]s. Everything is driven
+//! by the frame's `dt` in seconds (exponential easing, timers), so the
+//! result does not depend on the frame rate.
 //!
 //! [`spread`] fans out players drawn on top of each other (eight bots at
 //! the goal) so that each stays visible, and [`label_rows`] steps their
@@ -17,7 +18,7 @@ use std::collections::BTreeMap;
 
 use ledge_shared::protocol::PlayerId;
 
-use crate::view::{Facing, PlayerDraw, Vec2};
+use ledge_client::view::{Facing, PlayerDraw, Vec2};
 
 /// Horizontal speed below which a grounded player stands (px/s).
 pub const RUN_MIN_SPEED: f32 = 8.0;
@@ -353,11 +354,13 @@ impl Animator {
     }
 
     /// How many players it remembers.
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.players.len()
     }
 
     /// Whether it remembers no one.
+    #[cfg(test)]
     pub fn is_empty(&self) -> bool {
         self.players.is_empty()
     }
@@ -473,18 +476,10 @@ mod tests {
 
     /// A 12x16 player at `pos` moving at `vel`.
     fn player(id: u32, pos: Vec2, vel: Vec2, grounded: bool) -> PlayerDraw {
-        PlayerDraw {
-            id: PlayerId(id),
-            name: None,
-            pos,
-            size: Vec2::new(12.0, 16.0),
-            vel,
-            facing: Facing::Right,
-            grounded,
-            won: false,
-            dead: false,
-            wall: None,
-        }
+        let mut p = PlayerDraw::new(PlayerId(id), pos, Vec2::new(12.0, 16.0));
+        p.vel = vel;
+        p.grounded = grounded;
+        p
     }
 
     fn on_ground(vx: f32) -> PlayerDraw {

@@ -30,6 +30,10 @@
 //! stomp) is not played again. A replay that does not change what we see
 //! changes nothing here: cues come from differences only. A state seen for the first time
 //! (joining, a new game) plays nothing.
+//!
+//! The window's sound ([`crate::audio`]) and effects ([`crate::fx`]) are
+//! its only listeners, so it is part of the front end, not of the headless
+//! library.
 
 use glam::IVec2;
 use ledge_shared::fixed::UNITS_PER_PX;
@@ -93,14 +97,6 @@ impl Cues {
             scratch: Vec::new(),
             played: [None; EFFECTS],
         }
-    }
-
-    /// Forgets the previous frame (a new game: the next frame plays
-    /// nothing).
-    pub fn reset(&mut self) {
-        self.prev = None;
-        self.things.clear();
-        self.played = [None; EFFECTS];
     }
 
     /// This frame's effects for player `me` of `game` (none if it is not in
@@ -243,3 +239,6 @@ impl Cues {
         })
     }
 }
+
+#[cfg(test)]
+mod tests;
