@@ -16,8 +16,8 @@
 //!   session ([`net::session`]: the protocol sans IO, [`SessionState`],
 //!   and its QUIC driver, [`Session`]), dialing ([`net::transport`]),
 //!   trusting the certificate ([`net::trust`], [`net::verifier`]), the
-//!   browser's sans-IO link ([`net::link`]), the network thread
-//!   ([`net::background`]), a networked game for a GUI
+//!   browser page's sans-IO session ([`net::page_session`]), the network
+//!   thread ([`net::background`]), a networked game for a GUI
 //!   ([`net::online`], [`OnlineGame`]), and the server's level
 //!   ([`net::levels`], [`net::download`], [`net::bundle`]);
 //! * [`netstats`]: RTT, jitter, loss, rates;

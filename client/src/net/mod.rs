@@ -17,8 +17,9 @@
 //! * [`transport`]: resolve and dial a server over QUIC;
 //! * [`trust`]: pinned fingerprints and trust on first use (known hosts);
 //! * [`verifier`]: the certificate verifier behind both;
-//! * [`link`]: a session over a transport driven from outside (the
-//!   browser's WebTransport or WebSocket), sans IO ([`link::Link`]);
+//! * [`page_session`]: the browser page's session, over a transport
+//!   driven from outside (the browser's WebTransport or WebSocket), sans
+//!   IO ([`page_session::PageSession`]);
 //! * [`background`]: the network on its own thread, for GUI front ends;
 //! * [`online`]: a networked game for a GUI ([`online::OnlineGame`]);
 //! * [`levels`]: the server's level, checked by hash;
@@ -34,8 +35,8 @@ pub mod background;
 pub mod bundle;
 pub mod download;
 pub mod levels;
-pub mod link;
 pub mod online;
+pub mod page_session;
 pub mod session;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod transport;

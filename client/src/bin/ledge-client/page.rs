@@ -9,7 +9,7 @@
 
 use std::collections::BTreeMap;
 
-use ledge_client::net::link::{Link, Transmit};
+use ledge_client::net::page_session::{PageSession, Transmit};
 use ledge_client::net::{NetEvent, Network};
 use ledge_client::netstats::TransportSample;
 use ledge_client::time::Instant;
@@ -66,10 +66,10 @@ mod tag {
 const POLL_BUFFER: usize = 64 * 1024;
 
 /// The page's connection as a [`Network`]: the glue's messages fed to a
-/// [`Link`] (the session's protocol), its transmits handed to the glue.
+/// [`PageSession`] (the session's protocol), its transmits handed to the glue.
 #[derive(Debug)]
 pub struct WebNet {
-    link: Link,
+    session: PageSession,
     buf: Vec<u8>,
     /// "WebTransport" or "WebSocket", once open.
     transport: Option<String>,
@@ -81,7 +81,7 @@ impl WebNet {
         // SAFETY: an import without arguments.
         unsafe { ledge_net_open() };
         WebNet {
-            link: Link::new(options),
+            session: PageSession::new(options),
             buf: vec![0; POLL_BUFFER],
             transport: None,
         }
@@ -92,7 +92,7 @@ impl WebNet {
         self.transport.as_deref()
     }
 
-    /// Feeds the glue's messages to the link; pings when due.
+    /// Feeds the glue's messages to the session; pings when due.
     fn pump(&mut self) {
         let now = Instant::now();
         loop {
@@ -107,7 +107,7 @@ impl WebNet {
             match t {
                 tag::OPENED => {
                     self.transport = Some(String::from_utf8_lossy(payload).into_owned());
-                    self.link.on_open(now);
+                    self.session.on_open(now);
                 }
                 tag::CLOSED => {
                     let code = payload
@@ -115,23 +115,23 @@ impl WebNet {
                         .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
                         .filter(|&c| c != u32::MAX);
                     let reason = String::from_utf8_lossy(payload.get(4..).unwrap_or(&[]));
-                    self.link.on_closed(code, &reason);
+                    self.session.on_closed(code, &reason);
                 }
-                tag::FAILED => self.link.on_failed(&String::from_utf8_lossy(payload)),
+                tag::FAILED => self.session.on_failed(&String::from_utf8_lossy(payload)),
                 // The session's own messages, in the WebSocket framing.
                 _ => match web::decode(message) {
-                    Ok(m) => self.link.on_message(m, now),
+                    Ok(m) => self.session.on_message(m, now),
                     Err(e) => tell(&format!("the page's glue sent a bad message: {e}")),
                 },
             }
         }
-        self.link.poll(now);
+        self.session.poll(now);
         self.flush();
     }
 
-    /// Hands the link's transmits to the glue.
+    /// Hands the session's transmits to the glue.
     fn flush(&mut self) {
-        while let Some(t) = self.link.poll_transmit() {
+        while let Some(t) = self.session.poll_transmit() {
             let (kind, bytes) = match &t {
                 Transmit::Stream(b) => (web::Tag::Stream as u32, b),
                 Transmit::Datagram(b) => (web::Tag::Datagram as u32, b),
@@ -144,31 +144,31 @@ impl WebNet {
 
 impl Network for WebNet {
     fn try_recv(&mut self) -> Option<NetEvent> {
-        if let Some(event) = self.link.try_recv() {
+        if let Some(event) = self.session.try_recv() {
             return Some(event);
         }
         self.pump();
-        self.link.try_recv()
+        self.session.try_recv()
     }
 
     fn send_input(&mut self, tick: u64, buttons: Buttons) -> bool {
-        let sent = self.link.send_input(tick, buttons);
+        let sent = self.session.send_input(tick, buttons);
         self.flush();
         sent
     }
 
     fn chat(&mut self, text: &str) -> bool {
-        let sent = self.link.chat(text);
+        let sent = self.session.chat(text);
         self.flush();
         sent
     }
 
     fn transport(&self) -> Option<TransportSample> {
-        self.link.transport()
+        self.session.transport()
     }
 
     fn players(&self) -> BTreeMap<PlayerId, String> {
-        self.link.players()
+        self.session.players()
     }
 }
 

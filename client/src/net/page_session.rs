@@ -1,13 +1,14 @@
-//! A session over a transport driven from outside, sans IO: the browser's
-//! WebTransport or WebSocket (through the page's glue), or anything else
-//! that carries the control stream's bytes, datagrams and the level
-//! stream as messages.
+//! The browser page's session: a session over a transport driven from
+//! outside, sans IO: the browser's WebTransport or WebSocket (through the
+//! page's glue), or anything else that carries the control stream's bytes,
+//! datagrams and the level stream as messages.
 //!
-//! [`Link`] is the [`Network`] of a browser's
-//! [`crate::net::online::OnlineGame`]: the driver calls [`Link::on_open`] when
-//! the transport is up, feeds what arrives ([`Link::on_message`],
-//! [`Link::on_closed`]), calls [`Link::poll`] once per frame (pings) and
-//! sends what [`Link::poll_transmit`] gives. Behind it are the same
+//! [`PageSession`] is the [`Network`] of a browser's
+//! [`crate::net::online::OnlineGame`]: the driver calls
+//! [`PageSession::on_open`] when the transport is up, feeds what arrives
+//! ([`PageSession::on_message`], [`PageSession::on_closed`]), calls
+//! [`PageSession::poll`] once per frame (pings) and sends what
+//! [`PageSession::poll_transmit`] gives. Behind it are the same
 //! [`Handshake`], [`SessionState`] and [`Download`] as the native client's,
 //! so both speak one protocol. It reports as the background thread does:
 //! the level ([`NetEvent::Level`], after its download if the server plays
@@ -77,7 +78,7 @@ enum Phase {
 
 /// The session's protocol over a driven transport (see the module).
 #[derive(Debug)]
-pub struct Link {
+pub struct PageSession {
     options: JoinOptions,
     phase: Phase,
     events: VecDeque<NetEvent>,
@@ -91,10 +92,10 @@ pub struct Link {
     dropped: u64,
 }
 
-impl Link {
-    /// A link that will join as `options` say once its transport opens.
-    pub fn new(options: JoinOptions) -> Link {
-        Link {
+impl PageSession {
+    /// A session that will join as `options` say once its transport opens.
+    pub fn new(options: JoinOptions) -> PageSession {
+        PageSession {
             options,
             phase: Phase::Opening,
             events: VecDeque::new(),
@@ -380,7 +381,7 @@ impl Link {
     }
 }
 
-impl Network for Link {
+impl Network for PageSession {
     fn try_recv(&mut self) -> Option<NetEvent> {
         self.events.pop_front()
     }
@@ -462,10 +463,10 @@ mod tests {
     }
 
     /// The control messages among `out` (decoded), and the datagrams.
-    fn sent(link: &mut Link) -> (Vec<ClientControl>, Vec<Vec<u8>>) {
+    fn sent(session: &mut PageSession) -> (Vec<ClientControl>, Vec<Vec<u8>>) {
         let mut decoder = FrameDecoder::new(MAX_FRAME);
         let mut datagrams = Vec::new();
-        while let Some(t) = link.poll_transmit() {
+        while let Some(t) = session.poll_transmit() {
             match t {
                 Transmit::Stream(b) => decoder.push(&b).unwrap(),
                 Transmit::Datagram(d) => datagrams.push(d),
@@ -478,12 +479,12 @@ mod tests {
         (controls, datagrams)
     }
 
-    fn events(link: &mut Link) -> Vec<NetEvent> {
-        std::iter::from_fn(|| link.try_recv()).collect()
+    fn events(session: &mut PageSession) -> Vec<NetEvent> {
+        std::iter::from_fn(|| session.try_recv()).collect()
     }
 
-    fn joining(room: &str) -> Link {
-        Link::new(JoinOptions {
+    fn joining(room: &str) -> PageSession {
+        PageSession::new(JoinOptions {
             room: Some(room.into()),
             ..JoinOptions::new("ada")
         })
@@ -492,10 +493,10 @@ mod tests {
     #[test]
     fn joins_on_the_embedded_level_and_plays() {
         let now = Instant::now();
-        let mut link = joining("friends");
-        assert!(link.poll_transmit().is_none(), "nothing before the open");
-        link.on_open(now);
-        let (controls, _) = sent(&mut link);
+        let mut session = joining("friends");
+        assert!(session.poll_transmit().is_none(), "nothing before the open");
+        session.on_open(now);
+        let (controls, _) = sent(&mut session);
         assert_eq!(
             controls[0].as_hello(),
             Some((
@@ -513,10 +514,10 @@ mod tests {
             }],
         }));
         let (a, b) = bytes.split_at(7);
-        link.on_message(Incoming::Stream(a), now);
-        assert!(events(&mut link).is_empty());
-        link.on_message(Incoming::Stream(b), now);
-        let got = events(&mut link);
+        session.on_message(Incoming::Stream(a), now);
+        assert!(events(&mut session).is_empty());
+        session.on_message(Incoming::Stream(b), now);
+        let got = events(&mut session);
         assert!(
             matches!(&got[0], NetEvent::Level(_, f) if f.embedded),
             "{got:?}"
@@ -525,15 +526,15 @@ mod tests {
         assert!(
             matches!(&got[2], NetEvent::PlayerJoined { id: PlayerId(3), name } if name == "ada")
         );
-        assert_eq!(link.players().len(), 1);
+        assert_eq!(session.players().len(), 1);
 
         // At 60 Hz a datagram goes every other tick, carrying the one
         // between.
-        assert!(link.send_input(11, Buttons(Buttons::RIGHT)));
-        assert!(link.send_input(12, Buttons(Buttons::JUMP)));
-        assert!(link.send_input(13, Buttons(Buttons::RIGHT)));
-        link.poll(now);
-        let (controls, datagrams) = sent(&mut link);
+        assert!(session.send_input(11, Buttons(Buttons::RIGHT)));
+        assert!(session.send_input(12, Buttons(Buttons::JUMP)));
+        assert!(session.send_input(13, Buttons(Buttons::RIGHT)));
+        session.poll(now);
+        let (controls, datagrams) = sent(&mut session);
         assert!(
             matches!(controls[..], [ClientControl::Ping { .. }]),
             "{controls:?}"
@@ -544,37 +545,37 @@ mod tests {
         assert_eq!(packet.newest_tick, 13);
         assert_eq!(packet.get(12), Some(Buttons(Buttons::JUMP)));
         assert_eq!(packet.get(11), Some(Buttons(Buttons::RIGHT)));
-        assert!(link.transport().unwrap().bytes_out > 0);
+        assert!(session.transport().unwrap().bytes_out > 0);
     }
 
     #[test]
     fn downloads_another_level_before_reporting_the_welcome() {
         let now = Instant::now();
-        let mut link = joining("friends");
-        link.on_open(now);
-        sent(&mut link);
+        let mut session = joining("friends");
+        session.on_open(now);
+        sent(&mut session);
         let mut bundle = LevelBundle::default_level();
         bundle.level.name = "another".into();
         let bytes = bundle.encode();
         let offer = LevelBundle::offer(&bytes);
-        link.on_message(
+        session.on_message(
             Incoming::Stream(&frame(&ServerControl::Welcome(welcome(offer)))),
             now,
         );
-        let (controls, _) = sent(&mut link);
+        let (controls, _) = sent(&mut session);
         assert!(
             matches!(controls[..], [ClientControl::GetLevel { offset: 0 }]),
             "{controls:?}"
         );
         // A roster while downloading waits for the welcome's report.
-        link.on_message(
+        session.on_message(
             Incoming::Stream(&frame(&ServerControl::PlayerLeft { id: PlayerId(9) })),
             now,
         );
         for chunk in bytes.chunks(4096) {
-            link.on_message(Incoming::Level(chunk), now);
+            session.on_message(Incoming::Level(chunk), now);
         }
-        let progress = events(&mut link);
+        let progress = events(&mut session);
         assert!(progress
             .iter()
             .all(|e| matches!(e, NetEvent::LevelProgress { .. })));
@@ -582,8 +583,8 @@ mod tests {
             progress.last(),
             Some(NetEvent::LevelProgress { got, total }) if got == total
         ));
-        link.on_message(Incoming::LevelEnd, now);
-        let got = events(&mut link);
+        session.on_message(Incoming::LevelEnd, now);
+        let got = events(&mut session);
         assert!(
             matches!(&got[0], NetEvent::Level(b, f) if b.level.name == "another" && f.downloaded == bytes.len() as u64)
         );
@@ -591,22 +592,22 @@ mod tests {
         assert!(matches!(&got[2], NetEvent::PlayerLeft { id: PlayerId(9) }));
     }
 
-    /// A link welcomed in "friends" on the embedded level (its events not
+    /// A session welcomed in "friends" on the embedded level (its events not
     /// taken).
-    fn joined(now: Instant) -> Link {
-        let mut link = joining("friends");
-        link.on_open(now);
-        link.on_message(
+    fn joined(now: Instant) -> PageSession {
+        let mut session = joining("friends");
+        session.on_open(now);
+        session.on_message(
             Incoming::Stream(&frame(&ServerControl::Welcome(welcome(embedded().1)))),
             now,
         );
-        link
+        session
     }
 
-    /// A joined link that was just told it is kicked (events taken).
-    fn kicked(now: Instant) -> Link {
-        let mut link = joined(now);
-        link.on_message(
+    /// A joined session that was just told it is kicked (events taken).
+    fn kicked(now: Instant) -> PageSession {
+        let mut session = joined(now);
+        session.on_message(
             Incoming::Stream(&frame(&ServerControl::Notice {
                 kind: NoticeKind::Kick {
                     reason: "sent too many datagrams".into(),
@@ -614,34 +615,37 @@ mod tests {
             })),
             now,
         );
-        events(&mut link);
-        link
+        events(&mut session);
+        session
     }
 
     #[test]
     fn refusals_closes_and_silence_end_the_session_with_the_reason() {
         let now = Instant::now();
-        let mut link = joining("friends");
-        link.on_open(now);
-        link.on_message(
+        let mut session = joining("friends");
+        session.on_open(now);
+        session.on_message(
             Incoming::Stream(&frame(&ServerControl::Reject {
                 reason: RejectReason::RoomFull,
             })),
             now,
         );
-        let got = events(&mut link);
+        let got = events(&mut session);
         assert!(
             matches!(&got[..], [NetEvent::Failed(r)] if r.contains("room is full")),
             "{got:?}"
         );
-        assert!(link.is_ended());
-        link.on_closed(Some(CloseCode::Rejected.to_u32()), "full");
-        assert!(events(&mut link).is_empty(), "only the first reason counts");
+        assert!(session.is_ended());
+        session.on_closed(Some(CloseCode::Rejected.to_u32()), "full");
+        assert!(
+            events(&mut session).is_empty(),
+            "only the first reason counts"
+        );
 
-        let mut link = joined(now);
-        events(&mut link);
-        link.on_closed(Some(CloseCode::Kicked.to_u32()), "flooding");
-        let got = events(&mut link);
+        let mut session = joined(now);
+        events(&mut session);
+        session.on_closed(Some(CloseCode::Kicked.to_u32()), "flooding");
+        let got = events(&mut session);
         assert!(
             matches!(&got[..], [NetEvent::Disconnected(r)] if r.contains("flooding")),
             "{got:?}"
@@ -649,27 +653,27 @@ mod tests {
 
         // A close without a code (WebTransport in a browser) after a kick
         // notice: the notice says why.
-        let mut link = kicked(now);
-        link.on_failed("the WebTransport session broke");
-        link.on_closed(None, "");
-        let got = events(&mut link);
+        let mut session = kicked(now);
+        session.on_failed("the WebTransport session broke");
+        session.on_closed(None, "");
+        let got = events(&mut session);
         assert!(
             matches!(&got[..], [NetEvent::Disconnected(r)] if r.contains("broke")),
             "a failure is a failure: {got:?}"
         );
 
-        let mut link = kicked(now);
-        link.on_closed(None, "");
-        let got = events(&mut link);
+        let mut session = kicked(now);
+        session.on_closed(None, "");
+        let got = events(&mut session);
         assert!(
             matches!(&got[..], [NetEvent::Disconnected(r)] if r.contains("removed us") && r.contains("too many datagrams")),
             "{got:?}"
         );
 
-        let mut link = joining("friends");
-        link.on_open(now);
-        link.poll(now + HELLO_TIMEOUT + Duration::from_millis(1));
-        let got = events(&mut link);
+        let mut session = joining("friends");
+        session.on_open(now);
+        session.poll(now + HELLO_TIMEOUT + Duration::from_millis(1));
+        let got = events(&mut session);
         assert!(
             matches!(&got[..], [NetEvent::Failed(r)] if r.contains("did not answer")),
             "{got:?}"
@@ -679,11 +683,11 @@ mod tests {
     #[test]
     fn a_level_stream_nobody_asked_for_is_an_error() {
         let now = Instant::now();
-        let mut link = joined(now);
-        events(&mut link);
-        link.on_message(Incoming::Level(&[1, 2, 3]), now);
+        let mut session = joined(now);
+        events(&mut session);
+        session.on_message(Incoming::Level(&[1, 2, 3]), now);
         assert!(matches!(
-            &events(&mut link)[..],
+            &events(&mut session)[..],
             [NetEvent::Disconnected(_)]
         ));
     }
@@ -691,12 +695,12 @@ mod tests {
     #[test]
     fn queues_stay_bounded() {
         let now = Instant::now();
-        let mut link = joined(now);
+        let mut session = joined(now);
         for tick in 0..(MAX_TRANSMITS as u64 * 3) {
-            link.send_input(tick, Buttons::NONE);
+            session.send_input(tick, Buttons::NONE);
         }
-        let (_, datagrams) = sent(&mut link);
+        let (_, datagrams) = sent(&mut session);
         assert!(datagrams.len() <= MAX_TRANSMITS);
-        assert!(link.dropped() > 0);
+        assert!(session.dropped() > 0);
     }
 }

@@ -1,5 +1,6 @@
-//! The browser's session protocol ([`ledge_client::net::link::Link`], sans IO)
-//! against a real server, carried over native QUIC: a small driver gives
+//! The browser page's session
+//! ([`ledge_client::net::page_session::PageSession`], sans IO) against a
+//! real server, carried over native QUIC: a small driver gives
 //! it the control stream's bytes, the datagrams and the level stream, the
 //! way the page's glue gives it WebTransport's. It downloads a real Tiled
 //! map's level (Sticker Knight, with its images) byte for byte, is
@@ -8,7 +9,7 @@
 
 use std::time::Duration;
 
-use ledge_client::net::link::{Incoming, Link, Transmit};
+use ledge_client::net::page_session::{Incoming, PageSession, Transmit};
 use ledge_client::net::transport::{dial, Dialed};
 use ledge_client::net::{NetEvent, Network};
 use ledge_client::JoinOptions;
@@ -21,12 +22,12 @@ use tokio::time::Instant;
 /// Tiled's platformer example map (images beside it).
 const STICKER_KNIGHT: &str = "tiled-examples/sticker-knight/map/sandbox2.tmx";
 
-/// Runs `link` over `dialed` until `done` says so (or 20 s pass): writes
+/// Runs `session` over `dialed` until `done` says so (or 20 s pass): writes
 /// its transmits, feeds it what arrives, polls it every 16 ms, giving it
 /// `buttons` for each tick (`next_tick`, set from the first snapshot
 /// on).
 async fn drive(
-    link: &mut Link,
+    session: &mut PageSession,
     dialed: &Dialed,
     send: &mut SendStream,
     recv: &mut RecvStream,
@@ -41,7 +42,7 @@ async fn drive(
     let mut ticker = tokio::time::interval(Duration::from_millis(16));
     let deadline = Instant::now() + Duration::from_secs(20);
     loop {
-        while let Some(t) = link.poll_transmit() {
+        while let Some(t) = session.poll_transmit() {
             match t {
                 Transmit::Stream(b) => send.write_all(&b).await.expect("stream write"),
                 Transmit::Datagram(d) => {
@@ -49,7 +50,7 @@ async fn drive(
                 }
             }
         }
-        while let Some(event) = link.try_recv() {
+        while let Some(event) = session.try_recv() {
             let stop = on_event(&event);
             // Inputs a little ahead of the server's newest tick (the
             // level's download took a while since the welcome).
@@ -75,12 +76,12 @@ async fn drive(
         let now = ledge_client::time::Instant::now;
         tokio::select! {
             read = recv.read(&mut buf) => match read.expect("control stream") {
-                Some(n) => link.on_message(Incoming::Stream(&buf[..n]), now()),
-                None => link.on_closed(None, "stream finished"),
+                Some(n) => session.on_message(Incoming::Stream(&buf[..n]), now()),
+                None => session.on_closed(None, "stream finished"),
             },
             datagram = connection.read_datagram() => {
                 let d = datagram.expect("connection open");
-                link.on_message(Incoming::Datagram(&d), now());
+                session.on_message(Incoming::Datagram(&d), now());
             }
             uni = connection.accept_uni() => {
                 let mut stream = uni.expect("level stream");
@@ -94,13 +95,13 @@ async fn drive(
                 });
             }
             Some(piece) = level_rx.recv() => match piece {
-                Some(bytes) => link.on_message(Incoming::Level(&bytes), now()),
-                None => link.on_message(Incoming::LevelEnd, now()),
+                Some(bytes) => session.on_message(Incoming::Level(&bytes), now()),
+                None => session.on_message(Incoming::LevelEnd, now()),
             },
             _ = ticker.tick() => {
-                link.poll(now());
+                session.poll(now());
                 if let Some(tick) = next_tick.as_mut() {
-                    link.send_input(*tick, buttons);
+                    session.send_input(*tick, buttons);
                     *tick += 1;
                 }
             }
@@ -132,18 +133,18 @@ async fn the_browser_protocol_downloads_a_real_level_joins_and_moves() {
         .await
         .expect("dial");
     let (mut send, mut recv) = dialed.connection.open_bi().await.expect("bi stream");
-    let mut link = Link::new(JoinOptions {
+    let mut session = PageSession::new(JoinOptions {
         room: Some("friends".into()),
         ..JoinOptions::new("ada")
     });
-    assert!(link.poll_transmit().is_none(), "nothing before the open");
-    link.on_open(ledge_client::time::Instant::now());
+    assert!(session.poll_transmit().is_none(), "nothing before the open");
+    session.on_open(ledge_client::time::Instant::now());
 
     let mut next_tick = None;
     // Joined: the level first (downloaded, checked), then the welcome,
     // then bob in the roster.
     let events = drive(
-        &mut link,
+        &mut session,
         &dialed,
         &mut send,
         &mut recv,
@@ -185,7 +186,7 @@ async fn the_browser_protocol_downloads_a_real_level_joins_and_moves() {
     let first_x = std::cell::Cell::new(None::<i32>);
     let moved = std::cell::Cell::new(0i32);
     drive(
-        &mut link,
+        &mut session,
         &dialed,
         &mut send,
         &mut recv,
@@ -204,8 +205,8 @@ async fn the_browser_protocol_downloads_a_real_level_joins_and_moves() {
         &mut next_tick,
     )
     .await;
-    assert!(link.transport().unwrap().bytes_in > server_offer.size);
-    assert!(link.players().values().any(|n| n == "ada"));
-    assert!(!link.is_ended());
+    assert!(session.transport().unwrap().bytes_in > server_offer.size);
+    assert!(session.players().values().any(|n| n == "ada"));
+    assert!(!session.is_ended());
     drop(native);
 }
