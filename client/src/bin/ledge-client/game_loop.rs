@@ -11,9 +11,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use crate::anim::Animator;
-use crate::audio::{Audio, AudioStatus, Effect};
-use crate::cues::Cues;
+use crate::draw::anim::Animator;
+use crate::sound::audio::{Audio, AudioStatus, Effect};
+use crate::sound::cues::Cues;
 use ledge_client::time::Instant;
 use ledge_client::view::{px2, FrameView, NetStats};
 use ledge_shared::fixed::UNITS_PER_PX;
@@ -22,13 +22,14 @@ use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
 use macroquad::prelude::*;
 
-use crate::art::ArtView;
-use crate::camera::{self, Camera};
-use crate::keys::{Bindings, Gamepads};
+use crate::draw::art::ArtView;
+use crate::draw::camera::{self, Camera};
+use crate::draw::render::{self, EntitySprite, PlayerSprite};
+use crate::draw::{debug, fx, hud};
+use crate::input::keys::{Bindings, Gamepads};
+use crate::input::script::Script;
 use crate::outcome::{fail, EXIT_FAILED, EXIT_JOIN_TIMEOUT, EXIT_UNTRUSTED};
-use crate::render::{self, EntitySprite, PlayerSprite};
-use crate::script::Script;
-use crate::{debug, fx, hud, play, shot};
+use crate::{play, shot};
 
 /// How long "sound off: why" stays on screen, seconds from the start.
 const SOUND_NOTICE_SECONDS: f64 = 6.0;

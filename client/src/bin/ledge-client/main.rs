@@ -29,41 +29,34 @@
 //! * 3 ([`outcome::EXIT_UNTRUSTED`]): the server's certificate was refused.
 //!
 //! Modules, top to bottom (each uses only those below it): the entry
-//! points ([`native`], and `web` in the browser) prepare a [`game_loop::Setup`]; the
-//! [`game_loop`] runs the frames; [`play`], [`keys`], [`hud`], [`render`],
-//! [`fx`], [`shot`] and the rest do one thing each for it, among them the
-//! presentation the headless library leaves out: how players look from
-//! frame to frame ([`anim`]), the sound effects and their player
-//! ([`audio`]), and which of them a frame cues ([`cues`]); at the bottom
-//! the page's glue (`page`, in the browser), gamepads ([`pad`]) and how a run ends
-//! ([`outcome`]).
+//! points ([`native`] with [`local`], and `web` in the browser) prepare a
+//! [`game_loop::Setup`]; the [`game_loop`] runs the frames; [`play`] (the
+//! game, offline or online) and [`shot`] (`--screenshot`) serve it, with
+//! three groups that do one thing each for it: [`draw`] (the camera, the
+//! world, the players' animation, effects, the HUD, the debug overlay),
+//! [`sound`] (which effects a frame cues, and playing them) and [`input`]
+//! (keys, gamepads, scripts); at the bottom the page's glue (`page`, in the
+//! browser), the gamepads' state ([`input::pad`]) and how a run ends
+//! ([`outcome`]). The presentation here (animation, sound, cues) is the
+//! window's alone: the headless library leaves it out.
 
 // The browser build leaves out the command line, files and the network
 // thread, and with them some helpers the native build uses.
 #![cfg_attr(target_arch = "wasm32", allow(dead_code))]
 
-mod anim;
-mod art;
-mod audio;
-mod camera;
-mod cues;
-mod debug;
-mod fx;
+mod draw;
 mod game_loop;
-mod hud;
-mod keys;
+mod input;
 #[cfg(not(target_arch = "wasm32"))]
 mod local;
 #[cfg(not(target_arch = "wasm32"))]
 mod native;
 mod outcome;
-mod pad;
 #[cfg(target_arch = "wasm32")]
 mod page;
 mod play;
-mod render;
-mod script;
 mod shot;
+mod sound;
 #[cfg(target_arch = "wasm32")]
 mod web;
 

@@ -11,9 +11,9 @@ use ledge_client::{Fingerprint, OnlineRequest, Trust};
 use macroquad::prelude::vec2;
 
 use crate::game_loop::{game, Setup};
-use crate::keys::{self, Bindings};
+use crate::input::keys::{self, Bindings};
+use crate::input::script::Script;
 use crate::outcome::{tell, EXIT_CODE, EXIT_FAILED, EXIT_UNTRUSTED};
-use crate::script::Script;
 use crate::{local, play};
 
 /// How long the window waits for the server's first answer before it

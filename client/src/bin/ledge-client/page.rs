@@ -18,8 +18,8 @@ use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{web, PlayerId};
 
+use crate::input::pad::PadState;
 use crate::outcome::tell;
-use crate::pad::PadState;
 
 /// The glue's version: `web/ledge.js` says the same, and miniquad's loader
 /// compares them (`ledge_crate_version`) so a stale page says so.
@@ -286,9 +286,9 @@ pub fn report(r: &Report<'_>) {
         "players": players,
         // The level's flat colours, for tests of what the canvas shows.
         "palette": {
-            "sky": crate::render::palette::bytes(crate::render::palette::SKY),
-            "solid": crate::render::palette::bytes(crate::render::palette::SOLID),
-            "grass": crate::render::palette::bytes(crate::render::palette::GRASS),
+            "sky": crate::draw::render::palette::bytes(crate::draw::render::palette::SKY),
+            "solid": crate::draw::render::palette::bytes(crate::draw::render::palette::SOLID),
+            "grass": crate::draw::render::palette::bytes(crate::draw::render::palette::GRASS),
         },
     })
     .to_string();

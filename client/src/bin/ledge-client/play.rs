@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-use crate::anim::{spread, Animator, Pose};
+use crate::draw::anim::{spread, Animator, Pose};
 use glam::IVec2;
 use ledge_client::game::ClientGame;
 use ledge_client::net::NetStatus;
@@ -24,7 +24,7 @@ use ledge_shared::game::PlayerView;
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
 
-use crate::render::{EntitySprite, PlayerSprite};
+use crate::draw::render::{EntitySprite, PlayerSprite};
 
 impl From<&PlayerDraw> for PlayerSprite {
     fn from(p: &PlayerDraw) -> PlayerSprite {
@@ -44,7 +44,7 @@ impl From<&PlayerDraw> for PlayerSprite {
 /// The players of `view` to draw this frame (ours, then the others):
 /// posed by `animator` (advanced by `dt` seconds, the frame's duration)
 /// and, where several stand on one spot, fanned out sideways
-/// (`crate::anim::spread`: ours never moves). Dead players keep
+/// (`crate::draw::anim::spread`: ours never moves). Dead players keep
 /// their place and take no part in the fanning.
 pub fn sprites(
     view: &FrameView,

@@ -56,9 +56,9 @@ use glam::IVec2;
 use macroquad::math::{Rect, Vec2};
 use macroquad::texture::get_screen_data;
 
-use crate::camera::View;
-use crate::hud::{BannerLayout, FAILURE_PANEL};
-use crate::render::palette;
+use crate::draw::camera::View;
+use crate::draw::hud::{BannerLayout, FAILURE_PANEL};
+use crate::draw::render::palette;
 
 /// What a screenshot records.
 pub struct Shot<'a> {
@@ -94,7 +94,7 @@ pub struct FxShot<'a> {
     /// The flash's opacity.
     pub flash: f32,
     /// The effects started lately, oldest first.
-    pub recent: &'a [crate::audio::Effect],
+    pub recent: &'a [crate::sound::audio::Effect],
     /// Our player is dead (waiting to respawn).
     pub dead: bool,
 }
@@ -104,7 +104,7 @@ pub struct HudShot<'a> {
     /// The name shown.
     pub name: &'a str,
     /// Our run (`None` before we are in the game).
-    pub run: Option<crate::hud::RunInfo>,
+    pub run: Option<crate::draw::hud::RunInfo>,
     /// The network panel was shown.
     pub net_panel: bool,
     /// The muted marker was shown.
@@ -113,7 +113,7 @@ pub struct HudShot<'a> {
     pub sound_notice: Option<&'a str>,
     /// The room's results (the table is drawn when someone besides us is
     /// in it).
-    pub results: &'a [crate::hud::ResultRow],
+    pub results: &'a [crate::draw::hud::ResultRow],
 }
 
 /// A remote player as drawn.
@@ -284,7 +284,7 @@ fn describe_hud(s: &mut String, hud: Option<&HudShot>) {
                 let _ = writeln!(s, "    \"deaths\": {},", r.deaths);
                 let _ = writeln!(s, "    \"run_ticks\": {},", r.run_ticks);
                 let _ = writeln!(s, "    \"tick_rate\": {},", r.tick_rate);
-                let time = crate::hud::run_time(r.run_ticks, r.tick_rate);
+                let time = crate::draw::hud::run_time(r.run_ticks, r.tick_rate);
                 let _ = writeln!(s, "    \"time\": {},", json_string(&time));
                 let place = r.place.map_or("null".to_owned(), |p| p.to_string());
                 let _ = writeln!(s, "    \"place\": {place},");
@@ -312,7 +312,7 @@ fn describe_hud(s: &mut String, hud: Option<&HudShot>) {
             let _ = writeln!(
                 s,
                 "    \"results_table\": {}",
-                crate::hud::shows_table(h.results)
+                crate::draw::hud::shows_table(h.results)
             );
             let _ = writeln!(s, "  }},");
         }
@@ -377,7 +377,7 @@ mod tests {
             }],
             hud: Some(HudShot {
                 name: "ada \"x\"",
-                run: Some(crate::hud::RunInfo {
+                run: Some(crate::draw::hud::RunInfo {
                     coins: 2,
                     coins_total: 10,
                     deaths: 1,
@@ -389,14 +389,14 @@ mod tests {
                 muted: true,
                 sound_notice: None,
                 results: &[
-                    crate::hud::ResultRow {
+                    crate::draw::hud::ResultRow {
                         place: 1,
                         name: "bo".into(),
                         ticks: 600,
                         deaths: 0,
                         ours: false,
                     },
-                    crate::hud::ResultRow {
+                    crate::draw::hud::ResultRow {
                         place: 2,
                         name: "ada \"x\"".into(),
                         ticks: 604,
@@ -410,7 +410,7 @@ mod tests {
                 particles: 12,
                 shake: 1.5,
                 flash: 0.25,
-                recent: &[crate::audio::Effect::Hurt],
+                recent: &[crate::sound::audio::Effect::Hurt],
                 dead: true,
             },
         };

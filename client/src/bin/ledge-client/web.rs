@@ -16,7 +16,7 @@ use std::time::Duration;
 use ledge_client::JoinOptions;
 
 use crate::game_loop::{game, Setup};
-use crate::keys::Bindings;
+use crate::input::keys::Bindings;
 use crate::outcome::tell;
 use crate::page::{host, param, WebNet};
 use crate::play;

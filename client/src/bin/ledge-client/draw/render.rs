@@ -4,14 +4,14 @@
 //! layers and tileset images) is drawn by `art.rs`; the tilemap's flat
 //! colours only fill the cells the art does not draw.
 
-use crate::anim::{label_rows, Action, Label, Pose};
+use crate::draw::anim::{label_rows, Action, Label, Pose};
 use ledge_client::view::{EntityType, Facing};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::level::{EntityKind, Level};
 use ledge_shared::tilemap::{Slope, Tile, Tilemap};
 use macroquad::prelude::*;
 
-use crate::camera::View;
+use crate::draw::camera::View;
 
 /// The colours of the game.
 pub mod palette {

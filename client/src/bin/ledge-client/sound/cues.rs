@@ -31,7 +31,7 @@
 //! changes nothing here: cues come from differences only. A state seen for the first time
 //! (joining, a new game) plays nothing.
 //!
-//! The window's sound ([`crate::audio`]) and effects ([`crate::fx`]) are
+//! The window's sound ([`crate::sound::audio`]) and effects ([`crate::draw::fx`]) are
 //! its only listeners, so it is part of the front end, not of the headless
 //! library.
 
@@ -40,7 +40,7 @@ use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::game::{EntityType, EntityView, Game, PlayerConfig, PlayerView};
 use ledge_shared::protocol::PlayerId;
 
-use crate::audio::Effect;
+use crate::sound::audio::Effect;
 
 /// The same cue for the same value within this many ticks is a replay, not
 /// a new event (half a second at 60 ticks a second).

@@ -17,7 +17,7 @@ use ledge_shared::world::{
 };
 use macroquad::prelude::*;
 
-use crate::camera::View;
+use crate::draw::camera::View;
 
 /// Pixels per unit.
 const PX: f32 = 1.0 / UNITS_PER_PX as f32;

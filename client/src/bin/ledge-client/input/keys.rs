@@ -275,7 +275,7 @@ pub fn key_by_name(name: &str) -> Option<KeyCode> {
         .find(|k| format!("{k:?}").to_ascii_lowercase() == wanted)
 }
 
-/// Gamepads through gilrs (see [`crate::pad::PadState::buttons`]).
+/// Gamepads through gilrs (see [`crate::input::pad::PadState::buttons`]).
 #[cfg(all(feature = "gamepad", not(target_arch = "wasm32")))]
 pub struct Gamepads {
     gilrs: Option<gilrs::Gilrs>,
@@ -304,7 +304,7 @@ impl Gamepads {
         while gilrs.next_event().is_some() {}
         let mut bits = 0;
         for (_, pad) in gilrs.gamepads() {
-            let state = crate::pad::PadState {
+            let state = crate::input::pad::PadState {
                 left: pad.is_pressed(Button::DPadLeft),
                 right: pad.is_pressed(Button::DPadRight),
                 up: pad.is_pressed(Button::DPadUp),
@@ -321,7 +321,7 @@ impl Gamepads {
 }
 
 /// Gamepads in a browser: the page's Gamepad API, read each frame (see
-/// [`crate::pad::PadState::buttons`]).
+/// [`crate::input::pad::PadState::buttons`]).
 #[cfg(target_arch = "wasm32")]
 pub struct Gamepads;
 

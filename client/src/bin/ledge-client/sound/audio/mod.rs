@@ -14,7 +14,7 @@
 //!   device ([`alsa`]). Dropping the [`Audio`] stops it and joins it,
 //!   waiting at most [`STOP_TIMEOUT`].
 //!
-//! The window maps game events to effects ([`crate::cues`]) and owns the
+//! The window maps game events to effects ([`crate::sound::cues`]) and owns the
 //! mute key and the volume setting; this module only offers the calls. Only
 //! the window plays sound, so it is part of the front end, not of the
 //! headless library.

@@ -12,7 +12,7 @@ use ledge_shared::tilemap::{Tile, Tilemap};
 use ledge_shared::world::Sides;
 
 use super::{Cues, REPEAT_TICKS};
-use crate::audio::Effect;
+use crate::sound::audio::Effect;
 
 const P1: PlayerId = PlayerId(1);
 /// One tile, units.

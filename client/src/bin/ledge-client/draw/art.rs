@@ -13,7 +13,7 @@ use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::tilemap::Tilemap;
 use macroquad::prelude::*;
 
-use crate::camera::View;
+use crate::draw::camera::View;
 
 /// A level's art with its textures.
 pub struct ArtView {

@@ -6,7 +6,7 @@
 //!
 //! Only the window shows it, so it is part of the front end, not of the
 //! headless library; pure (no drawing here), so it is tested without a
-//! window, and [`crate::render`] draws the [`Pose`]s. Everything is driven
+//! window, and [`crate::draw::render`] draws the [`Pose`]s. Everything is driven
 //! by the frame's `dt` in seconds (exponential easing, timers), so the
 //! result does not depend on the frame rate.
 //!

@@ -5,7 +5,7 @@
 //!
 //! Effects are cosmetic and frame-driven: they never touch the simulation
 //! and are not part of its state. Our player's effects come from the same
-//! [`Effect`] cues the sound plays ([`crate::cues::Cues`], so a
+//! [`Effect`] cues the sound plays ([`crate::sound::cues::Cues`], so a
 //! rollback never replays one); the other players' deaths, respawns and
 //! finishes from what their drawn state says frame to frame
 //! ([`Fx::watch`]). Ours shake the screen and flash it; theirs do not.
@@ -17,12 +17,12 @@
 
 use std::collections::BTreeMap;
 
-use crate::audio::Effect;
+use crate::sound::audio::Effect;
 use ledge_client::rng::SplitMix64;
 use macroquad::prelude::*;
 
-use crate::camera::View;
-use crate::render::palette;
+use crate::draw::camera::View;
+use crate::draw::render::palette;
 
 /// Particles alive at most: a burst past it replaces the oldest.
 pub const MAX_PARTICLES: usize = 768;

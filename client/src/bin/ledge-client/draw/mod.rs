@@ -1,0 +1,16 @@
+//! What the window draws, each frame, from the game's views: where it looks
+//! ([`camera`]), the world and the players ([`render`], the level's own art
+//! in [`art`]), how the players move between ticks ([`anim`]), particles,
+//! shake and flashes ([`fx`]), the heads-up display ([`hud`]) and the
+//! debug overlay ([`debug`]).
+//!
+//! Grouped so that the front end's layout says what it does; this module
+//! only declares them.
+
+pub mod anim;
+pub mod art;
+pub mod camera;
+pub mod debug;
+pub mod fx;
+pub mod hud;
+pub mod render;

@@ -1,0 +1,10 @@
+//! What presses the game's buttons: the keyboard and gamepads through
+//! rebindable bindings ([`keys`]), one gamepad's state whatever reports it
+//! ([`pad`]), and scripted input for tests and demos ([`script`]).
+//!
+//! Grouped so that the front end's layout says what it does; this module
+//! only declares them.
+
+pub mod keys;
+pub mod pad;
+pub mod script;
