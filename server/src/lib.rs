@@ -58,6 +58,7 @@ pub mod quic_cert;
 pub mod ratelimit;
 pub mod record;
 pub mod room;
+pub mod room_logic;
 pub mod room_registry;
 pub mod server;
 pub mod sessions;

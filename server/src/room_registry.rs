@@ -20,7 +20,8 @@ use tracing::info;
 use crate::fleet::{Load, RoomLoad};
 use crate::metrics::Metrics;
 use crate::record::Recorder;
-use crate::room::{self, RoomConfig, RoomHandle};
+use crate::room::{self, RoomHandle};
+use crate::room_logic::RoomConfig;
 
 /// How long a room opened by name stays open while empty.
 pub const IDLE_CLOSE: Duration = Duration::from_secs(60);

@@ -25,7 +25,7 @@ use crate::link::Incoming;
 use crate::metrics::{self, Metrics};
 use crate::quic_cert::{CertError, Identity};
 use crate::record::Recorder;
-use crate::room::RoomConfig;
+use crate::room_logic::RoomConfig;
 use crate::room_registry::Rooms;
 use crate::sessions::Sessions;
 use crate::shared::Shared;
