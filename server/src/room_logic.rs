@@ -732,3 +732,533 @@ fn roster_entry((&id, m): (&PlayerId, &Member)) -> RosterEntry {
         name: m.name.clone(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const RIGHT: Buttons = Buttons(Buttons::RIGHT);
+    const JUMP: Buttons = Buttons(Buttons::JUMP);
+    const A: PlayerId = PlayerId(1);
+    const B: PlayerId = PlayerId(2);
+    const C: PlayerId = PlayerId(3);
+    /// A datagram size every snapshot of the default level fits.
+    const ROOMY: Option<usize> = Some(1200);
+
+    fn config(max_players: usize) -> RoomConfig {
+        RoomConfig {
+            name: "test".into(),
+            tick_rate: 60,
+            snapshot_interval: 2,
+            max_players,
+            max_catch_up: 15,
+            input_window: 64,
+            input_redundancy: 16,
+            history: 64,
+            level_id: "default".into(),
+            level_hash: 7,
+            level: LevelOffer::default(),
+            record: None,
+            idle_kick: Duration::from_secs(30),
+        }
+    }
+
+    fn game() -> Game {
+        Game::from_level(&ledge_levels::default_level()).unwrap()
+    }
+
+    fn room_with(config: RoomConfig) -> (RoomLogic, Arc<Metrics>) {
+        let (metrics, _registry) = Metrics::new();
+        (RoomLogic::new(game(), config, metrics.clone()), metrics)
+    }
+
+    fn room(max_players: usize) -> (RoomLogic, Arc<Metrics>) {
+        room_with(config(max_players))
+    }
+
+    fn frame(message: &ServerControl) -> Vec<u8> {
+        let mut frame = Vec::new();
+        write_frame(message, &mut frame).unwrap();
+        frame
+    }
+
+    fn control(to: PlayerId, message: &ServerControl) -> Action {
+        Action::Control {
+            to,
+            frame: frame(message),
+        }
+    }
+
+    fn roster(players: &[(PlayerId, &str)]) -> ServerControl {
+        ServerControl::Roster {
+            players: players
+                .iter()
+                .map(|&(id, name)| RosterEntry {
+                    id,
+                    name: name.into(),
+                })
+                .collect(),
+        }
+    }
+
+    fn actions(room: &mut RoomLogic) -> Vec<Action> {
+        let mut out = Vec::new();
+        room.take_actions(&mut out);
+        out
+    }
+
+    fn join(room: &mut RoomLogic, id: PlayerId, name: &str) -> Joined {
+        let joined = room.join(id, name.into()).unwrap();
+        actions(room);
+        joined
+    }
+
+    /// Runs `n` ticks 16 ms apart from `t0`, every client's datagrams at
+    /// most `datagram` bytes, and reports every snapshot as sent (a
+    /// perfect link). Returns the actions, in order.
+    fn ticks(room: &mut RoomLogic, n: u64, datagram: Option<usize>, t0: Instant) -> Vec<Action> {
+        let mut all = Vec::new();
+        for _ in 0..n {
+            let now = t0 + Duration::from_millis(16 * room.game().tick());
+            room.tick(now, |_| datagram);
+            for action in actions(room) {
+                if let Action::Snapshot {
+                    to, tick, outgoing, ..
+                } = &action
+                {
+                    match outgoing {
+                        Outgoing::Datagram(_) => room.datagram_sent(*to, *tick),
+                        Outgoing::Control(_) => room.stream_queued(*to, *tick, now),
+                    }
+                }
+                all.push(action);
+            }
+        }
+        all
+    }
+
+    /// The snapshots in `actions`: to whom, of which tick, full or delta,
+    /// as a datagram or not.
+    fn snapshots(actions: &[Action]) -> Vec<(PlayerId, u64, SnapshotKind, bool)> {
+        actions
+            .iter()
+            .filter_map(|a| match a {
+                Action::Snapshot {
+                    to,
+                    tick,
+                    kind,
+                    outgoing,
+                } => Some((*to, *tick, *kind, matches!(outgoing, Outgoing::Datagram(_)))),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Client `joined` sends `buttons` for the ticks from `first`, and
+    /// acknowledges snapshot `ack`.
+    fn send(joined: &Joined, first: u64, buttons: &[Buttons], ack: Option<u64>) -> Received {
+        let newest = first + buttons.len() as u64 - 1;
+        let newest_first: Vec<Buttons> = buttons.iter().rev().copied().collect();
+        lock(&joined.inbox).receive(&InputPacket::new(newest, &newest_first, ack))
+    }
+
+    /// The state hash of a game with `players` stepped with `steps`.
+    fn reference(players: &[PlayerId], steps: &[Vec<(PlayerId, Buttons)>]) -> u64 {
+        let mut game = game();
+        for &id in players {
+            game.add_player(id).unwrap();
+        }
+        for inputs in steps {
+            game.step(inputs);
+        }
+        game.state_hash()
+    }
+
+    fn starvation(metrics: &Metrics) -> u64 {
+        let label = RoomLabel {
+            room: "test".into(),
+        };
+        metrics.input_starvation.get_or_create(&label).get()
+    }
+
+    fn dropped(metrics: &Metrics, reason: DropReason) -> u64 {
+        metrics
+            .dropped
+            .get_or_create(&crate::metrics::DropLabel { reason })
+            .get()
+    }
+
+    #[test]
+    fn a_join_is_welcomed_with_a_roster_and_announced_to_the_others() {
+        let (mut room, _) = room(4);
+        let ann = room.join(A, "ann".into()).unwrap();
+        assert_eq!(ann.generation, 0);
+        let w = &ann.welcome;
+        assert_eq!(
+            (w.player_id, w.room.as_str(), w.server_tick),
+            (A, "test", 0)
+        );
+        assert_eq!((w.level_id.as_str(), w.level_hash), ("default", 7));
+        assert_eq!((w.timing.tick_rate, w.timing.snapshot_interval), (60, 2));
+        assert_eq!(w.timing.input_redundancy, 16);
+        assert_eq!(
+            w.sim_config,
+            encode_sim_config(room.game().config()).unwrap()
+        );
+        assert_eq!(w.session_token, SessionToken::default());
+        assert_eq!(actions(&mut room), [control(A, &roster(&[(A, "ann")]))]);
+
+        ticks(&mut room, 3, ROOMY, Instant::now());
+        let bob = room.join(B, "bob".into()).unwrap();
+        assert_eq!(bob.welcome.server_tick, 3);
+        let joined = ServerControl::PlayerJoined(RosterEntry {
+            id: B,
+            name: "bob".into(),
+        });
+        assert_eq!(
+            actions(&mut room),
+            [
+                control(B, &roster(&[(A, "ann"), (B, "bob")])),
+                control(A, &joined)
+            ]
+        );
+        assert_eq!(room.players(), 2);
+        assert_eq!(room.status().players, 2);
+        assert_eq!(room.game().players().count(), 2);
+    }
+
+    #[test]
+    fn a_full_room_and_a_name_taken_are_refused() {
+        let (mut room, _) = room(2);
+        join(&mut room, A, "ann");
+        let taken = room.join(B, "ANN".into()).unwrap_err();
+        assert!(
+            matches!(&taken, RejectReason::Other { reason } if reason.contains("is taken")),
+            "{taken:?}"
+        );
+        join(&mut room, B, "bob");
+        assert_eq!(
+            room.join(C, "carl".into()).unwrap_err(),
+            RejectReason::RoomFull
+        );
+        assert_eq!(actions(&mut room), []);
+        assert_eq!(room.players(), 2);
+        assert_eq!(room.game().players().count(), 2);
+    }
+
+    #[test]
+    fn a_leave_of_the_connection_holding_the_player_removes_it() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        // Another connection's leave, and an unknown player's: nothing.
+        room.leave(A, 1);
+        room.leave(C, 0);
+        room.detach(C, 0);
+        room.datagram_sent(C, 0);
+        assert_eq!(actions(&mut room), []);
+        assert_eq!(room.players(), 2);
+
+        room.leave(A, 0);
+        assert_eq!(
+            actions(&mut room),
+            [
+                control(B, &ServerControl::PlayerLeft { id: A }),
+                Action::Left(A)
+            ]
+        );
+        assert_eq!(room.players(), 1);
+        assert!(room.game().player(A).is_none());
+        // Its name is free again.
+        assert!(room.join(C, "Ann".into()).is_ok());
+    }
+
+    #[test]
+    fn a_lost_player_stays_sent_nothing_until_it_resumes() {
+        let (mut room, _) = room(4);
+        let t0 = Instant::now();
+        join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        room.detach(A, 0);
+        assert_eq!(actions(&mut room), []);
+        let sent = ticks(&mut room, 4, ROOMY, t0);
+        assert!(!sent.contains(&Action::SampleWire(A)));
+        let to: Vec<PlayerId> = snapshots(&sent).iter().map(|s| s.0).collect();
+        assert_eq!(to, [B, B]);
+        assert!(room.game().player(A).is_some(), "kept in the game");
+
+        // Within the grace time (the sessions' to judge): the same body, a
+        // new generation, and the room as it is now.
+        let resumed = room.rejoin(A).unwrap();
+        assert!(!resumed.close_old);
+        assert_eq!(resumed.joined.generation, 1);
+        assert_eq!(resumed.joined.welcome.player_id, A);
+        assert_eq!(resumed.joined.welcome.server_tick, 4);
+        assert_eq!(
+            actions(&mut room),
+            [control(A, &roster(&[(A, "ann"), (B, "bob")]))]
+        );
+        // The lost connection's late detach and leave change nothing.
+        room.detach(A, 0);
+        room.leave(A, 0);
+        assert_eq!(room.players(), 2);
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        let to: Vec<(PlayerId, SnapshotKind)> =
+            snapshots(&sent).iter().map(|s| (s.0, s.2)).collect();
+        assert_eq!(to, [(A, SnapshotKind::Full), (B, SnapshotKind::Full)]);
+    }
+
+    #[test]
+    fn a_player_resumed_while_still_attached_has_its_old_connection_closed() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        let resumed = room.rejoin(A).unwrap();
+        assert!(resumed.close_old);
+        assert_eq!(resumed.joined.generation, 1);
+        assert_eq!(room.rejoin(A).unwrap().joined.generation, 2);
+    }
+
+    #[test]
+    fn after_the_grace_time_a_lost_player_is_gone_and_cannot_resume() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        room.detach(A, 0);
+        // The sessions end it after the grace time.
+        room.leave(A, 0);
+        assert_eq!(
+            actions(&mut room),
+            [
+                control(B, &ServerControl::PlayerLeft { id: A }),
+                Action::Left(A)
+            ]
+        );
+        assert!(room.rejoin(A).is_none());
+        assert_eq!(actions(&mut room), []);
+    }
+
+    #[test]
+    fn a_resumer_gone_before_its_welcome_leaves_the_player_lost() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        room.detach(A, 0);
+        let resumed = room.rejoin(A).unwrap();
+        actions(&mut room);
+        room.resumer_gone(A, 0); // an older generation: ignored
+        assert_eq!(
+            snapshots(&ticks(&mut room, 2, ROOMY, Instant::now())).len(),
+            1
+        );
+        room.resumer_gone(A, resumed.joined.generation);
+        assert_eq!(snapshots(&ticks(&mut room, 2, ROOMY, Instant::now())), []);
+        assert_eq!(room.rejoin(A).unwrap().joined.generation, 2);
+    }
+
+    #[test]
+    fn a_tick_steps_the_game_with_each_players_input() {
+        let (mut room, metrics) = room(4);
+        let ann = join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        let r = send(&ann, 0, &[RIGHT, RIGHT, JUMP], None);
+        assert_eq!((r.fresh, r.late, r.too_early), (3, 0, 0));
+        ticks(&mut room, 3, ROOMY, Instant::now());
+        let steps: Vec<_> = [RIGHT, RIGHT, JUMP]
+            .iter()
+            .map(|&b| vec![(A, b), (B, Buttons::NONE)])
+            .collect();
+        assert_eq!(room.status().tick, 3);
+        assert_eq!(room.status().state_hash, reference(&[A, B], &steps));
+        // Bob never sent anything: not starving.
+        assert_eq!(starvation(&metrics), 0);
+    }
+
+    #[test]
+    fn a_missing_input_repeats_the_last_one_and_counts_as_starvation() {
+        let (mut room, metrics) = room(4);
+        let ann = join(&mut room, A, "ann");
+        send(&ann, 0, &[RIGHT], None);
+        ticks(&mut room, 3, ROOMY, Instant::now());
+        let steps = vec![vec![(A, RIGHT)]; 3];
+        assert_eq!(room.status().state_hash, reference(&[A], &steps));
+        assert_eq!(starvation(&metrics), 2);
+    }
+
+    #[test]
+    fn inputs_for_past_or_too_far_future_ticks_are_not_applied() {
+        let (mut room, metrics) = room(4);
+        let ann = join(&mut room, A, "ann");
+        ticks(&mut room, 2, ROOMY, Instant::now());
+        // Tick 0 was simulated; 2 + 64 lies beyond the window.
+        let late = send(&ann, 0, &[RIGHT], None);
+        assert_eq!((late.fresh, late.late), (0, 1));
+        let early = send(&ann, 2 + 64, &[RIGHT], None);
+        assert_eq!((early.fresh, early.too_early), (0, 1));
+        ticks(&mut room, 1, ROOMY, Instant::now());
+        let steps = vec![vec![(A, Buttons::NONE)]; 3];
+        assert_eq!(room.status().state_hash, reference(&[A], &steps));
+        // Nothing for tick 2: a starved tick, now that it sent something.
+        assert_eq!(starvation(&metrics), 1);
+    }
+
+    #[test]
+    fn snapshots_go_full_then_delta_against_the_acknowledged_one() {
+        let (mut room, _) = room(4);
+        let ann = join(&mut room, A, "ann");
+        let t0 = Instant::now();
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        // The wire is sampled once a second, from tick 0.
+        assert_eq!(sent[0], Action::SampleWire(A));
+        assert_eq!(snapshots(&sent), [(A, 2, SnapshotKind::Full, true)]);
+        // Unacknowledged: full again.
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        assert_eq!(snapshots(&sent), [(A, 4, SnapshotKind::Full, true)]);
+        send(&ann, 4, &[RIGHT], Some(4));
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        assert_eq!(snapshots(&sent), [(A, 6, SnapshotKind::Delta, true)]);
+        assert!(!sent.contains(&Action::SampleWire(A)));
+    }
+
+    #[test]
+    fn a_snapshot_that_fits_no_datagram_goes_on_the_stream_once_until_acknowledged() {
+        let (mut room, metrics) = room(4);
+        let ann = join(&mut room, A, "ann");
+        let t0 = Instant::now();
+        let sent = ticks(&mut room, 2, None, t0);
+        assert_eq!(snapshots(&sent), [(A, 2, SnapshotKind::Full, false)]);
+        // Within STREAM_SNAPSHOT_RESEND, unacknowledged: deferred.
+        let sent = ticks(&mut room, 4, None, t0);
+        assert_eq!(snapshots(&sent), []);
+        assert_eq!(dropped(&metrics, DropReason::SnapshotDeferred), 2);
+        // Acknowledged: the next one goes.
+        send(&ann, 6, &[RIGHT], Some(2));
+        let sent = ticks(&mut room, 2, None, t0);
+        assert_eq!(snapshots(&sent), [(A, 8, SnapshotKind::Delta, false)]);
+        // Unacknowledged for STREAM_SNAPSHOT_RESEND: sent again.
+        let sent = ticks(&mut room, 64, None, t0);
+        assert_eq!(snapshots(&sent).len(), 1);
+        assert_eq!(snapshots(&sent)[0].1, 8 + 64);
+    }
+
+    #[test]
+    fn a_snapshot_not_sent_is_not_taken_as_the_last_one() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        let now = Instant::now();
+        // Stream snapshots that never got queued (a full queue) defer nothing.
+        for tick in [2, 4] {
+            room.tick(now, |_| None);
+            room.tick(now, |_| None);
+            assert_eq!(
+                snapshots(&actions(&mut room)),
+                [(A, tick, SnapshotKind::Full, false)]
+            );
+        }
+    }
+
+    #[test]
+    fn an_idle_player_is_kicked_and_the_others_are_told() {
+        let mut config = config(3);
+        config.idle_kick = Duration::from_millis(100); // 6 ticks at 60 Hz
+        let (mut room, metrics) = room_with(config);
+        join(&mut room, A, "ann");
+        let bob = join(&mut room, B, "bob");
+        let t0 = Instant::now();
+        for tick in 0..7 {
+            send(&bob, tick, &[RIGHT], None);
+            let sent = ticks(&mut room, 1, ROOMY, t0);
+            assert!(
+                !sent.iter().any(|a| matches!(a, Action::Kick { .. })),
+                "tick {tick}"
+            );
+        }
+        send(&bob, 7, &[RIGHT], None);
+        let sent = ticks(&mut room, 1, ROOMY, t0);
+        let reason = "no input for 0 s (or half of it in a full room)".to_string();
+        let notice = ServerControl::Notice {
+            kind: NoticeKind::Kick {
+                reason: reason.clone(),
+            },
+        };
+        assert_eq!(
+            sent[..4],
+            [
+                control(A, &notice),
+                Action::Kick { to: A, reason },
+                control(B, &ServerControl::PlayerLeft { id: A }),
+                Action::Left(A),
+            ]
+        );
+        assert_eq!(room.players(), 1);
+        let kicks = metrics.kicks.get_or_create(&KickLabel {
+            reason: KickReason::Idle,
+        });
+        assert_eq!(kicks.get(), 1);
+    }
+
+    #[test]
+    fn a_full_room_kicks_an_idle_player_in_half_the_time() {
+        let mut config = config(2);
+        config.idle_kick = Duration::from_millis(100);
+        let (mut room, _) = room_with(config);
+        join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        let kicks = |sent: &[Action]| {
+            sent.iter()
+                .filter(|a| matches!(a, Action::Kick { .. }))
+                .count()
+        };
+        let t0 = Instant::now();
+        // Silent since tick 0, past 3 ticks (not 6) at tick 4.
+        assert_eq!(kicks(&ticks(&mut room, 4, ROOMY, t0)), 0);
+        let kicked = kicks(&ticks(&mut room, 1, ROOMY, t0));
+        assert_eq!(kicked, 2, "both at once");
+        assert_eq!(room.players(), 0);
+    }
+
+    #[test]
+    fn a_lost_player_is_not_kicked_for_its_silence() {
+        let mut config = config(3);
+        config.idle_kick = Duration::from_millis(100);
+        let (mut room, _) = room_with(config);
+        join(&mut room, A, "ann");
+        room.detach(A, 0);
+        let sent = ticks(&mut room, 20, ROOMY, Instant::now());
+        assert_eq!(sent, []);
+        assert_eq!(room.players(), 1);
+    }
+
+    #[test]
+    fn a_quiet_client_in_a_still_room_is_skipped_up_to_quiet_max() {
+        let (mut room, metrics) = room(4);
+        let ann = join(&mut room, A, "ann");
+        let t0 = Instant::now();
+        // Standing still, once landed.
+        ticks(&mut room, 240, ROOMY, t0);
+        let mut packet = InputPacket::new(239, &[Buttons::NONE], Some(240));
+        packet.hold = true;
+        lock(&ann.inbox).receive(&packet);
+        // It spoke: one snapshot; then none while nothing changes, until
+        // QUIET_MAX (30 ticks) after the last one sent.
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        assert_eq!(snapshots(&sent), [(A, 242, SnapshotKind::Delta, true)]);
+        let sent = ticks(&mut room, 28, ROOMY, t0);
+        assert_eq!(snapshots(&sent), []);
+        assert_eq!(metrics.snapshots_skipped.get(), 14);
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        assert_eq!(snapshots(&sent), [(A, 272, SnapshotKind::Delta, true)]);
+    }
+
+    #[test]
+    fn chat_goes_to_everyone_in_the_room() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        room.detach(B, 0);
+        room.chat(A, "hi".into());
+        let chat = ServerControl::Chat {
+            from: A,
+            text: "hi".into(),
+        };
+        assert_eq!(actions(&mut room), [control(A, &chat), control(B, &chat)]);
+    }
+}
