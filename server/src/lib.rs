@@ -16,7 +16,10 @@
 //! * [`clock`]: the absolute tick schedule;
 //! * [`inputs`]: a client's bounded input buffer;
 //! * [`snapshots`]: a room's snapshot history and per-client encoding;
-//! * [`room`]: the game, its tick loop and snapshot sending;
+//! * [`room_logic`]: a room's rules, sans-IO: its game, joins, resumes,
+//!   ticks and what each client is sent, as actions;
+//! * [`room`]: a room's task: its tick loop, the handle connections talk to
+//!   it through, and its actions carried out over the clients' links;
 //! * [`room_registry`]: the open rooms, opened by name up to the cap,
 //!   closed when idle;
 //! * [`sessions`]: players kept after a lost connection, for a resume;
