@@ -191,7 +191,7 @@ pub struct WebConfig {
     pub webtransport: Option<SocketAddr>,
     /// How long WebTransport certificates live (13 days; tests shorten it
     /// to see a rotation).
-    pub cert_life: crate::web::certs::CertLife,
+    pub cert_life: crate::web::webtransport_cert::CertLife,
 }
 
 impl WebConfig {

@@ -43,7 +43,8 @@ use crate::config::Limits;
 use crate::link::{Acceptor, ControlSend, Gone, Incoming, Link, Received, Receiver, Transport};
 use crate::metrics::{Channel, ClientBytes, DropReason, KickLabel, KickReason, Metrics};
 use crate::ratelimit::TokenBucket;
-use crate::room::{self, ClientLink, JoinError, Outbound, PlayerInbox, RoomHandle};
+use crate::room::{ClientLink, JoinError, Outbound, RoomHandle};
+use crate::room_logic::{self, PlayerInbox};
 use crate::shared::Shared;
 use crate::shutdown::stopped;
 
@@ -309,7 +310,7 @@ fn refusal(version: u32, shutdown: &watch::Receiver<bool>) -> Option<RejectReaso
 }
 
 /// A room, its seat and the session token for this connection.
-type Seat = (RoomHandle, room::Joined, SessionToken);
+type Seat = (RoomHandle, room_logic::Joined, SessionToken);
 
 /// Seats the client: its player back if it resumes, else a new player in
 /// the room it asked for (or the least full one); rejects it if there is
@@ -429,7 +430,7 @@ async fn join(
     player_id: PlayerId,
     name: &str,
     link: ClientLink,
-) -> Result<(RoomHandle, room::Joined), RejectReason> {
+) -> Result<(RoomHandle, room_logic::Joined), RejectReason> {
     for room in shared.rooms.for_join(wanted, Instant::now())? {
         if wanted.is_none() && !room.has_room() {
             continue;
@@ -803,7 +804,7 @@ impl Client<'_> {
                 if forged {
                     packet.ack_snapshot = None;
                 }
-                let r = room::lock(&self.inbox).receive(&packet);
+                let r = room_logic::lock(&self.inbox).receive(&packet);
                 let m = &self.shared.metrics;
                 m.count_drops(DropReason::InputLate, u64::from(r.late));
                 m.count_drops(DropReason::InputTooEarly, u64::from(r.too_early));

@@ -9,15 +9,19 @@
 //! [`Server`]; tests start the same server in-process on `127.0.0.1:0`.
 //!
 //! * [`config`]: settings, command line and TOML file ([`ServerConfig`]);
-//! * [`cert`] / [`fingerprint`]: the self-signed identity clients pin;
+//! * [`quic_cert`] / [`fingerprint`]: the QUIC endpoint's self-signed
+//!   identity, kept on disk, which clients pin;
 //! * [`tls`]: QUIC/TLS endpoint configuration and buffer sizes;
 //! * [`levels`]: the level played, its id and hash;
 //! * [`clock`]: the absolute tick schedule;
 //! * [`inputs`]: a client's bounded input buffer;
 //! * [`snapshots`]: a room's snapshot history and per-client encoding;
-//! * [`room`]: the game, its tick loop and snapshot sending;
-//! * [`rooms`]: the open rooms, opened by name up to the cap, closed when
-//!   idle;
+//! * [`room_logic`]: a room's rules, sans-IO: its game, joins, resumes,
+//!   ticks and what each client is sent, as actions;
+//! * [`room`]: a room's task: its tick loop, the handle connections talk to
+//!   it through, and its actions carried out over the clients' links;
+//! * [`room_registry`]: the open rooms, opened by name up to the cap,
+//!   closed when idle;
 //! * [`sessions`]: players kept after a lost connection, for a resume;
 //! * [`shutdown`]: the shutdown signal, its handle and the wait for it;
 //! * [`shared`]: the state every connection task shares (rooms, sessions,
@@ -44,7 +48,6 @@
 pub mod admission;
 #[cfg(feature = "agones")]
 pub mod agones;
-pub mod cert;
 pub mod clock;
 pub mod config;
 pub mod connection;
@@ -54,10 +57,12 @@ pub mod inputs;
 pub mod levels;
 pub mod link;
 pub mod metrics;
+pub mod quic_cert;
 pub mod ratelimit;
 pub mod record;
 pub mod room;
-pub mod rooms;
+pub mod room_logic;
+pub mod room_registry;
 pub mod server;
 pub mod sessions;
 pub mod shared;

@@ -17,24 +17,24 @@ use tracing::{debug, error, info, warn};
 use wtransport::endpoint::IncomingSession;
 
 use crate::admission::{Admission, Refusal, Ticket, Verdict};
-use crate::cert::{CertError, Identity};
 use crate::config::{ConfigError, ServerConfig, WebConfig};
 use crate::connection::{self, SHUTDOWN_LINGER};
 use crate::fingerprint::Fingerprint;
 use crate::levels::{self, LevelLoadError};
 use crate::link::Incoming;
 use crate::metrics::{self, Metrics};
+use crate::quic_cert::{CertError, Identity};
 use crate::record::Recorder;
-use crate::room::RoomConfig;
-use crate::rooms::Rooms;
+use crate::room_logic::RoomConfig;
+use crate::room_registry::Rooms;
 use crate::sessions::Sessions;
 use crate::shared::Shared;
 use crate::shutdown::{stopped, ShutdownHandle};
 use crate::snapshots::DEFAULT_HISTORY;
 use crate::tls::{self, TlsError};
-use crate::web::certs::CertLife;
 use crate::web::files::{WebRoot, WebRootError};
-use crate::web::webtransport::{self as wt, WebCerts, WebTransportError};
+use crate::web::webtransport_cert::CertLife;
+use crate::web::webtransport_endpoint::{self as wt, WebCerts, WebTransportError};
 use crate::web::{self, WebState};
 
 /// How long shutdown waits for connection tasks, then for the endpoint.

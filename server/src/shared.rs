@@ -14,7 +14,7 @@ use tokio::sync::watch;
 use crate::admission::Admission;
 use crate::config::Limits;
 use crate::metrics::Metrics;
-use crate::rooms::Rooms;
+use crate::room_registry::Rooms;
 use crate::sessions::Sessions;
 
 /// What every connection task shares.

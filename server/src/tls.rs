@@ -13,7 +13,7 @@ use std::time::Duration;
 use ledge_shared::protocol::ALPN;
 use quinn::crypto::rustls::QuicServerConfig;
 
-use crate::cert::Identity;
+use crate::quic_cert::Identity;
 
 /// Outgoing datagram buffer per connection, in bytes: about two
 /// snapshots. When it is full quinn drops the oldest queued datagram, so a

@@ -3,7 +3,7 @@
 //! bidirectional stream, the control stream, carrying exactly what a
 //! native client's does; datagrams are the native datagrams; the level
 //! bundle goes on a server-opened one-way stream, as natively. The
-//! endpoint and its certificates: [`crate::web::webtransport`].
+//! endpoint and its certificates: [`crate::web::webtransport_endpoint`].
 
 use bytes::Bytes;
 use ledge_shared::protocol::CloseCode;

@@ -12,9 +12,9 @@
 //! a WebSocket is bounded by its own limits
 //! ([`crate::link::websocket`]).
 
-pub mod certs;
 pub mod files;
-pub mod webtransport;
+pub mod webtransport_cert;
+pub mod webtransport_endpoint;
 
 use std::net::SocketAddr;
 use std::sync::Arc;
@@ -40,7 +40,7 @@ use crate::link::websocket::{self, Upgraded};
 use crate::link::{Incoming, Transport};
 use crate::shared::Shared;
 use files::WebRoot;
-use webtransport::WebCerts;
+use webtransport_endpoint::WebCerts;
 
 /// Most HTTP connections served at once.
 pub const MAX_HTTP_CONNECTIONS: usize = 128;

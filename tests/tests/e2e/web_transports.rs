@@ -689,7 +689,7 @@ async fn the_webtransport_certificate_is_replaced_before_it_expires_and_sessions
         move |c| {
             let mut web = WebConfig::new(SocketAddr::from(([127, 0, 0, 1], 0)));
             web.root = root;
-            web.cert_life = ledge_server::web::certs::CertLife {
+            web.cert_life = ledge_server::web::webtransport_cert::CertLife {
                 validity: Duration::from_secs(8),
                 backdate: Duration::ZERO,
             };

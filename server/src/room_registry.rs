@@ -1,6 +1,6 @@
-//! The server's rooms: those open from the start (`room-1`, `room-2`, ...,
-//! never closed) and those players open by name (`--room NAME`), up to the
-//! room cap. A room opened by name closes once it has been empty and
+//! The registry of the server's rooms: those open from the start
+//! (`room-1`, `room-2`, ..., never closed) and those players open by name
+//! (`--room NAME`), up to the room cap. A room opened by name closes once it has been empty and
 //! unasked for [`IDLE_CLOSE`], so names cannot pile up; its metric series
 //! go with it.
 //!
@@ -20,7 +20,8 @@ use tracing::info;
 use crate::fleet::{Load, RoomLoad};
 use crate::metrics::Metrics;
 use crate::record::Recorder;
-use crate::room::{self, RoomConfig, RoomHandle};
+use crate::room::{self, RoomHandle};
+use crate::room_logic::RoomConfig;
 
 /// How long a room opened by name stays open while empty.
 pub const IDLE_CLOSE: Duration = Duration::from_secs(60);

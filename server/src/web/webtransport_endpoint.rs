@@ -1,6 +1,6 @@
 //! The WebTransport endpoint (HTTP/3 over UDP, `wtransport`) and the
-//! rotation of its certificate ([`super::certs`]), driven by tokio timers.
-//! Sessions themselves are served like any connection
+//! rotation of its certificate ([`super::webtransport_cert`]), driven by
+//! tokio timers. Sessions themselves are served like any connection
 //! ([`crate::link::webtransport`], [`crate::connection`]).
 
 use std::net::SocketAddr;
@@ -12,7 +12,7 @@ use tracing::{info, warn};
 use wtransport::endpoint::endpoint_side;
 use wtransport::tls::{Certificate, CertificateChain, PrivateKey};
 
-use super::certs::{self, CertInfo, Rotation, Step, WebCert};
+use super::webtransport_cert::{self, CertInfo, Rotation, Step, WebCert};
 use crate::tls::{DATAGRAM_RECEIVE_BUFFER, DATAGRAM_SEND_BUFFER, STREAM_RECEIVE_WINDOW};
 
 /// The server side of a wtransport endpoint.
@@ -73,7 +73,7 @@ pub struct Settings {
     /// Idle timeout (keep-alives at a third of it).
     pub idle_timeout: Duration,
     /// How long its certificates live.
-    pub cert_life: certs::CertLife,
+    pub cert_life: webtransport_cert::CertLife,
 }
 
 /// The names in the certificate (browsers check only its hash).
@@ -115,7 +115,7 @@ fn server_config(
 
 /// Makes the first certificate and binds the endpoint.
 pub fn bind(settings: &Settings) -> Result<(Arc<Endpoint>, Arc<WebCerts>), BindError> {
-    let cert = certs::generate(SystemTime::now(), &names(), settings.cert_life)
+    let cert = webtransport_cert::generate(SystemTime::now(), &names(), settings.cert_life)
         .map_err(|e| BindError::Setup(e.into()))?;
     let config = server_config(settings, &cert).map_err(BindError::Setup)?;
     let endpoint = Endpoint::server(config).map_err(BindError::Io)?;
@@ -158,21 +158,23 @@ pub async fn rotate(
         let step = certs.lock().rotation.poll(now);
         match step {
             None => {}
-            Some(Step::Prepare) => match certs::generate(now, &names(), settings.cert_life) {
-                Ok(next) => {
-                    info!(
-                        sha256 = %crate::Fingerprint(next.info.sha256),
-                        "made the next WebTransport certificate (listed in /web.json)"
-                    );
-                    let mut state = certs.lock();
-                    state.rotation.prepared(next.info);
-                    state.next = Some(next);
+            Some(Step::Prepare) => {
+                match webtransport_cert::generate(now, &names(), settings.cert_life) {
+                    Ok(next) => {
+                        info!(
+                            sha256 = %crate::Fingerprint(next.info.sha256),
+                            "made the next WebTransport certificate (listed in /web.json)"
+                        );
+                        let mut state = certs.lock();
+                        state.rotation.prepared(next.info);
+                        state.next = Some(next);
+                    }
+                    Err(e) => {
+                        warn!("cannot make the next WebTransport certificate: {e}; trying again");
+                        tokio::time::sleep(RETRY_AFTER).await;
+                    }
                 }
-                Err(e) => {
-                    warn!("cannot make the next WebTransport certificate: {e}; trying again");
-                    tokio::time::sleep(RETRY_AFTER).await;
-                }
-            },
+            }
             Some(Step::Promote) => {
                 let next = certs.lock().next.take();
                 let Some(next) = next else { continue };

@@ -15,7 +15,8 @@
 //!
 //! A certificate is thus current from about 10 % to 50 % of its life and
 //! never near its end. The native QUIC endpoint's certificate (the one
-//! `ledge-client --cert-hash` pins) is another, kept on disk, unchanged.
+//! `ledge-client --cert-hash` pins) is another, kept on disk, unchanged
+//! ([`crate::quic_cert`]).
 
 use std::time::{Duration, SystemTime};
 

@@ -1,4 +1,7 @@
-//! The server's TLS identity: a self-signed certificate kept on disk.
+//! The native QUIC endpoint's TLS identity: a self-signed certificate kept
+//! on disk, the one `ledge-client --cert-hash` pins. (WebTransport's
+//! short-lived, rotating certificates are another:
+//! [`crate::web::webtransport_cert`].)
 //!
 //! Generated with rcgen on first start (SANs `localhost` and `127.0.0.1`)
 //! and reused afterwards, so the fingerprint clients pinned stays valid

@@ -1,0 +1,1264 @@
+//! A room's logic, sans-IO: its authoritative [`Game`], its players, and
+//! what each client is sent. Time and requests come in as arguments
+//! (joins, leaves, resumes, chat, ticks); what the room sends, closes or
+//! samples comes out as [`Action`]s, in order, which the room task
+//! ([`crate::room`]) carries out over the clients' links. So the room's
+//! rules are tested without sockets, tasks or timers, like [`crate::fleet`].
+//!
+//! Every tick: take each player's input for this tick from its inbox (or
+//! repeat its last one and count the starvation), remove the players idle
+//! too long, step the game, and every `snapshot_interval` ticks capture a
+//! snapshot and send each attached player a delta against the snapshot it
+//! acknowledged ([`Action::Snapshot`]: a datagram when it fits the
+//! client's datagram size, a control-stream frame when not). The room task
+//! reports each snapshot actually sent ([`RoomLogic::datagram_sent`],
+//! [`RoomLogic::stream_queued`]), since a datagram can be lost before the
+//! wire and a full control queue drops a frame.
+//!
+//! A quiet client (one that sent nothing since its last snapshot, holding
+//! its buttons: [`InputPacket::hold`]) gets no snapshot that would change
+//! nothing for it: nothing but time changed since both the one it
+//! acknowledged and the last one it was sent
+//! (`StateSnapshot::extrapolates_to`). It gets one again when it speaks,
+//! when anything changes, or after [`QUIET_MAX`]. An idle room then costs a
+//! few packets a second per player instead of 30 snapshots and their ACKs.
+
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use ledge_shared::game::Game;
+use ledge_shared::input::Buttons;
+use ledge_shared::protocol::{
+    encode_sim_config, name_key, write_frame, InputPacket, LevelOffer, NetTiming, NoticeKind,
+    Outgoing, PlayerId, RejectReason, RosterEntry, ServerControl, SessionToken, Snapshot, Welcome,
+    MAX_ROSTER,
+};
+use prometheus_client::metrics::counter::Counter;
+use tracing::{error, info, warn};
+
+use crate::inputs::{InputBuffer, Received};
+use crate::metrics::{DropReason, KickLabel, KickReason, Metrics, RoomLabel, SnapshotKind};
+use crate::record::Recorder;
+use crate::snapshots::RoomSnapshots;
+use crate::tls::DATAGRAM_SEND_BUFFER;
+
+/// How long the room waits for a client to acknowledge a snapshot sent on
+/// the control stream before it sends another one there.
+pub const STREAM_SNAPSHOT_RESEND: Duration = Duration::from_millis(1000);
+
+/// Longest a client goes without a snapshot while nothing changes (should
+/// its own quiet inputs, 5 a second, be lost): its clock and loss figure
+/// keep a sample, its acknowledged baseline stays in the room's history,
+/// and the client, which calls a server silent for 1 s stalled, never does.
+pub const QUIET_MAX: Duration = Duration::from_millis(500);
+
+/// How a room runs.
+#[derive(Debug, Clone)]
+pub struct RoomConfig {
+    /// The room's name (sent in `Welcome`).
+    pub name: String,
+    /// Fixed tick rate in Hz.
+    pub tick_rate: u32,
+    /// Ticks between snapshots.
+    pub snapshot_interval: u32,
+    /// Most players at once.
+    pub max_players: usize,
+    /// Most ticks run back to back after a stall; older ones are skipped.
+    pub max_catch_up: u32,
+    /// Ticks of input accepted ahead of the next simulated tick.
+    pub input_window: usize,
+    /// Ticks of input a client should repeat in each packet.
+    pub input_redundancy: u8,
+    /// Snapshots kept as baselines.
+    pub history: usize,
+    /// Level id sent in `Welcome`.
+    pub level_id: String,
+    /// Level hash sent in `Welcome`.
+    pub level_hash: u64,
+    /// The level bundle offered in `Welcome`.
+    pub level: LevelOffer,
+    /// Where to record the match (inputs, joins, leaves, hashes), if on.
+    pub record: Option<Recorder>,
+    /// A player sending no input for this long is removed (half of it
+    /// while the room is full).
+    pub idle_kick: Duration,
+}
+
+/// The room's progress, published after every tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RoomStatus {
+    /// Ticks simulated so far.
+    pub tick: u64,
+    /// The game's state hash after that tick.
+    pub state_hash: u64,
+    /// Players currently in the room.
+    pub players: usize,
+}
+
+/// Inputs and acknowledgements of one client, written by its connection
+/// task, read by the room.
+#[derive(Debug)]
+pub struct PlayerInbox {
+    /// Button bits by tick.
+    pub inputs: InputBuffer,
+    /// Newest snapshot tick the client acknowledged.
+    pub ack: Option<u64>,
+    /// Whether any input arrived yet (starvation counts only after).
+    pub received_any: bool,
+    /// Input packets received (late or early ones too): the client is
+    /// there, whatever its timing.
+    pub packets: u64,
+    /// Earliest arrival (most negative timing) since the last snapshot.
+    timing_min: Option<i16>,
+    /// Timing of the last packet.
+    last_timing: i16,
+}
+
+impl PlayerInbox {
+    fn new(window: usize, next_tick: u64) -> PlayerInbox {
+        PlayerInbox {
+            inputs: InputBuffer::new(window, next_tick),
+            ack: None,
+            received_any: false,
+            packets: 0,
+            timing_min: None,
+            last_timing: 0,
+        }
+    }
+
+    /// Stores a decoded input packet.
+    pub fn receive(&mut self, packet: &InputPacket) -> Received {
+        let r = self.inputs.receive(packet);
+        if let Some(ack) = packet.ack_snapshot {
+            self.ack = Some(self.ack.map_or(ack, |a| a.max(ack)));
+        }
+        self.received_any = true;
+        self.packets += 1;
+        self.last_timing = r.timing;
+        self.timing_min = Some(self.timing_min.map_or(r.timing, |m| m.min(r.timing)));
+        r
+    }
+
+    /// The timing to report: the worst (latest) arrival since the last
+    /// report, or the last one when nothing arrived since.
+    fn take_timing(&mut self) -> i16 {
+        self.timing_min.take().unwrap_or(self.last_timing)
+    }
+}
+
+/// Locks an inbox, ignoring poisoning (the data stays consistent: every
+/// update is a few plain assignments).
+pub fn lock(inbox: &Mutex<PlayerInbox>) -> MutexGuard<'_, PlayerInbox> {
+    inbox.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A successful join.
+#[derive(Debug)]
+pub struct Joined {
+    /// What to send the client (its `session_token` is the connection's to
+    /// fill in).
+    pub welcome: Welcome,
+    /// Where the connection puts the client's inputs.
+    pub inbox: Arc<Mutex<PlayerInbox>>,
+    /// Which connection holds the player: 0 on joining, one more on each
+    /// resume. Leaves and detaches of an older generation are ignored.
+    pub generation: u32,
+}
+
+/// A player handed to a new connection ([`RoomLogic::rejoin`]).
+#[derive(Debug)]
+pub struct Resumed {
+    /// What the new connection is given, as on joining.
+    pub joined: Joined,
+    /// The old connection still held the player (the client gave up on it
+    /// before the server noticed): close it, before the new one takes over.
+    pub close_old: bool,
+}
+
+/// Something the room's I/O does for it. Actions come in the order the
+/// room decided them; a player's frames must be queued in that order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Action {
+    /// Queue a complete frame on the player's control stream (dropped, and
+    /// counted, when its queue is full).
+    Control {
+        /// The player.
+        to: PlayerId,
+        /// The frame, length prefix included.
+        frame: Vec<u8>,
+    },
+    /// Close the player's connection (`CloseCode::Kicked`, `reason`) after
+    /// what was queued before, or at once when its queue is full.
+    Kick {
+        /// The player.
+        to: PlayerId,
+        /// Why (also in the `Notice` queued before).
+        reason: String,
+    },
+    /// Add what the player's connection put through its socket since the
+    /// last sample to the wire metrics.
+    SampleWire(PlayerId),
+    /// Send a snapshot; say whether it went with
+    /// [`RoomLogic::datagram_sent`] or [`RoomLogic::stream_queued`].
+    Snapshot {
+        /// The player.
+        to: PlayerId,
+        /// The snapshot's tick.
+        tick: u64,
+        /// Full or delta (for the metrics).
+        kind: SnapshotKind,
+        /// A datagram, or a frame for the control stream.
+        outgoing: Outgoing,
+    },
+    /// The player has left the room: its connection is the room's no more.
+    Left(PlayerId),
+}
+
+/// A player in the room.
+#[derive(Debug)]
+struct Member {
+    name: String,
+    inbox: Arc<Mutex<PlayerInbox>>,
+    /// Buttons applied last tick (repeated when an input is missing).
+    buttons: Buttons,
+    /// Newest tick of this client's own input applied.
+    last_applied: Option<u64>,
+    /// A snapshot sent on the control stream and when, until acknowledged.
+    stream_pending: Option<(u64, Instant)>,
+    /// Which connection holds it ([`Joined::generation`]).
+    generation: u32,
+    /// The tick its last input packet was seen at (or of its joining).
+    heard_at: u64,
+    /// Its inbox's packet count when last seen.
+    packets_seen: u64,
+    /// Its inbox's packet count when it was last sent a snapshot.
+    packets_at_snapshot: u64,
+    /// The tick of the last snapshot sent to it.
+    last_snapshot: Option<u64>,
+    /// A connection holds it (false: lost, kept for a resume).
+    attached: bool,
+}
+
+impl Member {
+    /// A member held by a new connection (of `generation`) from `tick`,
+    /// its inputs going to `inbox`.
+    fn attach(&mut self, inbox: Arc<Mutex<PlayerInbox>>, generation: u32, tick: u64) {
+        self.inbox = inbox;
+        self.buttons = Buttons::NONE;
+        self.last_applied = None;
+        self.stream_pending = None;
+        self.generation = generation;
+        self.attached = true;
+        self.heard_at = tick;
+        self.packets_seen = 0;
+        self.packets_at_snapshot = 0;
+        self.last_snapshot = None;
+    }
+
+    /// The acknowledged baseline and the timing to report in a snapshot
+    /// at `tick`, or `None` when the client is quiet and this snapshot
+    /// would change nothing for it.
+    fn snapshot_due(
+        &mut self,
+        tick: u64,
+        quiet_max: u64,
+        snapshots: &RoomSnapshots,
+    ) -> Option<(Option<u64>, i16)> {
+        let mut inbox = lock(&self.inbox);
+        let quiet = inbox.packets == self.packets_at_snapshot
+            && self.stream_pending.is_none()
+            && self.last_snapshot.is_some_and(|p| {
+                tick.saturating_sub(p) < quiet_max && snapshots.unchanged_since(p)
+            })
+            && inbox.ack.is_some_and(|a| snapshots.unchanged_since(a));
+        if quiet {
+            return None;
+        }
+        self.packets_at_snapshot = inbox.packets;
+        Some((inbox.ack, inbox.take_timing()))
+    }
+}
+
+/// One room: its game, its players and what they are sent.
+pub struct RoomLogic {
+    config: RoomConfig,
+    game: Game,
+    members: BTreeMap<PlayerId, Member>,
+    inputs: Vec<(PlayerId, Buttons)>,
+    snapshots: RoomSnapshots,
+    metrics: Arc<Metrics>,
+    starvation: Counter,
+    actions: Vec<Action>,
+}
+
+impl RoomLogic {
+    /// A room playing `game`, counting into `metrics` (its series labelled
+    /// with the room's name).
+    pub fn new(game: Game, config: RoomConfig, metrics: Arc<Metrics>) -> RoomLogic {
+        let label = RoomLabel {
+            room: config.name.clone(),
+        };
+        RoomLogic {
+            starvation: metrics.input_starvation.get_or_create_owned(&label),
+            snapshots: RoomSnapshots::new(config.history),
+            game,
+            members: BTreeMap::new(),
+            inputs: Vec::new(),
+            metrics,
+            config,
+            actions: Vec::new(),
+        }
+    }
+
+    /// How the room runs.
+    pub fn config(&self) -> &RoomConfig {
+        &self.config
+    }
+
+    /// The game.
+    pub fn game(&self) -> &Game {
+        &self.game
+    }
+
+    /// Players in the room (attached or kept for a resume).
+    pub fn players(&self) -> usize {
+        self.members.len()
+    }
+
+    /// The room's progress now.
+    pub fn status(&self) -> RoomStatus {
+        RoomStatus {
+            tick: self.game.tick(),
+            state_hash: self.game.state_hash(),
+            players: self.members.len(),
+        }
+    }
+
+    /// Moves the actions decided so far to the end of `into`, in order.
+    pub fn take_actions(&mut self, into: &mut Vec<Action>) {
+        into.append(&mut self.actions);
+    }
+
+    /// Adds a player named `name`: a `Roster` for it, a `PlayerJoined` for
+    /// the others. Refused when the room is full, the name is taken (by
+    /// [`name_key`]) or the game refuses the player.
+    pub fn join(&mut self, player_id: PlayerId, name: String) -> Result<Joined, RejectReason> {
+        if self.members.len() >= self.config.max_players {
+            return Err(RejectReason::RoomFull);
+        }
+        let key = name_key(&name);
+        if let Some(taken) = self.members.values().find(|m| name_key(&m.name) == key) {
+            return Err(RejectReason::Other {
+                reason: format!(
+                    "the name \"{name}\" is taken in this room (by \"{}\"; names must differ by \
+                     more than case or look-alike letters): choose another with --name",
+                    taken.name
+                ),
+            });
+        }
+        if let Err(e) = self.game.add_player(player_id) {
+            warn!(%player_id, "game refused the player: {e}");
+            return Err(RejectReason::Other {
+                reason: "the game refused the player".into(),
+            });
+        }
+        if let Some(r) = &self.config.record {
+            r.join(player_id);
+        }
+        let tick = self.game.tick();
+        let inbox = Arc::new(Mutex::new(PlayerInbox::new(self.config.input_window, tick)));
+        info!(room = %self.config.name, %player_id, %name, tick, "player joined");
+        let member = Member {
+            name,
+            inbox: inbox.clone(),
+            buttons: Buttons::NONE,
+            last_applied: None,
+            stream_pending: None,
+            generation: 0,
+            attached: true,
+            heard_at: tick,
+            packets_seen: 0,
+            packets_at_snapshot: 0,
+            last_snapshot: None,
+        };
+        self.members.insert(player_id, member);
+        self.announce_join(player_id);
+        Ok(Joined {
+            welcome: self.welcome(player_id, tick),
+            inbox,
+            generation: 0,
+        })
+    }
+
+    /// Removes a player, if connection `generation` still holds it (no-op
+    /// if unknown).
+    pub fn leave(&mut self, player_id: PlayerId, generation: u32) {
+        if self
+            .members
+            .get(&player_id)
+            .is_some_and(|m| m.generation == generation)
+        {
+            self.remove(player_id);
+        }
+    }
+
+    /// Keeps a player whose connection (of `generation`) was lost: it stays
+    /// in the game, standing still, and gets nothing sent until
+    /// [`RoomLogic::rejoin`] or [`RoomLogic::leave`].
+    pub fn detach(&mut self, player_id: PlayerId, generation: u32) {
+        let tick = self.game.tick();
+        let window = self.config.input_window;
+        if let Some(m) = self.members.get_mut(&player_id) {
+            if m.generation == generation && m.attached {
+                info!(room = %self.config.name, %player_id, "connection lost; keeping the player");
+                m.attached = false;
+                m.buttons = Buttons::NONE;
+                m.inbox = Arc::new(Mutex::new(PlayerInbox::new(window, tick)));
+                m.packets_seen = 0;
+                m.packets_at_snapshot = 0;
+                m.last_snapshot = None;
+            }
+        }
+    }
+
+    /// Hands a kept (or still attached) player to a new connection (a
+    /// resumed session): the same body, a new inbox, a new generation, and
+    /// a `Roster` of the room as it is now. `None` if the player is gone.
+    pub fn rejoin(&mut self, player_id: PlayerId) -> Option<Resumed> {
+        let tick = self.game.tick();
+        let inbox = Arc::new(Mutex::new(PlayerInbox::new(self.config.input_window, tick)));
+        let m = self.members.get_mut(&player_id)?;
+        let close_old = m.attached;
+        let generation = m.generation + 1;
+        m.attach(inbox.clone(), generation, tick);
+        info!(room = %self.config.name, %player_id, generation, tick, "player resumed");
+        // The room as it is now: who joined and left meanwhile.
+        self.send_roster(player_id);
+        Some(Resumed {
+            joined: Joined {
+                welcome: self.welcome(player_id, tick),
+                inbox,
+                generation,
+            },
+            close_old,
+        })
+    }
+
+    /// The connection that resumed player `player_id` (as `generation`) was
+    /// gone before it got the player: the player is lost again (kept, sent
+    /// nothing).
+    pub fn resumer_gone(&mut self, player_id: PlayerId, generation: u32) {
+        let m = self.members.get_mut(&player_id);
+        if let Some(m) = m.filter(|m| m.generation == generation) {
+            m.attached = false;
+        }
+    }
+
+    /// Relays a chat line to everyone in the room.
+    pub fn chat(&mut self, from: PlayerId, text: String) {
+        self.broadcast(&ServerControl::Chat { from, text });
+    }
+
+    /// Runs one tick at `now`. `datagram_size` is a player's connection's
+    /// largest datagram now (`None`: datagrams unavailable).
+    pub fn tick(&mut self, now: Instant, datagram_size: impl Fn(PlayerId) -> Option<usize>) {
+        let tick = self.game.tick();
+        self.take_inputs(tick);
+        self.remove_idle(tick);
+        self.game.step(&self.inputs);
+        if let Some(r) = &self.config.record {
+            r.tick(tick, &self.inputs, || self.game.state_hash());
+        }
+        if tick % u64::from(self.config.tick_rate.max(1)) == 0 {
+            // Once a second: reading quinn's statistics takes the
+            // connection's lock.
+            for (&id, _) in self.members.iter().filter(|(_, m)| m.attached) {
+                self.actions.push(Action::SampleWire(id));
+            }
+        }
+        let interval = u64::from(self.config.snapshot_interval.max(1));
+        if self.game.tick() % interval == 0 && !self.members.is_empty() {
+            self.send_snapshots(now, &datagram_size);
+        }
+    }
+
+    /// The snapshot of `tick` went to player `to` as a datagram.
+    pub fn datagram_sent(&mut self, to: PlayerId, tick: u64) {
+        if let Some(m) = self.members.get_mut(&to) {
+            m.last_snapshot = Some(tick);
+        }
+    }
+
+    /// The snapshot of `tick` was queued on player `to`'s control stream at
+    /// `at` (the `now` of its tick): none goes there again until it is
+    /// acknowledged or [`STREAM_SNAPSHOT_RESEND`] has passed.
+    pub fn stream_queued(&mut self, to: PlayerId, tick: u64, at: Instant) {
+        if let Some(m) = self.members.get_mut(&to) {
+            m.last_snapshot = Some(tick);
+            m.stream_pending = Some((tick, at));
+        }
+    }
+
+    /// Takes each player's input for `tick` from its inbox, or repeats its
+    /// last one (counting the starvation once it has sent any).
+    fn take_inputs(&mut self, tick: u64) {
+        self.inputs.clear();
+        for (&id, m) in &mut self.members {
+            let mut inbox = lock(&m.inbox);
+            if inbox.packets != m.packets_seen {
+                m.packets_seen = inbox.packets;
+                m.heard_at = tick;
+            }
+            match inbox.inputs.take(tick) {
+                Some(buttons) => {
+                    m.buttons = buttons;
+                    m.last_applied = Some(tick);
+                }
+                None if inbox.received_any => {
+                    self.starvation.inc();
+                }
+                None => {}
+            }
+            drop(inbox);
+            self.inputs.push((id, m.buttons));
+        }
+    }
+
+    /// The `Welcome` for player `player_id` at `tick`.
+    fn welcome(&self, player_id: PlayerId, tick: u64) -> Welcome {
+        Welcome {
+            player_id,
+            room: self.config.name.clone(),
+            level_id: self.config.level_id.clone(),
+            level_hash: self.config.level_hash,
+            level: self.config.level,
+            server_tick: tick,
+            timing: NetTiming {
+                tick_rate: self.config.tick_rate,
+                snapshot_interval: self.config.snapshot_interval,
+                input_redundancy: self.config.input_redundancy,
+            },
+            // The game's constants, so the client predicts with exactly
+            // the server's rules (a GameConfig is a few dozen bytes).
+            sim_config: match encode_sim_config(self.game.config()) {
+                Ok(bytes) => bytes,
+                Err(e) => {
+                    warn!("cannot send the game config: {e}");
+                    Vec::new()
+                }
+            },
+            session_token: SessionToken::default(),
+        }
+    }
+
+    fn remove(&mut self, player_id: PlayerId) {
+        if let Some(member) = self.members.remove(&player_id) {
+            let removed = self.game.remove_player(player_id);
+            if let (true, Some(r)) = (removed, &self.config.record) {
+                r.leave(player_id);
+            }
+            info!(room = %self.config.name, %player_id, name = %member.name, "player left");
+            self.broadcast(&ServerControl::PlayerLeft { id: player_id });
+            self.actions.push(Action::Left(player_id));
+        }
+    }
+
+    /// Removes the connected players that sent no input for the idle time
+    /// (half of it while the room is full): a silent client must not
+    /// hold a seat. Each gets a `Notice{Kick}` and a close saying why.
+    fn remove_idle(&mut self, tick: u64) {
+        let mut limit = self.config.idle_kick;
+        if self.members.len() >= self.config.max_players {
+            limit /= 2;
+        }
+        let limit = (limit.as_secs_f64() * f64::from(self.config.tick_rate)) as u64;
+        let idle: Vec<PlayerId> = self
+            .members
+            .iter()
+            .filter(|(_, m)| m.attached && tick.saturating_sub(m.heard_at) > limit)
+            .map(|(&id, _)| id)
+            .collect();
+        if idle.is_empty() {
+            return;
+        }
+        let secs = self.config.idle_kick.as_secs_f32();
+        let reason = format!("no input for {secs:.0} s (or half of it in a full room)");
+        for id in idle {
+            let kick = ServerControl::Notice {
+                kind: NoticeKind::Kick {
+                    reason: reason.clone(),
+                },
+            };
+            self.send_control(id, &kick);
+            self.actions.push(Action::Kick {
+                to: id,
+                reason: reason.clone(),
+            });
+            info!(room = %self.config.name, player = %id, "removed: {reason}");
+            self.metrics
+                .kicks
+                .get_or_create(&KickLabel {
+                    reason: KickReason::Idle,
+                })
+                .inc();
+            self.remove(id);
+        }
+        self.inputs.retain(|(id, _)| self.members.contains_key(id));
+    }
+
+    /// Captures the snapshot of the tick just run and decides what each
+    /// attached player is sent.
+    fn send_snapshots(&mut self, now: Instant, datagram_size: &dyn Fn(PlayerId) -> Option<usize>) {
+        let tick = self.game.tick();
+        let state = self.game.snapshot();
+        if let Err(e) = self.snapshots.capture(tick, state.entities) {
+            error!(room = %self.config.name, tick, "cannot capture a snapshot: {e}");
+            return;
+        }
+        let quiet_max = (QUIET_MAX.as_secs_f64() * f64::from(self.config.tick_rate)) as u64;
+        for (&id, m) in self.members.iter_mut().filter(|(_, m)| m.attached) {
+            let Some((ack, timing)) = m.snapshot_due(tick, quiet_max, &self.snapshots) else {
+                self.metrics.snapshots_skipped.inc();
+                continue;
+            };
+            if let Some((pending, _)) = m.stream_pending {
+                if ack.is_some_and(|a| a >= pending) {
+                    m.stream_pending = None;
+                }
+            }
+            let encoded = self
+                .snapshots
+                .encode_for(ack, m.last_snapshot, m.last_applied, timing);
+            let snapshot = match encoded {
+                Ok(s) => s,
+                Err(e) => {
+                    error!(tick, "cannot encode a snapshot: {e}");
+                    return;
+                }
+            };
+            let kind = snapshot_kind(&snapshot);
+            let max = datagram_size(id).map(|max| max.min(DATAGRAM_SEND_BUFFER / 2));
+            let outgoing = match snapshot.into_outgoing(max) {
+                Ok(o) => o,
+                Err(e) => {
+                    error!(tick, "cannot encode a snapshot: {e}");
+                    continue;
+                }
+            };
+            if matches!(outgoing, Outgoing::Control(_))
+                && m.stream_pending
+                    .is_some_and(|(_, at)| now.duration_since(at) < STREAM_SNAPSHOT_RESEND)
+            {
+                self.metrics.count_drop(DropReason::SnapshotDeferred);
+                continue;
+            }
+            self.actions.push(Action::Snapshot {
+                to: id,
+                tick,
+                kind,
+                outgoing,
+            });
+        }
+    }
+
+    /// Tells the newcomer `id` who is in the room (a `Roster`, queued now
+    /// and so written right after its `Welcome`) and everyone else that it
+    /// joined.
+    fn announce_join(&mut self, id: PlayerId) {
+        self.send_roster(id);
+        let Some(joined) = self.members.get_key_value(&id).map(roster_entry) else {
+            return;
+        };
+        let mut frame = Vec::new();
+        if write_frame(&ServerControl::PlayerJoined(joined), &mut frame).is_ok() {
+            for (&other, _) in self.members.iter().filter(|(&other, _)| other != id) {
+                self.actions.push(Action::Control {
+                    to: other,
+                    frame: frame.clone(),
+                });
+            }
+        }
+    }
+
+    /// Queues a `Roster` of the room as it is now for member `id`.
+    fn send_roster(&mut self, id: PlayerId) {
+        let players = self
+            .members
+            .iter()
+            .take(MAX_ROSTER)
+            .map(roster_entry)
+            .collect();
+        if self.members.contains_key(&id) {
+            self.send_control(id, &ServerControl::Roster { players });
+        }
+    }
+
+    /// Queues `message` for member `id`'s control stream.
+    fn send_control(&mut self, id: PlayerId, message: &ServerControl) {
+        let mut frame = Vec::new();
+        if write_frame(message, &mut frame).is_ok() {
+            self.actions.push(Action::Control { to: id, frame });
+        }
+    }
+
+    /// Queues `message` for every member's control stream.
+    fn broadcast(&mut self, message: &ServerControl) {
+        let mut frame = Vec::new();
+        if write_frame(message, &mut frame).is_ok() {
+            for &to in self.members.keys() {
+                self.actions.push(Action::Control {
+                    to,
+                    frame: frame.clone(),
+                });
+            }
+        }
+    }
+}
+
+/// Whether a snapshot is a delta or a full one.
+fn snapshot_kind(snapshot: &Snapshot) -> SnapshotKind {
+    if snapshot.baseline_tick.is_some() {
+        SnapshotKind::Delta
+    } else {
+        SnapshotKind::Full
+    }
+}
+
+/// A member as the roster lists it.
+fn roster_entry((&id, m): (&PlayerId, &Member)) -> RosterEntry {
+    RosterEntry {
+        id,
+        name: m.name.clone(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const RIGHT: Buttons = Buttons(Buttons::RIGHT);
+    const JUMP: Buttons = Buttons(Buttons::JUMP);
+    const A: PlayerId = PlayerId(1);
+    const B: PlayerId = PlayerId(2);
+    const C: PlayerId = PlayerId(3);
+    /// A datagram size every snapshot of the default level fits.
+    const ROOMY: Option<usize> = Some(1200);
+
+    fn config(max_players: usize) -> RoomConfig {
+        RoomConfig {
+            name: "test".into(),
+            tick_rate: 60,
+            snapshot_interval: 2,
+            max_players,
+            max_catch_up: 15,
+            input_window: 64,
+            input_redundancy: 16,
+            history: 64,
+            level_id: "default".into(),
+            level_hash: 7,
+            level: LevelOffer::default(),
+            record: None,
+            idle_kick: Duration::from_secs(30),
+        }
+    }
+
+    fn game() -> Game {
+        Game::from_level(&ledge_levels::default_level()).unwrap()
+    }
+
+    fn room_with(config: RoomConfig) -> (RoomLogic, Arc<Metrics>) {
+        let (metrics, _registry) = Metrics::new();
+        (RoomLogic::new(game(), config, metrics.clone()), metrics)
+    }
+
+    fn room(max_players: usize) -> (RoomLogic, Arc<Metrics>) {
+        room_with(config(max_players))
+    }
+
+    fn frame(message: &ServerControl) -> Vec<u8> {
+        let mut frame = Vec::new();
+        write_frame(message, &mut frame).unwrap();
+        frame
+    }
+
+    fn control(to: PlayerId, message: &ServerControl) -> Action {
+        Action::Control {
+            to,
+            frame: frame(message),
+        }
+    }
+
+    fn roster(players: &[(PlayerId, &str)]) -> ServerControl {
+        ServerControl::Roster {
+            players: players
+                .iter()
+                .map(|&(id, name)| RosterEntry {
+                    id,
+                    name: name.into(),
+                })
+                .collect(),
+        }
+    }
+
+    fn actions(room: &mut RoomLogic) -> Vec<Action> {
+        let mut out = Vec::new();
+        room.take_actions(&mut out);
+        out
+    }
+
+    fn join(room: &mut RoomLogic, id: PlayerId, name: &str) -> Joined {
+        let joined = room.join(id, name.into()).unwrap();
+        actions(room);
+        joined
+    }
+
+    /// Runs `n` ticks 16 ms apart from `t0`, every client's datagrams at
+    /// most `datagram` bytes, and reports every snapshot as sent (a
+    /// perfect link). Returns the actions, in order.
+    fn ticks(room: &mut RoomLogic, n: u64, datagram: Option<usize>, t0: Instant) -> Vec<Action> {
+        let mut all = Vec::new();
+        for _ in 0..n {
+            let now = t0 + Duration::from_millis(16 * room.game().tick());
+            room.tick(now, |_| datagram);
+            for action in actions(room) {
+                if let Action::Snapshot {
+                    to, tick, outgoing, ..
+                } = &action
+                {
+                    match outgoing {
+                        Outgoing::Datagram(_) => room.datagram_sent(*to, *tick),
+                        Outgoing::Control(_) => room.stream_queued(*to, *tick, now),
+                    }
+                }
+                all.push(action);
+            }
+        }
+        all
+    }
+
+    /// The snapshots in `actions`: to whom, of which tick, full or delta,
+    /// as a datagram or not.
+    fn snapshots(actions: &[Action]) -> Vec<(PlayerId, u64, SnapshotKind, bool)> {
+        actions
+            .iter()
+            .filter_map(|a| match a {
+                Action::Snapshot {
+                    to,
+                    tick,
+                    kind,
+                    outgoing,
+                } => Some((*to, *tick, *kind, matches!(outgoing, Outgoing::Datagram(_)))),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Client `joined` sends `buttons` for the ticks from `first`, and
+    /// acknowledges snapshot `ack`.
+    fn send(joined: &Joined, first: u64, buttons: &[Buttons], ack: Option<u64>) -> Received {
+        let newest = first + buttons.len() as u64 - 1;
+        let newest_first: Vec<Buttons> = buttons.iter().rev().copied().collect();
+        lock(&joined.inbox).receive(&InputPacket::new(newest, &newest_first, ack))
+    }
+
+    /// The state hash of a game with `players` stepped with `steps`.
+    fn reference(players: &[PlayerId], steps: &[Vec<(PlayerId, Buttons)>]) -> u64 {
+        let mut game = game();
+        for &id in players {
+            game.add_player(id).unwrap();
+        }
+        for inputs in steps {
+            game.step(inputs);
+        }
+        game.state_hash()
+    }
+
+    fn starvation(metrics: &Metrics) -> u64 {
+        let label = RoomLabel {
+            room: "test".into(),
+        };
+        metrics.input_starvation.get_or_create(&label).get()
+    }
+
+    fn dropped(metrics: &Metrics, reason: DropReason) -> u64 {
+        metrics
+            .dropped
+            .get_or_create(&crate::metrics::DropLabel { reason })
+            .get()
+    }
+
+    #[test]
+    fn a_join_is_welcomed_with_a_roster_and_announced_to_the_others() {
+        let (mut room, _) = room(4);
+        let ann = room.join(A, "ann".into()).unwrap();
+        assert_eq!(ann.generation, 0);
+        let w = &ann.welcome;
+        assert_eq!(
+            (w.player_id, w.room.as_str(), w.server_tick),
+            (A, "test", 0)
+        );
+        assert_eq!((w.level_id.as_str(), w.level_hash), ("default", 7));
+        assert_eq!((w.timing.tick_rate, w.timing.snapshot_interval), (60, 2));
+        assert_eq!(w.timing.input_redundancy, 16);
+        assert_eq!(
+            w.sim_config,
+            encode_sim_config(room.game().config()).unwrap()
+        );
+        assert_eq!(w.session_token, SessionToken::default());
+        assert_eq!(actions(&mut room), [control(A, &roster(&[(A, "ann")]))]);
+
+        ticks(&mut room, 3, ROOMY, Instant::now());
+        let bob = room.join(B, "bob".into()).unwrap();
+        assert_eq!(bob.welcome.server_tick, 3);
+        let joined = ServerControl::PlayerJoined(RosterEntry {
+            id: B,
+            name: "bob".into(),
+        });
+        assert_eq!(
+            actions(&mut room),
+            [
+                control(B, &roster(&[(A, "ann"), (B, "bob")])),
+                control(A, &joined)
+            ]
+        );
+        assert_eq!(room.players(), 2);
+        assert_eq!(room.status().players, 2);
+        assert_eq!(room.game().players().count(), 2);
+    }
+
+    #[test]
+    fn a_full_room_and_a_name_taken_are_refused() {
+        let (mut room, _) = room(2);
+        join(&mut room, A, "ann");
+        let taken = room.join(B, "ANN".into()).unwrap_err();
+        assert!(
+            matches!(&taken, RejectReason::Other { reason } if reason.contains("is taken")),
+            "{taken:?}"
+        );
+        join(&mut room, B, "bob");
+        assert_eq!(
+            room.join(C, "carl".into()).unwrap_err(),
+            RejectReason::RoomFull
+        );
+        assert_eq!(actions(&mut room), []);
+        assert_eq!(room.players(), 2);
+        assert_eq!(room.game().players().count(), 2);
+    }
+
+    #[test]
+    fn a_leave_of_the_connection_holding_the_player_removes_it() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        // Another connection's leave, and an unknown player's: nothing.
+        room.leave(A, 1);
+        room.leave(C, 0);
+        room.detach(C, 0);
+        room.datagram_sent(C, 0);
+        assert_eq!(actions(&mut room), []);
+        assert_eq!(room.players(), 2);
+
+        room.leave(A, 0);
+        assert_eq!(
+            actions(&mut room),
+            [
+                control(B, &ServerControl::PlayerLeft { id: A }),
+                Action::Left(A)
+            ]
+        );
+        assert_eq!(room.players(), 1);
+        assert!(room.game().player(A).is_none());
+        // Its name is free again.
+        assert!(room.join(C, "Ann".into()).is_ok());
+    }
+
+    #[test]
+    fn a_lost_player_stays_sent_nothing_until_it_resumes() {
+        let (mut room, _) = room(4);
+        let t0 = Instant::now();
+        join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        room.detach(A, 0);
+        assert_eq!(actions(&mut room), []);
+        let sent = ticks(&mut room, 4, ROOMY, t0);
+        assert!(!sent.contains(&Action::SampleWire(A)));
+        let to: Vec<PlayerId> = snapshots(&sent).iter().map(|s| s.0).collect();
+        assert_eq!(to, [B, B]);
+        assert!(room.game().player(A).is_some(), "kept in the game");
+
+        // Within the grace time (the sessions' to judge): the same body, a
+        // new generation, and the room as it is now.
+        let resumed = room.rejoin(A).unwrap();
+        assert!(!resumed.close_old);
+        assert_eq!(resumed.joined.generation, 1);
+        assert_eq!(resumed.joined.welcome.player_id, A);
+        assert_eq!(resumed.joined.welcome.server_tick, 4);
+        assert_eq!(
+            actions(&mut room),
+            [control(A, &roster(&[(A, "ann"), (B, "bob")]))]
+        );
+        // The lost connection's late detach and leave change nothing.
+        room.detach(A, 0);
+        room.leave(A, 0);
+        assert_eq!(room.players(), 2);
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        let to: Vec<(PlayerId, SnapshotKind)> =
+            snapshots(&sent).iter().map(|s| (s.0, s.2)).collect();
+        assert_eq!(to, [(A, SnapshotKind::Full), (B, SnapshotKind::Full)]);
+    }
+
+    #[test]
+    fn a_player_resumed_while_still_attached_has_its_old_connection_closed() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        let resumed = room.rejoin(A).unwrap();
+        assert!(resumed.close_old);
+        assert_eq!(resumed.joined.generation, 1);
+        assert_eq!(room.rejoin(A).unwrap().joined.generation, 2);
+    }
+
+    #[test]
+    fn after_the_grace_time_a_lost_player_is_gone_and_cannot_resume() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        room.detach(A, 0);
+        // The sessions end it after the grace time.
+        room.leave(A, 0);
+        assert_eq!(
+            actions(&mut room),
+            [
+                control(B, &ServerControl::PlayerLeft { id: A }),
+                Action::Left(A)
+            ]
+        );
+        assert!(room.rejoin(A).is_none());
+        assert_eq!(actions(&mut room), []);
+    }
+
+    #[test]
+    fn a_resumer_gone_before_its_welcome_leaves_the_player_lost() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        room.detach(A, 0);
+        let resumed = room.rejoin(A).unwrap();
+        actions(&mut room);
+        room.resumer_gone(A, 0); // an older generation: ignored
+        assert_eq!(
+            snapshots(&ticks(&mut room, 2, ROOMY, Instant::now())).len(),
+            1
+        );
+        room.resumer_gone(A, resumed.joined.generation);
+        assert_eq!(snapshots(&ticks(&mut room, 2, ROOMY, Instant::now())), []);
+        assert_eq!(room.rejoin(A).unwrap().joined.generation, 2);
+    }
+
+    #[test]
+    fn a_tick_steps_the_game_with_each_players_input() {
+        let (mut room, metrics) = room(4);
+        let ann = join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        let r = send(&ann, 0, &[RIGHT, RIGHT, JUMP], None);
+        assert_eq!((r.fresh, r.late, r.too_early), (3, 0, 0));
+        ticks(&mut room, 3, ROOMY, Instant::now());
+        let steps: Vec<_> = [RIGHT, RIGHT, JUMP]
+            .iter()
+            .map(|&b| vec![(A, b), (B, Buttons::NONE)])
+            .collect();
+        assert_eq!(room.status().tick, 3);
+        assert_eq!(room.status().state_hash, reference(&[A, B], &steps));
+        // Bob never sent anything: not starving.
+        assert_eq!(starvation(&metrics), 0);
+    }
+
+    #[test]
+    fn a_missing_input_repeats_the_last_one_and_counts_as_starvation() {
+        let (mut room, metrics) = room(4);
+        let ann = join(&mut room, A, "ann");
+        send(&ann, 0, &[RIGHT], None);
+        ticks(&mut room, 3, ROOMY, Instant::now());
+        let steps = vec![vec![(A, RIGHT)]; 3];
+        assert_eq!(room.status().state_hash, reference(&[A], &steps));
+        assert_eq!(starvation(&metrics), 2);
+    }
+
+    #[test]
+    fn inputs_for_past_or_too_far_future_ticks_are_not_applied() {
+        let (mut room, metrics) = room(4);
+        let ann = join(&mut room, A, "ann");
+        ticks(&mut room, 2, ROOMY, Instant::now());
+        // Tick 0 was simulated; 2 + 64 lies beyond the window.
+        let late = send(&ann, 0, &[RIGHT], None);
+        assert_eq!((late.fresh, late.late), (0, 1));
+        let early = send(&ann, 2 + 64, &[RIGHT], None);
+        assert_eq!((early.fresh, early.too_early), (0, 1));
+        ticks(&mut room, 1, ROOMY, Instant::now());
+        let steps = vec![vec![(A, Buttons::NONE)]; 3];
+        assert_eq!(room.status().state_hash, reference(&[A], &steps));
+        // Nothing for tick 2: a starved tick, now that it sent something.
+        assert_eq!(starvation(&metrics), 1);
+    }
+
+    #[test]
+    fn snapshots_go_full_then_delta_against_the_acknowledged_one() {
+        let (mut room, _) = room(4);
+        let ann = join(&mut room, A, "ann");
+        let t0 = Instant::now();
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        // The wire is sampled once a second, from tick 0.
+        assert_eq!(sent[0], Action::SampleWire(A));
+        assert_eq!(snapshots(&sent), [(A, 2, SnapshotKind::Full, true)]);
+        // Unacknowledged: full again.
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        assert_eq!(snapshots(&sent), [(A, 4, SnapshotKind::Full, true)]);
+        send(&ann, 4, &[RIGHT], Some(4));
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        assert_eq!(snapshots(&sent), [(A, 6, SnapshotKind::Delta, true)]);
+        assert!(!sent.contains(&Action::SampleWire(A)));
+    }
+
+    #[test]
+    fn a_snapshot_that_fits_no_datagram_goes_on_the_stream_once_until_acknowledged() {
+        let (mut room, metrics) = room(4);
+        let ann = join(&mut room, A, "ann");
+        let t0 = Instant::now();
+        let sent = ticks(&mut room, 2, None, t0);
+        assert_eq!(snapshots(&sent), [(A, 2, SnapshotKind::Full, false)]);
+        // Within STREAM_SNAPSHOT_RESEND, unacknowledged: deferred.
+        let sent = ticks(&mut room, 4, None, t0);
+        assert_eq!(snapshots(&sent), []);
+        assert_eq!(dropped(&metrics, DropReason::SnapshotDeferred), 2);
+        // Acknowledged: the next one goes.
+        send(&ann, 6, &[RIGHT], Some(2));
+        let sent = ticks(&mut room, 2, None, t0);
+        assert_eq!(snapshots(&sent), [(A, 8, SnapshotKind::Delta, false)]);
+        // Unacknowledged for STREAM_SNAPSHOT_RESEND: sent again.
+        let sent = ticks(&mut room, 64, None, t0);
+        assert_eq!(snapshots(&sent).len(), 1);
+        assert_eq!(snapshots(&sent)[0].1, 8 + 64);
+    }
+
+    #[test]
+    fn a_snapshot_not_sent_is_not_taken_as_the_last_one() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        let now = Instant::now();
+        // Stream snapshots that never got queued (a full queue) defer nothing.
+        for tick in [2, 4] {
+            room.tick(now, |_| None);
+            room.tick(now, |_| None);
+            assert_eq!(
+                snapshots(&actions(&mut room)),
+                [(A, tick, SnapshotKind::Full, false)]
+            );
+        }
+    }
+
+    #[test]
+    fn an_idle_player_is_kicked_and_the_others_are_told() {
+        let mut config = config(3);
+        config.idle_kick = Duration::from_millis(100); // 6 ticks at 60 Hz
+        let (mut room, metrics) = room_with(config);
+        join(&mut room, A, "ann");
+        let bob = join(&mut room, B, "bob");
+        let t0 = Instant::now();
+        for tick in 0..7 {
+            send(&bob, tick, &[RIGHT], None);
+            let sent = ticks(&mut room, 1, ROOMY, t0);
+            assert!(
+                !sent.iter().any(|a| matches!(a, Action::Kick { .. })),
+                "tick {tick}"
+            );
+        }
+        send(&bob, 7, &[RIGHT], None);
+        let sent = ticks(&mut room, 1, ROOMY, t0);
+        let reason = "no input for 0 s (or half of it in a full room)".to_string();
+        let notice = ServerControl::Notice {
+            kind: NoticeKind::Kick {
+                reason: reason.clone(),
+            },
+        };
+        assert_eq!(
+            sent[..4],
+            [
+                control(A, &notice),
+                Action::Kick { to: A, reason },
+                control(B, &ServerControl::PlayerLeft { id: A }),
+                Action::Left(A),
+            ]
+        );
+        assert_eq!(room.players(), 1);
+        let kicks = metrics.kicks.get_or_create(&KickLabel {
+            reason: KickReason::Idle,
+        });
+        assert_eq!(kicks.get(), 1);
+    }
+
+    #[test]
+    fn a_full_room_kicks_an_idle_player_in_half_the_time() {
+        let mut config = config(2);
+        config.idle_kick = Duration::from_millis(100);
+        let (mut room, _) = room_with(config);
+        join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        let kicks = |sent: &[Action]| {
+            sent.iter()
+                .filter(|a| matches!(a, Action::Kick { .. }))
+                .count()
+        };
+        let t0 = Instant::now();
+        // Silent since tick 0, past 3 ticks (not 6) at tick 4.
+        assert_eq!(kicks(&ticks(&mut room, 4, ROOMY, t0)), 0);
+        let kicked = kicks(&ticks(&mut room, 1, ROOMY, t0));
+        assert_eq!(kicked, 2, "both at once");
+        assert_eq!(room.players(), 0);
+    }
+
+    #[test]
+    fn a_lost_player_is_not_kicked_for_its_silence() {
+        let mut config = config(3);
+        config.idle_kick = Duration::from_millis(100);
+        let (mut room, _) = room_with(config);
+        join(&mut room, A, "ann");
+        room.detach(A, 0);
+        let sent = ticks(&mut room, 20, ROOMY, Instant::now());
+        assert_eq!(sent, []);
+        assert_eq!(room.players(), 1);
+    }
+
+    #[test]
+    fn a_quiet_client_in_a_still_room_is_skipped_up_to_quiet_max() {
+        let (mut room, metrics) = room(4);
+        let ann = join(&mut room, A, "ann");
+        let t0 = Instant::now();
+        // Standing still, once landed.
+        ticks(&mut room, 240, ROOMY, t0);
+        let mut packet = InputPacket::new(239, &[Buttons::NONE], Some(240));
+        packet.hold = true;
+        lock(&ann.inbox).receive(&packet);
+        // It spoke: one snapshot; then none while nothing changes, until
+        // QUIET_MAX (30 ticks) after the last one sent.
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        assert_eq!(snapshots(&sent), [(A, 242, SnapshotKind::Delta, true)]);
+        let sent = ticks(&mut room, 28, ROOMY, t0);
+        assert_eq!(snapshots(&sent), []);
+        assert_eq!(metrics.snapshots_skipped.get(), 14);
+        let sent = ticks(&mut room, 2, ROOMY, t0);
+        assert_eq!(snapshots(&sent), [(A, 272, SnapshotKind::Delta, true)]);
+    }
+
+    #[test]
+    fn chat_goes_to_everyone_in_the_room() {
+        let (mut room, _) = room(4);
+        join(&mut room, A, "ann");
+        join(&mut room, B, "bob");
+        room.detach(B, 0);
+        room.chat(A, "hi".into());
+        let chat = ServerControl::Chat {
+            from: A,
+            text: "hi".into(),
+        };
+        assert_eq!(actions(&mut room), [control(A, &chat), control(B, &chat)]);
+    }
+}
