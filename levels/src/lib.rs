@@ -13,7 +13,7 @@
 //! * [`ogmo::load_str`], [`tmx::load_str`]: the same from text;
 //! * [`default_level`], [`default_route`]: the embedded default level and the
 //!   route a runner bot can follow through it;
-//! * [`TileMapping`]: editor tile ids and grid values to [`Tile`]s;
+//! * [`TileMapping`]: editor tile ids and grid values to [`Tile`](ledge_shared::tilemap::Tile)s;
 //! * [`ENTITY_NAMES`]: the entity name table (see its docs for parameters);
 //! * [`LevelError`]: every refusal names the file and the field.
 //!

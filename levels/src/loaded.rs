@@ -16,7 +16,7 @@ pub struct LoadedLevel {
     /// has none).
     pub route: Vec<Waypoint>,
     /// Things skipped, one line each (unknown entities when
-    /// [`LoadOptions::skip_unknown_entities`] is set).
+    /// [`LoadOptions::skip_unknown_entities`](crate::LoadOptions::skip_unknown_entities) is set).
     pub warnings: Vec<String>,
     /// What a client draws: the editor's tile layers and tileset images.
     pub art: art::LevelArt,

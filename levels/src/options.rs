@@ -13,14 +13,14 @@ pub const MAX_LEVEL_TILES: u32 = 4096;
 /// Largest level file read from disk, in bytes (64 MiB).
 pub const MAX_FILE_BYTES: u64 = 64 << 20;
 
-/// How to load a level. [`LevelSettings`] (the settings file beside a
+/// How to load a level. [`LevelSettings`](crate::LevelSettings) (the settings file beside a
 /// level) sets these from TOML.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LoadOptions {
     /// Tile ids and grid values to tiles.
     pub mapping: TileMapping,
-    /// Skip entities whose name is not in [`ENTITY_NAMES`] (each is listed in
-    /// [`LoadedLevel::warnings`]) instead of refusing the file. Default:
+    /// Skip entities whose name is not in [`ENTITY_NAMES`](crate::ENTITY_NAMES) (each is listed in
+    /// [`LoadedLevel::warnings`](crate::LoadedLevel::warnings)) instead of refusing the file. Default:
     /// skip.
     pub skip_unknown_entities: bool,
     /// Only these tile/grid layers (by name) collide, every tile of them

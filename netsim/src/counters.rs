@@ -1,5 +1,5 @@
 //! The relay's counters: shared atomics the flows add to
-//! ([`Counters`]) and the plain figures read from them ([`RelayStats`]).
+//! (`Counters`) and the plain figures read from them ([`RelayStats`]).
 
 use std::fmt;
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -1,6 +1,6 @@
 //! What a server in an Agones fleet tells the orchestrator, and when:
 //! a sans-IO state machine (like `quinn-proto`) that the SDK driver
-//! ([`crate::agones`], cargo feature `agones`) feeds with the rooms' load
+//! (`crate::agones`, cargo feature `agones`) feeds with the rooms' load
 //! and the GameServer's state, and whose [`Call`]s it makes.
 //!
 //! Following Agones' "high density game servers" pattern, one process

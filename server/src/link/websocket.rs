@@ -231,7 +231,7 @@ async fn write(
 }
 
 /// The receive side of a WebSocket session. Dropped, it keeps reading
-/// (and discarding) for up to [`CLOSE_LINGER`], until the client answers
+/// (and discarding) for up to `CLOSE_LINGER`, until the client answers
 /// the close: a socket closed with unread input is reset, and a reset
 /// makes the client's system discard what it had not read yet, the close
 /// frame and the goodbye before it included.

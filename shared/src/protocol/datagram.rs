@@ -176,7 +176,7 @@ pub fn input_timing(input_tick: u64, server_tick: u64) -> i16 {
 
 /// A snapshot for one client: a delta-encoded [`StateSnapshot`] and that
 /// client's input bookkeeping. Sent as a datagram, or inside
-/// [`ServerControl::FullState`] when it does not fit one.
+/// [`ServerControl::FullState`](super::ServerControl::FullState) when it does not fit one.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Snapshot {
     /// The tick of the state.
