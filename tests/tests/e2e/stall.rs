@@ -13,6 +13,7 @@ use ledge_client::{OnlineGame, OnlineRequest, Trust};
 use ledge_netsim::LinkConfig;
 use ledge_server::{Server, ServerConfig};
 use ledge_shared::input::Buttons;
+use ledge_shared::protocol::PlayerId;
 use ledge_tests::{TestServer, UdpRelay};
 
 /// Runs `online` in 10 ms frames until `done` holds; returns when it did,
@@ -90,6 +91,24 @@ fn a_silent_server_is_noticed_within_a_second() {
     runtime.block_on(async { server.stop().await.unwrap() });
 }
 
+/// Cuts the client off (total loss) until it says it is reconnecting (its
+/// connection timed out).
+fn cut_off_until_reconnecting(relay: &UdpRelay, online: &mut OnlineGame) {
+    relay.blackhole();
+    play_until(online, "reconnecting", Duration::from_secs(15), |o, _| {
+        matches!(o.status(), NetStatus::Reconnecting { .. })
+    });
+}
+
+/// Checks that the client is back as player `me`, resumed once; returns the
+/// server's metrics.
+fn assert_resumed_as(online: &OnlineGame, server: &TestServer, me: PlayerId) -> String {
+    assert_eq!(online.game().unwrap().me(), me, "the same player");
+    let m = server.metrics();
+    assert_eq!(ledge_tests::metric(&m, "ledge_sessions_resumed_total"), 1.0);
+    m
+}
+
 #[test]
 fn a_gui_client_reconnects_by_itself_and_keeps_its_player() {
     let (runtime, server, relay, mut online) = join_through_relay();
@@ -97,13 +116,7 @@ fn a_gui_client_reconnects_by_itself_and_keeps_its_player() {
 
     // 20 s of total loss: both ends time out (10 s) and the client keeps
     // trying; the server keeps the player.
-    relay.blackhole();
-    play_until(
-        &mut online,
-        "reconnecting",
-        Duration::from_secs(15),
-        |o, _| matches!(o.status(), NetStatus::Reconnecting { .. }),
-    );
+    cut_off_until_reconnecting(&relay, &mut online);
     // The rest of the 20 s (the connection died after about 10 s).
     std::thread::sleep(Duration::from_secs(9));
     relay.restore();
@@ -112,9 +125,7 @@ fn a_gui_client_reconnects_by_itself_and_keeps_its_player() {
             && o.game().is_some_and(|g| g.synced())
             && o.stalled(now).is_none()
     });
-    assert_eq!(online.game().unwrap().me(), me, "the same player");
-    let m = server.metrics();
-    assert_eq!(ledge_tests::metric(&m, "ledge_sessions_resumed_total"), 1.0);
+    assert_resumed_as(&online, &server, me);
     drop(online);
     runtime.block_on(async { server.stop().await.unwrap() });
 }
@@ -129,22 +140,14 @@ fn a_slow_reconnect_keeps_the_player() {
     let (runtime, server, relay, mut online) = join_through_relay();
     let me = online.game().unwrap().me();
 
-    relay.blackhole();
-    play_until(
-        &mut online,
-        "reconnecting",
-        Duration::from_secs(15),
-        |o, _| matches!(o.status(), NetStatus::Reconnecting { .. }),
-    );
+    cut_off_until_reconnecting(&relay, &mut online);
     let slow = LinkConfig::delay(Duration::from_millis(900));
     relay.set_links(slow, slow);
     relay.restore();
     play_until(&mut online, "back", Duration::from_secs(20), |o, _| {
         matches!(o.status(), NetStatus::Connected { .. })
     });
-    assert_eq!(online.game().unwrap().me(), me, "the same player");
-    let m = server.metrics();
-    assert_eq!(ledge_tests::metric(&m, "ledge_sessions_resumed_total"), 1.0);
+    let m = assert_resumed_as(&online, &server, me);
     assert_eq!(
         ledge_tests::metric(&m, "ledge_players{room=\"room-1\"}"),
         1.0,
