@@ -28,7 +28,7 @@ use proptest::prelude::*;
 use proptest::test_runner::TestCaseResult;
 
 use crate::platformer_kit;
-use crate::tile_kit::{pushes, random_map, v, w};
+use crate::tile_kit::{against, first_pushed_back, pushes, random_map, v, w};
 use platformer_kit::map_at;
 
 // ------------------------------------------------------------------ helpers
@@ -1103,15 +1103,7 @@ proptest! {
         let b = Aabb::new(half).unwrap();
         let d = d0 * k;
         let hit = sweep_tiles(&m, &b, start, d.as_i64vec2(), flags);
-        // The first lattice position a tile pushes back against the motion.
-        // (The rules also push a box crossing a slope's thin end down
-        // through its bottom, with the motion: not a collision to stop at.)
-        let against = |j: i32| {
-            pushes(&m, start + d0 * j, half, d0 * j, flags)
-                .iter()
-                .any(|c| c.mtv.as_i64vec2().dot(d0.as_i64vec2()) < 0)
-        };
-        let first = (1..=k).find(|&j| against(j));
+        let first = first_pushed_back(&m, start, half, d0, k, flags);
         match (hit, first) {
             (None, None) => {}
             (None, Some(j)) => prop_assert!(false, "no hit, but lattice {} of {} is pushed; {}", j, k, render(&m)),
@@ -1127,7 +1119,7 @@ proptest! {
                 // under a ramp the box's body has entered through a culled
                 // face, are the contact pass's, at any speed.)
                 let p = pushes(&m, h.stop, half, moved, flags);
-                let back = p.iter().any(|c| c.mtv.as_i64vec2().dot(d0.as_i64vec2()) < 0);
+                let back = p.iter().any(|c| against(c, d0));
                 prop_assert!(!back, "stop {} pushed back: {:?}; {}", h.stop, p, render(&m));
                 // The hit is real: the motion is pushed at it (a hit exactly
                 // at a lattice position, say a foot entering a column from

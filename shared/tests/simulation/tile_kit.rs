@@ -17,7 +17,7 @@ use ledge_shared::world::{
 use proptest::prelude::*;
 use std::cmp::Reverse;
 
-use crate::platformer_kit::{ent_sized, level_sized, Sim, LEFT, RIGHT};
+use crate::platformer_kit::{ent_sized, level_sized, map_at, Sim, LEFT, RIGHT};
 
 /// Shorthand for a unit vector.
 pub fn v(x: i32, y: i32) -> IVec2 {
@@ -127,6 +127,31 @@ pub fn pushes(
     map.box_contacts(pos, half, moved, flags, &mut out);
     out.retain(|c| !c.is_trigger());
     out
+}
+
+/// Whether contact `c` pushes back against a motion along `d0`.
+pub fn against(c: &TileContact, d0: IVec2) -> bool {
+    c.mtv.as_i64vec2().dot(d0.as_i64vec2()) < 0
+}
+
+/// The first lattice position `j` in `1..=k` at which a box of `half`
+/// moved from `start` to `start + d0 * j` is pushed back against the motion
+/// (the sweep oracles' reference hit). (The rules also push a box crossing a
+/// slope's thin end down through its bottom, with the motion: not a
+/// collision to stop at.)
+pub fn first_pushed_back(
+    map: &Tilemap,
+    start: IVec2,
+    half: IVec2,
+    d0: IVec2,
+    k: i32,
+    flags: ContactFlags,
+) -> Option<i32> {
+    (1..=k).find(|&j| {
+        pushes(map, start + d0 * j, half, d0 * j, flags)
+            .iter()
+            .any(|c| against(c, d0))
+    })
 }
 
 /// Slides a box along a flat run of tiles: `along` is the unit direction of
@@ -340,4 +365,58 @@ pub fn run_hills(t: i32, land: usize, speed: i32, from: i32, to: i32) {
         assert!(ticks < 100_000);
     }
     assert_eq!(min_bottom, 9 * t, "T {t} speed {speed}");
+}
+
+/// A ramp: its row (row 5, solid ground under it), the column of its first
+/// slope tile, and its standing height above the row's bottom line as a
+/// function of the foot's offset from that column's left edge and the tile
+/// size.
+pub struct Ramp {
+    pub name: &'static str,
+    pub row: &'static str,
+    pub col: i32,
+    pub height: fn(i32, i32) -> i32,
+}
+
+pub const RAMPS: [Ramp; 4] = [
+    Ramp {
+        name: "45 rising right",
+        row: "...../########",
+        col: 5,
+        height: |x, t| x.clamp(0, t),
+    },
+    Ramp {
+        name: "45 rising left",
+        row: "########\\.....",
+        col: 8,
+        height: |x, t| t - x.clamp(0, t),
+    },
+    Ramp {
+        name: "22.5 rising right",
+        row: ".....ab#######",
+        col: 5,
+        height: |x, t| x.clamp(0, 2 * t).div_euclid(2),
+    },
+    Ramp {
+        name: "22.5 rising left",
+        row: "#######cd.....",
+        col: 7,
+        height: |x, t| t - x.clamp(0, 2 * t).div_euclid(2),
+    },
+];
+
+/// The ramp's map: five empty rows, its row, two solid rows; tiles of `t`
+/// with the top-left corner at `origin`.
+pub fn ramp_map(origin: IVec2, t: i32, ramp: &Ramp) -> Tilemap {
+    let rows = [
+        "..............",
+        "..............",
+        "..............",
+        "..............",
+        "..............",
+        ramp.row,
+        "##############",
+        "##############",
+    ];
+    map_at(origin, t, &rows)
 }

@@ -12,7 +12,7 @@ use ledge_shared::fixed::{px, MAX_COORD};
 use ledge_shared::tilemap::{ContactFlags, Slope, Tile, Tilemap, TilemapError};
 
 use crate::platformer_kit;
-use crate::tile_kit::{col_x, resolve, resolved, row_y, run, slide};
+use crate::tile_kit::{col_x, ramp_map, resolve, resolved, row_y, run, slide, RAMPS};
 use platformer_kit::map_at;
 
 /// 16 px tiles.
@@ -119,68 +119,6 @@ fn wall_seams_never_snag() {
     }
 }
 
-/// A ramp scene: the slope row (row 5) and solid ground under it.
-struct Ramp {
-    name: &'static str,
-    row: &'static str,
-    /// Column of the ramp's first slope tile.
-    col: i32,
-    /// Standing height above the ramp row's bottom line, as a function of the
-    /// foot's offset from the ramp's left edge.
-    height: fn(i32) -> i32,
-}
-
-const RAMPS: [Ramp; 4] = [
-    Ramp {
-        name: "45 rising right",
-        row: "...../########",
-        col: 5,
-        height: |x| x.clamp(0, T),
-    },
-    Ramp {
-        name: "45 rising left",
-        row: "########\\.....",
-        col: 8,
-        height: |x| {
-            if x < 0 {
-                T
-            } else if x < T {
-                T - x
-            } else {
-                0
-            }
-        },
-    },
-    Ramp {
-        name: "22.5 rising right",
-        row: ".....ab#######",
-        col: 5,
-        height: |x| {
-            if x < 0 {
-                0
-            } else if x < 2 * T {
-                x.div_euclid(2)
-            } else {
-                T
-            }
-        },
-    },
-    Ramp {
-        name: "22.5 rising left",
-        row: "#######cd.....",
-        col: 7,
-        height: |x| {
-            if x < 0 {
-                T
-            } else if x < 2 * T {
-                T - x.div_euclid(2)
-            } else {
-                0
-            }
-        },
-    },
-];
-
 /// Walks over each ramp, flat -> slope -> flat, in both directions: with
 /// gravity and ground snap, the foot is exactly on the surface function every
 /// tick, the x speed never changes, nothing is left overlapping.
@@ -190,20 +128,10 @@ fn ramps_are_followed_exactly() {
     let flags = ContactFlags::default();
     for origin in ORIGINS {
         for ramp in &RAMPS {
-            let rows = [
-                "..............",
-                "..............",
-                "..............",
-                "..............",
-                "..............",
-                ramp.row,
-                "##############",
-                "##############",
-            ];
-            let m = map(origin, &rows);
+            let m = ramp_map(origin, T, ramp);
             let base = row_y(&m, 6);
             let left = col_x(&m, ramp.col);
-            let surface = |foot_x: i32| base - (ramp.height)(foot_x - left);
+            let surface = |foot_x: i32| base - (ramp.height)(foot_x - left, T);
             for half in BOXES {
                 for gravity in [0, 1, 90, 700] {
                     for speed in [1, 3, 16, 100, 255, 256, 257, 511, 768] {

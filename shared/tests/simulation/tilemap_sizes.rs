@@ -25,7 +25,8 @@
 
 use crate::platformer_kit;
 use crate::tile_kit::{
-    col_x, pushes, random_map, resolve, resolved, row_y, run, run_hills, shot, slide, v, w,
+    against, col_x, first_pushed_back, pushes, ramp_map, random_map, resolve, resolved, row_y, run,
+    run_hills, shot, slide, v, w, RAMPS,
 };
 
 use glam::IVec2;
@@ -183,58 +184,6 @@ fn wall_seams_never_snag_at_every_subpixel_offset() {
     }
 }
 
-/// A ramp: its row (row 5, solid ground under it), the column of its first
-/// slope tile, and its standing height above the row's bottom line as a
-/// function of the foot's offset from that column's left edge and the tile
-/// size.
-struct Ramp {
-    name: &'static str,
-    row: &'static str,
-    col: i32,
-    height: fn(i32, i32) -> i32,
-}
-
-const RAMPS: [Ramp; 4] = [
-    Ramp {
-        name: "45 rising right",
-        row: "...../########",
-        col: 5,
-        height: |x, t| x.clamp(0, t),
-    },
-    Ramp {
-        name: "45 rising left",
-        row: "########\\.....",
-        col: 8,
-        height: |x, t| t - x.clamp(0, t),
-    },
-    Ramp {
-        name: "22.5 rising right",
-        row: ".....ab#######",
-        col: 5,
-        height: |x, t| x.clamp(0, 2 * t).div_euclid(2),
-    },
-    Ramp {
-        name: "22.5 rising left",
-        row: "#######cd.....",
-        col: 7,
-        height: |x, t| t - x.clamp(0, 2 * t).div_euclid(2),
-    },
-];
-
-fn ramp_map(t: i32, ramp: &Ramp) -> Tilemap {
-    let rows = [
-        "..............",
-        "..............",
-        "..............",
-        "..............",
-        "..............",
-        ramp.row,
-        "##############",
-        "##############",
-    ];
-    map_at(ORIGIN, t, &rows)
-}
-
 /// Over every unit column of each ramp, flat -> slope -> flat, the floor
 /// under a foot is the ramp's surface function (so it changes by at most
 /// one unit between neighbouring columns), a box of any width resting there
@@ -245,7 +194,7 @@ fn ramps_are_continuous_at_every_unit_column() {
     let flags = ContactFlags::default();
     for t in SIZES {
         for ramp in &RAMPS {
-            let m = ramp_map(t, ramp);
+            let m = ramp_map(ORIGIN, t, ramp);
             let (base, left) = (row_y(&m, 6), col_x(&m, ramp.col));
             let half = boxes(t)[0];
             let mut last: Option<i32> = None;
@@ -291,7 +240,7 @@ fn ramps_are_followed_exactly() {
     let flags = ContactFlags::default();
     for t in SIZES {
         for ramp in &RAMPS {
-            let m = ramp_map(t, ramp);
+            let m = ramp_map(ORIGIN, t, ramp);
             let (base, left) = (row_y(&m, 6), col_x(&m, ramp.col));
             let surface = |foot_x: i32| base - (ramp.height)(foot_x - left, t);
             for half in boxes(t) {
@@ -535,12 +484,7 @@ proptest! {
         let b = Aabb::new(half).unwrap();
         let d = d0 * k;
         let hit = sweep_tiles(&m, &b, start, d.as_i64vec2(), flags);
-        let against = |j: i32| {
-            pushes(&m, start + d0 * j, half, d0 * j, flags)
-                .iter()
-                .any(|c| c.mtv.as_i64vec2().dot(d0.as_i64vec2()) < 0)
-        };
-        let first = (1..=k).find(|&j| against(j));
+        let first = first_pushed_back(&m, start, half, d0, k, flags);
         match (hit, first) {
             (None, None) => {}
             (None, Some(j)) => prop_assert!(false, "T {}: no hit, but lattice {} of {} is pushed", t, j, k),
@@ -552,7 +496,7 @@ proptest! {
                 }
                 let moved = h.stop - start;
                 let p = pushes(&m, h.stop, half, moved, flags);
-                let back = p.iter().any(|c| c.mtv.as_i64vec2().dot(d0.as_i64vec2()) < 0);
+                let back = p.iter().any(|c| against(c, d0));
                 prop_assert!(!back, "T {}: stop {} pushed back: {:?}", t, h.stop, p);
                 let shift = v(7 * t, -3 * t);
                 let moved_map = Tilemap::new(m.origin() + shift, t, 7, 5, m.tiles().to_vec()).unwrap();
