@@ -18,6 +18,7 @@ use ledge_shared::game::{GameConfig, MAX_RESPAWN_DELAY_TICKS};
 
 use crate::admission::AdmissionConfig;
 use crate::fleet::FleetConfig;
+use crate::web::guard::{mbps_to_bytes, WebLimits, DEFAULT_ADDRESS_SHARE};
 
 /// Default UDP address the server listens on.
 pub const DEFAULT_BIND: &str = "0.0.0.0:4433";
@@ -180,7 +181,7 @@ pub struct ServerConfig {
 }
 
 /// Where browsers connect (docs/SERVER.md, "Browsers").
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct WebConfig {
     /// TCP address of the HTTP/1.1 server: the page, `/web.json`,
     /// `/level`, WebSocket sessions at `/ws`.
@@ -192,6 +193,8 @@ pub struct WebConfig {
     /// How long WebTransport certificates live (13 days; tests shorten it
     /// to see a rotation).
     pub cert_life: crate::web::webtransport_cert::CertLife,
+    /// The web port's per-address limits and uplink budget.
+    pub limits: WebLimits,
 }
 
 impl WebConfig {
@@ -203,6 +206,7 @@ impl WebConfig {
             root: PathBuf::from(DEFAULT_WEB_ROOT),
             webtransport: Some(bind),
             cert_life: Default::default(),
+            limits: WebLimits::default(),
         }
     }
 }
@@ -312,6 +316,9 @@ impl ServerConfig {
         }
         if self.idle_timeout < Duration::from_millis(100) {
             return bad("idle_timeout must be at least 0.1 s");
+        }
+        if let Some(web) = &self.web {
+            web.limits.check().map_err(ConfigError::Invalid)?;
         }
         let l = &self.limits;
         let rates = [
@@ -496,6 +503,14 @@ pub struct Cli {
     /// No WebTransport: browsers use WebSocket only.
     #[arg(long)]
     pub no_webtransport: bool,
+    /// The host's upload budget for the web port's downloads (the page,
+    /// the level), Mbit/s, all addresses together [default: 100].
+    #[arg(long, value_name = "MBPS")]
+    pub web_uplink_mbps: Option<f64>,
+    /// Of that, the most one address may take, Mbit/s [default: a quarter
+    /// of --web-uplink-mbps].
+    #[arg(long, value_name = "MBPS")]
+    pub web_address_mbps: Option<f64>,
 }
 
 /// The TOML file: every key optional.
@@ -535,6 +550,41 @@ struct FileConfig {
     webtransport_bind: Option<String>,
     /// `false`: as `--no-webtransport`.
     webtransport: Option<bool>,
+    web_limits: Option<FileWebLimits>,
+}
+
+/// The file's `[web_limits]`: every key optional (docs/SERVER.md).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileWebLimits {
+    connections_per_address: Option<usize>,
+    requests_per_second: Option<f64>,
+    request_burst: Option<f64>,
+    downloads_per_address: Option<usize>,
+    downloads_per_minute: Option<u32>,
+    uplink_mbps: Option<f64>,
+    address_mbps: Option<f64>,
+}
+
+impl FileWebLimits {
+    /// The limits: defaults, then the file's keys, then the flags' rates.
+    fn resolve(&self, uplink_flag: Option<f64>, address_flag: Option<f64>) -> WebLimits {
+        let mut l = WebLimits::default();
+        set(&mut l.connections_per_address, self.connections_per_address);
+        set(&mut l.requests_per_second, self.requests_per_second);
+        set(&mut l.request_burst, self.request_burst);
+        set(&mut l.downloads_per_address, self.downloads_per_address);
+        set(&mut l.downloads_per_minute, self.downloads_per_minute);
+        let uplink = uplink_flag.or(self.uplink_mbps);
+        if let Some(mbps) = uplink {
+            l.uplink_bytes_per_second = mbps_to_bytes(mbps);
+            l.address_bytes_per_second = mbps_to_bytes(mbps * DEFAULT_ADDRESS_SHARE);
+        }
+        if let Some(mbps) = address_flag.or(self.address_mbps) {
+            l.address_bytes_per_second = mbps_to_bytes(mbps);
+        }
+        l
+    }
 }
 
 /// The file's `[agones]`: present (even empty) means run under Agones.
@@ -693,6 +743,10 @@ impl Cli {
                 Some(b) => Some(b),
                 None => file_bind("webtransport_bind", &file.webtransport_bind)?,
             };
+            web.limits = file
+                .web_limits
+                .unwrap_or_default()
+                .resolve(self.web_uplink_mbps, self.web_address_mbps);
             web.webtransport = match (self.no_webtransport, file.webtransport) {
                 (true, _) | (false, Some(false)) => None,
                 _ => Some(wt_bind.unwrap_or(bind)),

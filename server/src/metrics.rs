@@ -23,6 +23,7 @@ use tracing::{debug, warn};
 
 pub use crate::admission::Refusal;
 pub use crate::link::{Transport, Wire};
+pub use crate::web::guard::WebRefusal;
 
 /// Label: a room.
 #[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
@@ -91,6 +92,51 @@ pub struct DropLabel {
 pub struct RefusalLabel {
     /// The reason.
     pub reason: Refusal,
+}
+
+/// Label: why the web port turned a request or connection away.
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct WebRefusalLabel {
+    /// The reason.
+    pub reason: WebRefusal,
+}
+
+/// What kind of network an address is on (a bounded label: addresses
+/// themselves would grow the exposition without end).
+#[derive(Debug, Clone, Copy, Hash, PartialEq, Eq, EncodeLabelValue)]
+pub enum AddressClass {
+    /// This machine.
+    Loopback,
+    /// A private or link-local network (the LAN).
+    Private,
+    /// Anything else (the internet).
+    Public,
+}
+
+impl AddressClass {
+    /// The class of `ip`.
+    pub fn of(ip: std::net::IpAddr) -> AddressClass {
+        use std::net::IpAddr;
+        let ip = match ip {
+            IpAddr::V6(v6) => v6.to_ipv4_mapped().map_or(IpAddr::V6(v6), IpAddr::V4),
+            v4 => v4,
+        };
+        match ip {
+            _ if ip.is_loopback() => AddressClass::Loopback,
+            IpAddr::V4(v4) if v4.is_private() || v4.is_link_local() => AddressClass::Private,
+            // Unique local (fc00::/7) and link-local (fe80::/10).
+            IpAddr::V6(v6) if (v6.segments()[0] & 0xfe00) == 0xfc00 => AddressClass::Private,
+            IpAddr::V6(v6) if (v6.segments()[0] & 0xffc0) == 0xfe80 => AddressClass::Private,
+            _ => AddressClass::Public,
+        }
+    }
+}
+
+/// Label: an [`AddressClass`].
+#[derive(Debug, Clone, Hash, PartialEq, Eq, EncodeLabelSet)]
+pub struct AddressClassLabel {
+    /// The class.
+    pub class: AddressClass,
 }
 
 /// Label: a transport.
@@ -191,6 +237,15 @@ pub struct Metrics {
     pub transport_connections_refused: Family<TransportRefusalLabel, Counter>,
     /// Connections not yet past their hello.
     pub pending_connections: Gauge,
+    /// Open HTTP connections on the web port.
+    pub web_connections: Gauge,
+    /// Addresses the web port keeps limits for ([`crate::web::guard`]).
+    pub web_addresses: Gauge,
+    /// Requests and connections the web port turned away, by reason.
+    pub web_refused: Family<WebRefusalLabel, Counter>,
+    /// Bytes of downloads (the level, the page's larger files) sent by the
+    /// web port, by the class of the address they went to.
+    pub web_download_bytes: Family<AddressClassLabel, Counter>,
     /// Bytes received per client.
     pub client_bytes_in: Family<ClientLabel, Counter>,
     /// Bytes sent per client.
@@ -291,6 +346,10 @@ impl Metrics {
             transport_connections_opened: Family::default(),
             transport_connections_refused: Family::default(),
             pending_connections: Gauge::default(),
+            web_connections: Gauge::default(),
+            web_addresses: Gauge::default(),
+            web_refused: Family::default(),
+            web_download_bytes: Family::default(),
             client_bytes_in: Family::default(),
             client_bytes_out: Family::default(),
             bytes_in: Family::default(),
@@ -364,6 +423,26 @@ impl Metrics {
             "connections_refused",
             "Connections refused, or closed before their hello, by reason",
             self.connections_refused.clone(),
+        );
+        r.register(
+            "web_connections",
+            "Open HTTP connections on the web port",
+            self.web_connections.clone(),
+        );
+        r.register(
+            "web_addresses",
+            "Addresses the web port keeps per-address limits for",
+            self.web_addresses.clone(),
+        );
+        r.register(
+            "web_refused",
+            "Requests and connections the web port turned away, by reason",
+            self.web_refused.clone(),
+        );
+        r.register(
+            "web_download_bytes",
+            "Bytes of downloads sent by the web port, by address class",
+            self.web_download_bytes.clone(),
         );
         r.register(
             "retries",

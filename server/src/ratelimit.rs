@@ -1,6 +1,7 @@
-//! Token buckets: per-client rate limits and abuse thresholds.
+//! Token buckets and a throttle: per-client rate limits, abuse thresholds,
+//! and warnings at most so often.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// A token bucket: holds at most `capacity` tokens, refills at `rate` tokens
 /// per second, starts full. Pure: the caller passes the time.
@@ -48,10 +49,53 @@ impl TokenBucket {
     }
 }
 
+/// At most one message per `every`: [`Throttle::note`] says when one is
+/// due and how many events it stands for. Pure, like [`TokenBucket`].
+#[derive(Debug, Clone)]
+pub struct Throttle {
+    every: Duration,
+    last: Option<Instant>,
+    events: u64,
+}
+
+impl Throttle {
+    /// One message at most every `every`.
+    pub fn new(every: Duration) -> Throttle {
+        Throttle {
+            every,
+            last: None,
+            events: 0,
+        }
+    }
+
+    /// Counts an event at `now`; `Some(n)` when a message is due, `n` the
+    /// events since the last one (this one included).
+    pub fn note(&mut self, now: Instant) -> Option<u64> {
+        self.events += 1;
+        let due = self
+            .last
+            .is_none_or(|t| now.saturating_duration_since(t) >= self.every);
+        due.then(|| {
+            self.last = Some(now);
+            std::mem::take(&mut self.events)
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::time::Duration;
+
+    #[test]
+    fn a_throttle_speaks_once_per_period_and_counts_the_rest() {
+        let t0 = Instant::now();
+        let mut t = Throttle::new(Duration::from_secs(10));
+        assert_eq!(t.note(t0), Some(1));
+        assert!((0..5).all(|i| t.note(t0 + Duration::from_secs(i)).is_none()));
+        assert_eq!(t.note(t0 + Duration::from_secs(10)), Some(6));
+        assert_eq!(t.note(t0 + Duration::from_secs(11)), None);
+    }
 
     #[test]
     fn allows_the_burst_then_the_rate() {

@@ -221,6 +221,7 @@ struct WebParts {
     addr: SocketAddr,
     root: WebRoot,
     webtransport: Option<WebTransportParts>,
+    limits: web::guard::WebLimits,
 }
 
 struct WebTransportParts {
@@ -288,6 +289,7 @@ fn bind_web(w: &WebConfig, idle_timeout: Duration) -> Result<WebParts, ServerErr
         addr,
         root,
         webtransport,
+        limits: w.limits,
     })
 }
 
@@ -677,6 +679,8 @@ fn serve_browsers(
         webtransport: wt_port,
         accepted,
         idle_timeout: config.idle_timeout,
+        guard: web::guard::WebGuard::new(w.limits, std::time::Instant::now()),
+        warnings: std::sync::Mutex::new(crate::ratelimit::Throttle::new(web::WARN_EVERY)),
     });
     browsers
         .tasks

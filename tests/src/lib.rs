@@ -503,6 +503,7 @@ impl PredictedClient {
         }
     }
 }
+pub mod attack;
 pub mod browser;
 pub mod e2e;
 pub mod web;

@@ -4,7 +4,7 @@
 //! a browser page would, and [`http_get`] for the web port's documents.
 
 use std::collections::VecDeque;
-use std::net::SocketAddr;
+use std::net::{IpAddr, SocketAddr};
 use std::time::Duration;
 
 use futures_util::{SinkExt, StreamExt};
@@ -13,7 +13,7 @@ use ledge_shared::protocol::{
     write_frame, ClientControl, CloseCode, FrameDecoder, Message as _, ServerControl, MAX_FRAME,
 };
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
-use tokio::net::TcpStream;
+use tokio::net::{TcpSocket, TcpStream};
 use tokio_tungstenite::tungstenite::protocol::frame::coding::CloseCode as WsCloseCode;
 use tokio_tungstenite::tungstenite::Message;
 use tokio_tungstenite::WebSocketStream;
@@ -40,31 +40,62 @@ impl HttpAnswer {
     }
 }
 
+/// A TCP connection to `addr` from `source` (another loopback address
+/// stands for another machine), or from any address.
+pub async fn connect_from(source: Option<IpAddr>, addr: SocketAddr) -> std::io::Result<TcpStream> {
+    let Some(ip) = source else {
+        return TcpStream::connect(addr).await;
+    };
+    let socket = match ip {
+        IpAddr::V4(_) => TcpSocket::new_v4()?,
+        IpAddr::V6(_) => TcpSocket::new_v6()?,
+    };
+    socket.bind(SocketAddr::new(ip, 0))?;
+    socket.connect(addr).await
+}
+
 /// `GET path` over HTTP/1.1 on a fresh connection.
 pub async fn http_get(addr: SocketAddr, path: &str) -> HttpAnswer {
-    let mut stream = TcpStream::connect(addr).await.expect("web port accepts");
-    let request = format!("GET {path} HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n");
-    stream.write_all(request.as_bytes()).await.unwrap();
+    http_get_from(None, addr, path, &[])
+        .await
+        .expect("an answer")
+}
+
+/// `GET path` from `source` with `headers` (name, value) over HTTP/1.1 on
+/// a fresh connection; `None` if the connection failed or no head came
+/// within 10 s.
+pub async fn http_get_from(
+    source: Option<IpAddr>,
+    addr: SocketAddr,
+    path: &str,
+    headers: &[(&str, &str)],
+) -> Option<HttpAnswer> {
+    let mut stream = connect_from(source, addr).await.ok()?;
+    let extra: String = headers
+        .iter()
+        .map(|(n, v)| format!("{n}: {v}\r\n"))
+        .collect();
+    let request =
+        format!("GET {path} HTTP/1.1\r\nHost: localhost\r\n{extra}Connection: close\r\n\r\n");
+    stream.write_all(request.as_bytes()).await.ok()?;
     let mut response = Vec::new();
     tokio::time::timeout(Duration::from_secs(10), stream.read_to_end(&mut response))
         .await
-        .expect("an answer in time")
-        .unwrap();
-    let split = response
-        .windows(4)
-        .position(|w| w == b"\r\n\r\n")
-        .expect("an HTTP head");
+        .ok()?
+        .ok()?;
+    parse_answer(&response)
+}
+
+/// An HTTP/1.1 answer's head and body (`None`: no head).
+fn parse_answer(response: &[u8]) -> Option<HttpAnswer> {
+    let split = response.windows(4).position(|w| w == b"\r\n\r\n")?;
     let head = String::from_utf8_lossy(&response[..split]).into_owned();
-    let status = head
-        .split_whitespace()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .expect("a status code");
-    HttpAnswer {
+    let status = head.split_whitespace().nth(1)?.parse().ok()?;
+    Some(HttpAnswer {
         status,
         head,
         body: response[split + 4..].to_vec(),
-    }
+    })
 }
 
 /// What a web client received.
@@ -108,7 +139,15 @@ pub struct WsRefused {
 impl WsClient {
     /// Connects to `ws://addr/ws`.
     pub async fn connect(addr: SocketAddr) -> Result<WsClient, WsRefused> {
-        let stream = TcpStream::connect(addr).await.map_err(|e| WsRefused {
+        Self::connect_from(None, addr).await
+    }
+
+    /// Connects to `ws://addr/ws` from `source` ([`connect_from`]).
+    pub async fn connect_from(
+        source: Option<IpAddr>,
+        addr: SocketAddr,
+    ) -> Result<WsClient, WsRefused> {
+        let stream = connect_from(source, addr).await.map_err(|e| WsRefused {
             status: None,
             error: e.to_string(),
         })?;

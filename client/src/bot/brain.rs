@@ -32,6 +32,25 @@ pub trait Brain: Send {
     }
 }
 
+/// A varied script that repeats every 4 s (240 ticks) and stays around
+/// the spawn of the default level (its crate, its elevator): runs, jumps,
+/// turns and stands. The buttons for `tick`; played from other offsets
+/// by several players, it exercises prediction on every kind of move
+/// (`tests/e2e/prediction.rs`, the predictor's tests).
+pub fn drill(tick: u64) -> Buttons {
+    Buttons(match tick % 240 {
+        0..=49 => Buttons::RIGHT,
+        50..=70 => Buttons::RIGHT | Buttons::JUMP,
+        71..=100 => Buttons::RIGHT,
+        101..=110 => 0,
+        111..=160 => Buttons::LEFT,
+        161..=175 => Buttons::LEFT | Buttons::JUMP,
+        176..=200 => Buttons::LEFT,
+        201..=205 => Buttons::JUMP,
+        _ => 0,
+    })
+}
+
 /// Holds no button, ever.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Idle;

@@ -27,6 +27,21 @@ pub struct WebFile {
     pub body: Bytes,
     /// Its `Content-Type`.
     pub content_type: &'static str,
+    /// Its entity tag: the SHA-256 of its bytes, quoted, so a browser
+    /// reloading the page revalidates it (`If-None-Match`) and gets a 304
+    /// instead of the whole file again.
+    pub etag: String,
+}
+
+/// The quoted entity tag of `bytes`: their SHA-256, lower-case hex
+/// (shortened to 128 bits, plenty to tell versions apart).
+pub fn etag_of(bytes: &[u8]) -> String {
+    let digest = ring::digest::digest(&ring::digest::SHA256, bytes);
+    let hex: String = digest.as_ref()[..16]
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    format!("\"{hex}\"")
 }
 
 /// Why the web page's directory cannot be served.
@@ -152,11 +167,13 @@ impl WebRoot {
                 });
             }
             let content_type = content_type(&name);
+            let etag = etag_of(&body);
             files.insert(
                 name,
                 WebFile {
                     body: body.into(),
                     content_type,
+                    etag,
                 },
             );
         }
@@ -221,6 +238,14 @@ mod tests {
         assert_eq!(content_type("data.json"), "application/json");
         assert_eq!(content_type("style.css"), "text/css; charset=utf-8");
         assert_eq!(content_type("noext"), "application/octet-stream");
+        // Entity tags follow the bytes.
+        let (a, b) = (
+            root.get("index.html").unwrap(),
+            root.get("glue.js").unwrap(),
+        );
+        assert_eq!(a.etag, etag_of(b"<p>hi</p>"));
+        assert_ne!(a.etag, b.etag);
+        assert!(a.etag.starts_with('"') && a.etag.len() == 34, "{}", a.etag);
     }
 
     #[test]

@@ -8,11 +8,18 @@
 //!
 //! The HTTP side is bounded: at most [`MAX_HTTP_CONNECTIONS`] connections
 //! at once (more wait in the kernel's backlog), each for at most
-//! [`REQUEST_TIMEOUT`], a request head arriving within [`HEADER_TIMEOUT`];
-//! a WebSocket is bounded by its own limits
-//! ([`crate::link::websocket`]).
+//! [`REQUEST_TIMEOUT`], a request head arriving within [`HEADER_TIMEOUT`]
+//! (an idle keep-alive connection too); a WebSocket is bounded by its own
+//! limits ([`crate::link::websocket`]). Per address ([`guard`]): open
+//! connections, requests a second, downloads, and the bytes a second of
+//! their bodies, refused with 429 and `Retry-After` ([`refusal`]); bodies
+//! are paced ([`paced`]). Files and the level carry entity tags, so a
+//! reload revalidates them instead of downloading them again.
 
 pub mod files;
+pub mod guard;
+pub mod paced;
+pub mod refusal;
 pub mod webtransport_cert;
 pub mod webtransport_endpoint;
 
@@ -38,8 +45,11 @@ use tracing::{debug, warn};
 use crate::admission::{Refusal, Ticket, Verdict};
 use crate::link::websocket::{self, Upgraded};
 use crate::link::{Incoming, Transport};
+use crate::metrics::{AddressClass, AddressClassLabel, WebRefusalLabel};
+use crate::ratelimit::Throttle;
 use crate::shared::Shared;
 use files::WebRoot;
+use guard::{ConnectionPermit, Limited, WebGuard, WebRefusal, PACED_FROM};
 use webtransport_endpoint::WebCerts;
 
 /// Most HTTP connections served at once.
@@ -52,6 +62,11 @@ pub const REQUEST_TIMEOUT: Duration = Duration::from_secs(60);
 
 /// Most bytes of a request buffered (its head: no route reads a body).
 pub const MAX_REQUEST_BUFFER: usize = 16 * 1024;
+/// Most refused connections being answered at once; past it they are
+/// closed unanswered (a flood gets what it sends).
+pub const MAX_REFUSALS_AT_ONCE: usize = 64;
+/// A warning about refusals at most this often.
+pub const WARN_EVERY: Duration = Duration::from_secs(10);
 
 /// A WebSocket admitted and upgraded, for the server's accept loop.
 pub type Accepted = (Incoming, Ticket);
@@ -73,6 +88,42 @@ pub struct WebState {
     pub accepted: mpsc::Sender<Accepted>,
     /// A WebSocket client silent this long is lost.
     pub idle_timeout: Duration,
+    /// The per-address limits.
+    pub guard: Arc<WebGuard>,
+    /// Refusal warnings, at most every [`WARN_EVERY`].
+    pub warnings: std::sync::Mutex<Throttle>,
+}
+
+impl WebState {
+    /// Counts a refusal of `peer` and warns at most every [`WARN_EVERY`].
+    fn refused(&self, peer: SocketAddr, limited: Limited) {
+        let metrics = &self.shared.metrics;
+        metrics
+            .web_refused
+            .get_or_create(&WebRefusalLabel {
+                reason: limited.reason,
+            })
+            .inc();
+        let due = self
+            .warnings
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .note(Instant::now());
+        if let Some(n) = due {
+            warn!(
+                %peer,
+                reason = ?limited.reason,
+                "web port: {n} refused since the last warning (limits: docs/SERVER.md, \
+                 \"The web port's limits\"; counts: ledge_web_refused_total)"
+            );
+        }
+    }
+
+    /// The answer to a refused request, counted.
+    fn refuse(&self, peer: SocketAddr, limited: Limited) -> Response {
+        self.refused(peer, limited);
+        refusal::limited_response(limited)
+    }
 }
 
 /// The routes.
@@ -106,11 +157,19 @@ fn text(status: StatusCode, body: String) -> Response {
     answer(status, "text/plain; charset=utf-8", body)
 }
 
-async fn index(State(state): State<Arc<WebState>>) -> Response {
+/// Who is asking: the peer and its connection's permit (put in each
+/// request's extensions by [`serve`]).
+#[derive(Debug, Clone)]
+struct Caller {
+    peer: SocketAddr,
+    permit: Arc<ConnectionPermit>,
+}
+
+async fn index(State(state): State<Arc<WebState>>, request: Request) -> Response {
     if let Some(missing) = state.root.missing() {
         return text(StatusCode::SERVICE_UNAVAILABLE, format!("{missing}\n"));
     }
-    file_response(&state, "index.html")
+    file_response(&state, &request, "index.html")
 }
 
 async fn file(State(state): State<Arc<WebState>>, request: Request) -> Response {
@@ -119,13 +178,74 @@ async fn file(State(state): State<Arc<WebState>>, request: Request) -> Response 
     if request.method() != axum::http::Method::GET && request.method() != axum::http::Method::HEAD {
         return text(StatusCode::METHOD_NOT_ALLOWED, "GET only\n".into());
     }
-    file_response(&state, name)
+    file_response(&state, &request, name)
 }
 
-fn file_response(state: &WebState, name: &str) -> Response {
+fn file_response(state: &WebState, request: &Request, name: &str) -> Response {
     match state.root.get(name) {
-        Some(f) => answer(StatusCode::OK, f.content_type, f.body.clone()),
+        Some(f) => download(state, request, f.content_type, &f.etag, f.body.clone()),
         None => text(StatusCode::NOT_FOUND, "not found\n".into()),
+    }
+}
+
+/// Whether `If-None-Match` names `etag` (or `*`): the client has it.
+fn not_modified(headers: &axum::http::HeaderMap, etag: &str) -> bool {
+    headers
+        .get_all(header::IF_NONE_MATCH)
+        .iter()
+        .filter_map(|v| v.to_str().ok())
+        .flat_map(|v| v.split(','))
+        .map(|tag| tag.trim().trim_start_matches("W/"))
+        .any(|tag| tag == "*" || tag == etag)
+}
+
+/// `body` with its entity tag: 304 when the client has it; a download
+/// (counted and paced, [`guard`]) when it is large.
+fn download(
+    state: &WebState,
+    request: &Request,
+    content_type: &str,
+    etag: &str,
+    body: Bytes,
+) -> Response {
+    let with_tag = |mut response: Response| {
+        if let Ok(value) = etag.parse() {
+            response.headers_mut().insert(header::ETAG, value);
+        }
+        response
+    };
+    if not_modified(request.headers(), etag) {
+        return with_tag(answer(
+            StatusCode::NOT_MODIFIED,
+            content_type,
+            axum::body::Body::empty(),
+        ));
+    }
+    let caller = request.extensions().get::<Caller>();
+    let (Some(caller), true) = (caller, body.len() >= PACED_FROM) else {
+        return with_tag(answer(StatusCode::OK, content_type, body));
+    };
+    match state.guard.download(&caller.permit, Instant::now()) {
+        Err(limited) => state.refuse(caller.peer, limited),
+        Ok(permit) => {
+            let class = AddressClass::of(caller.peer.ip());
+            let sent = state
+                .shared
+                .metrics
+                .web_download_bytes
+                .get_or_create(&AddressClassLabel { class })
+                .clone();
+            let len = body.len();
+            let mut response = answer(
+                StatusCode::OK,
+                content_type,
+                paced::paced_body(body, permit, sent),
+            );
+            response
+                .headers_mut()
+                .insert(header::CONTENT_LENGTH, len.into());
+            with_tag(response)
+        }
     }
 }
 
@@ -160,10 +280,13 @@ async fn web_json_route(State(state): State<Arc<WebState>>) -> Response {
     answer(StatusCode::OK, "application/json", doc.to_string())
 }
 
-async fn level(State(state): State<Arc<WebState>>) -> Response {
-    answer(
-        StatusCode::OK,
+async fn level(State(state): State<Arc<WebState>>, request: Request) -> Response {
+    let etag = format!("\"{}\"", state.level_hex);
+    download(
+        &state,
+        &request,
         "application/octet-stream",
+        &etag,
         state.level.clone(),
     )
 }
@@ -240,11 +363,97 @@ pub fn bind(addr: SocketAddr) -> std::io::Result<TcpListener> {
     crate::metrics::bind(addr)
 }
 
+/// Whether a request has a body (no route takes one).
+fn has_body(headers: &axum::http::HeaderMap) -> bool {
+    headers.contains_key(header::TRANSFER_ENCODING)
+        || headers
+            .get(header::CONTENT_LENGTH)
+            .is_some_and(|v| v.as_bytes() != b"0")
+}
+
+/// The checks every request passes before its route: its address's
+/// request rate, and no body.
+fn screen<B>(state: &WebState, caller: &Caller, request: &Request<B>) -> Result<(), Limited> {
+    state.guard.request(&caller.permit, Instant::now())?;
+    if has_body(request.headers()) {
+        return Err(Limited {
+            reason: WebRefusal::Body,
+            retry_after: Duration::ZERO,
+        });
+    }
+    Ok(())
+}
+
+/// Open HTTP connections, counted in the gauge until dropped.
+struct OpenConnection(prometheus_client::metrics::gauge::Gauge);
+
+impl OpenConnection {
+    fn new(gauge: &prometheus_client::metrics::gauge::Gauge) -> OpenConnection {
+        gauge.inc();
+        OpenConnection(gauge.clone())
+    }
+}
+
+impl Drop for OpenConnection {
+    fn drop(&mut self) {
+        self.0.dec();
+    }
+}
+
+/// Serves one HTTP connection (and hands a WebSocket upgrade over).
+async fn serve_connection(
+    stream: tokio::net::TcpStream,
+    caller: Caller,
+    router: Router,
+    state: Arc<WebState>,
+) {
+    let _open = OpenConnection::new(&state.shared.metrics.web_connections);
+    let peer = caller.peer;
+    let service = hyper::service::service_fn(move |mut request: Request<hyper::body::Incoming>| {
+        let (caller, state, mut router) = (caller.clone(), state.clone(), router.clone());
+        async move {
+            if let Err(limited) = screen(&state, &caller, &request) {
+                return Ok(state.refuse(caller.peer, limited));
+            }
+            request.extensions_mut().insert(ConnectInfo(caller.peer));
+            request.extensions_mut().insert(caller);
+            tower_service::Service::call(&mut router, request).await
+        }
+    });
+    let connection = hyper::server::conn::http1::Builder::new()
+        .timer(TokioTimer::new())
+        .header_read_timeout(HEADER_TIMEOUT)
+        .max_buf_size(MAX_REQUEST_BUFFER)
+        .serve_connection(TokioIo::new(stream), service)
+        .with_upgrades();
+    match tokio::time::timeout(REQUEST_TIMEOUT, connection).await {
+        Ok(Ok(())) => {}
+        Ok(Err(e)) => debug!(%peer, "web request: {e}"),
+        Err(_) => debug!(%peer, "web request timed out"),
+    }
+}
+
+/// Every second until `stop`: forgets the addresses that went idle and
+/// shows how many are left (`ledge_web_addresses`).
+async fn forget_idle_addresses(state: Arc<WebState>, mut stop: watch::Receiver<bool>) {
+    let mut every = tokio::time::interval(Duration::from_secs(1));
+    loop {
+        tokio::select! {
+            () = crate::shutdown::stopped(&mut stop) => return,
+            _ = every.tick() => {}
+        }
+        let addresses = state.guard.addresses(Instant::now());
+        state.shared.metrics.web_addresses.set(addresses as i64);
+    }
+}
+
 /// Serves the web port until `stop`.
 pub async fn serve(listener: TcpListener, state: Arc<WebState>, mut stop: watch::Receiver<bool>) {
-    let router = router(state);
+    let router = router(state.clone());
     let slots = Arc::new(Semaphore::new(MAX_HTTP_CONNECTIONS));
+    let refusals = Arc::new(Semaphore::new(MAX_REFUSALS_AT_ONCE));
     let mut connections = JoinSet::new();
+    connections.spawn(forget_idle_addresses(state.clone(), stop.clone()));
     loop {
         let permit = tokio::select! {
             () = crate::shutdown::stopped(&mut stop) => break,
@@ -265,27 +474,30 @@ pub async fn serve(listener: TcpListener, state: Arc<WebState>, mut stop: watch:
                 }
             },
         };
-        let router = router.clone();
-        connections.spawn(async move {
-            let _permit = permit;
-            let service =
-                hyper::service::service_fn(move |mut request: Request<hyper::body::Incoming>| {
-                    request.extensions_mut().insert(ConnectInfo(peer));
-                    let mut router = router.clone();
-                    async move { tower_service::Service::call(&mut router, request).await }
+        match state.guard.connect(peer.ip(), Instant::now()) {
+            Ok(conn) => {
+                let caller = Caller {
+                    peer,
+                    permit: Arc::new(conn),
+                };
+                let (router, state) = (router.clone(), state.clone());
+                connections.spawn(async move {
+                    let _permit = permit;
+                    serve_connection(stream, caller, router, state).await;
                 });
-            let connection = hyper::server::conn::http1::Builder::new()
-                .timer(TokioTimer::new())
-                .header_read_timeout(HEADER_TIMEOUT)
-                .max_buf_size(MAX_REQUEST_BUFFER)
-                .serve_connection(TokioIo::new(stream), service)
-                .with_upgrades();
-            match tokio::time::timeout(REQUEST_TIMEOUT, connection).await {
-                Ok(Ok(())) => {}
-                Ok(Err(e)) => debug!(%peer, "web request: {e}"),
-                Err(_) => debug!(%peer, "web request timed out"),
             }
-        });
+            Err(limited) => {
+                drop(permit);
+                state.refused(peer, limited);
+                // Past the answering cap the connection just closes.
+                if let Ok(slot) = refusals.clone().try_acquire_owned() {
+                    connections.spawn(async move {
+                        let _slot = slot;
+                        refusal::refuse_connection(stream, limited).await;
+                    });
+                }
+            }
+        }
     }
     connections.shutdown().await;
 }

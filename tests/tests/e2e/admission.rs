@@ -9,7 +9,7 @@
 //! run one at a time.
 
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -18,10 +18,10 @@ use ledge_client::net::session::{handshake, JoinOptions};
 use ledge_client::net::transport::{dial_from, endpoint};
 use ledge_server::admission::AdmissionConfig;
 use ledge_shared::protocol::{write_frame, ALPN};
+use ledge_tests::attack::Attack;
 use ledge_tests::e2e::{assert_steady, bot_options, spawn_bot, task_panics, TickProbe};
 use ledge_tests::{metric, TestServer};
 use tokio::sync::{Mutex, MutexGuard};
-use tokio::task::JoinSet;
 
 /// Where the honest client connects from.
 const HONEST: Ipv4Addr = Ipv4Addr::new(127, 0, 0, 2);
@@ -48,66 +48,19 @@ fn refused(server: &TestServer, reason: &str) -> f64 {
     )
 }
 
-/// Attack tasks and their shared stop flag and counters. They run on a
-/// runtime of their own (one thread), as an attacker runs on a machine of
-/// its own: they never hold up the server's tasks in the test's runtime.
-struct Attack {
-    runtime: Option<tokio::runtime::Runtime>,
-    tasks: JoinSet<()>,
-    stop: Arc<AtomicBool>,
-    /// Connections (or handshakes) the attackers got through.
-    opened: Arc<AtomicU64>,
-    /// Attempts that failed (refused, closed).
-    failed: Arc<AtomicU64>,
+/// The QUIC port's attacks, as tasks of an [`Attack`].
+trait QuicAttacks {
+    fn silent(&mut self, server: &TestServer, from: IpAddr, count: usize, one_socket: bool);
+    fn slowloris(&mut self, server: &TestServer, from: IpAddr, count: usize);
+    fn half_open(&mut self, server: &TestServer, from: IpAddr, per_second: u32);
 }
 
-impl Attack {
-    fn new() -> Attack {
-        Attack {
-            runtime: Some(
-                tokio::runtime::Builder::new_multi_thread()
-                    .worker_threads(1)
-                    .enable_all()
-                    .build()
-                    .expect("attacker runtime"),
-            ),
-            tasks: JoinSet::new(),
-            stop: Arc::default(),
-            opened: Arc::default(),
-            failed: Arc::default(),
-        }
-    }
-
-    fn spawn(&mut self, task: impl std::future::Future<Output = ()> + Send + 'static) {
-        let runtime = self.runtime.as_ref().expect("attack running");
-        self.tasks.spawn_on(task, runtime.handle());
-    }
-
-    /// Stops every task and waits for them.
-    async fn stop(mut self) -> (u64, u64) {
-        self.stop.store(true, Ordering::SeqCst);
-        while let Some(done) = self.tasks.join_next().await {
-            done.expect("attack task");
-        }
-        if let Some(runtime) = self.runtime.take() {
-            runtime.shutdown_background();
-        }
-        (
-            self.opened.load(Ordering::SeqCst),
-            self.failed.load(Ordering::SeqCst),
-        )
-    }
-
+impl QuicAttacks for Attack {
     /// `count` tasks from `from` (one socket each when `one_socket` is
     /// false) that complete the QUIC handshake, then never send a hello,
     /// and reconnect as soon as the server drops them.
     fn silent(&mut self, server: &TestServer, from: IpAddr, count: usize, one_socket: bool) {
-        let attacker = self
-            .runtime
-            .as_ref()
-            .expect("attack running")
-            .handle()
-            .clone();
+        let attacker = self.handle();
         let _attacker = attacker.enter();
         let shared = one_socket.then(|| {
             endpoint(SocketAddr::new(from, 0), Some(server.fingerprint)).expect("attacker binds")

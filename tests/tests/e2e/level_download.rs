@@ -172,7 +172,7 @@ async fn a_cut_download_resumes_and_a_tampered_one_is_refused() {
 
 /// Writes a map whose tileset image is `side` x `side` pixels of noise
 /// (which no PNG compresses): `side * side * 4` bytes of image.
-fn noisy_map(dir: &Path, side: u32) -> PathBuf {
+pub(crate) fn noisy_map(dir: &Path, side: u32) -> PathBuf {
     let mut pixels = Vec::with_capacity((side * side * 4) as usize);
     let mut x = 0x2545_f491_4f6c_dd1du64;
     for _ in 0..side * side * 4 {

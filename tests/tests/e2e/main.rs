@@ -31,5 +31,6 @@ mod roster;
 mod seats;
 mod stall;
 mod trust;
+mod web_hostile;
 mod web_transports;
 mod wire_budget;

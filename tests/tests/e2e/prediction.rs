@@ -4,6 +4,7 @@
 
 use std::time::{Duration, Instant};
 
+use ledge_client::bot::brain::drill;
 use ledge_client::game::predict::BLEND_KEEP;
 use ledge_client::view::Vec2;
 use ledge_client::ClientGame;
@@ -11,22 +12,11 @@ use ledge_shared::input::Buttons;
 use ledge_tests::e2e::{assert_steady, TickProbe};
 use ledge_tests::{starvation, PredictedClient, TestServer};
 
-/// A varied script: runs, jumps, turns, stands (around the spawn, the crate
-/// and the elevator), repeating every 4 seconds.
-fn script(tick: u64) -> Buttons {
-    let t = tick % 240;
-    let b = match t {
-        0..=49 => Buttons::RIGHT,
-        50..=70 => Buttons::RIGHT | Buttons::JUMP,
-        71..=100 => Buttons::RIGHT,
-        101..=110 => 0,
-        111..=160 => Buttons::LEFT,
-        161..=175 => Buttons::LEFT | Buttons::JUMP,
-        176..=200 => Buttons::LEFT,
-        201..=205 => Buttons::JUMP,
-        _ => 0,
-    };
-    Buttons(b)
+fn late_inputs(server: &TestServer) -> f64 {
+    ledge_tests::metric(
+        &server.metrics(),
+        "ledge_dropped_messages_total{reason=\"InputLate\"}",
+    )
 }
 
 /// Clients playing at once in the exactness test.
@@ -57,7 +47,7 @@ async fn unimpaired_clients_predict_the_server_exactly_for_sixty_seconds() {
             let me = c.game.me();
             c.run(
                 warm_up,
-                |_, tick| (script(tick + offset), true),
+                |_, tick| (drill(tick + offset), true),
                 |_, _, _| {},
             )
             .await;
@@ -66,7 +56,7 @@ async fn unimpaired_clients_predict_the_server_exactly_for_sixty_seconds() {
             let snapshots_before = c.snapshots;
             c.run(
                 until,
-                |_, tick| (script(tick + offset), true),
+                |_, tick| (drill(tick + offset), true),
                 |_, update, r| {
                     if let Some(e) = update.state.get(me.0) {
                         min_x = min_x.min(e.pos.x);
@@ -81,6 +71,7 @@ async fn unimpaired_clients_predict_the_server_exactly_for_sixty_seconds() {
     }
     tokio::time::sleep_until(warm_up.into()).await;
     let starved_before = starvation(&server, "room-1");
+    let late_before = late_inputs(&server);
     let ticks_before = TickProbe::read(&server, "room-1");
     let mut results = Vec::new();
     for t in tasks {
@@ -88,9 +79,10 @@ async fn unimpaired_clients_predict_the_server_exactly_for_sixty_seconds() {
     }
     let ticks_after = TickProbe::read(&server, "room-1");
     let starved = starvation(&server, "room-1") - starved_before;
+    let late = late_inputs(&server) - late_before;
     let rate = ticks_before.rate_until(&ticks_after);
     eprintln!(
-        "{CLIENTS} clients for {:?}: server at {rate:.2} Hz, starved {starved}",
+        "{CLIENTS} clients for {:?}: server at {rate:.2} Hz, starved {starved}, late {late}",
         started.elapsed()
     );
     let mut failures = Vec::new();
@@ -123,7 +115,10 @@ async fn unimpaired_clients_predict_the_server_exactly_for_sixty_seconds() {
         );
         assert!(*moved > 40 * 256, "the player moved");
         if stats.mispredictions != 0 || stats.corrections != 0 || net.corrections != 0 {
-            failures.push(format!("{stats:?}"));
+            failures.push(format!(
+                "{stats:?}, the last: {:?}",
+                c.game.predictor().last_mismatch()
+            ));
         }
     }
     assert_eq!(starved, 0.0, "inputs arrived late: timing was not exact");

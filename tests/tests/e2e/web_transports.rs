@@ -22,7 +22,7 @@ use ledge_tests::{drain, ids, metric, next_snapshot, snapshot_where, TestServer,
 use tokio_tungstenite::tungstenite::Message as WsMessage;
 
 /// A page directory with an `index.html` and a script.
-fn page() -> tempfile::TempDir {
+pub(crate) fn page() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("index.html"), "<h1>ledge</h1>").unwrap();
     std::fs::write(dir.path().join("app.js"), "console.log(1)").unwrap();
@@ -31,7 +31,7 @@ fn page() -> tempfile::TempDir {
 
 /// A server with the web port (and WebTransport) on loopback, serving
 /// `root`.
-async fn web_server(
+pub(crate) async fn web_server(
     root: &std::path::Path,
     adjust: impl FnOnce(&mut ledge_server::ServerConfig),
 ) -> TestServer {
