@@ -18,6 +18,7 @@ use ledge_shared::game::{GameConfig, MAX_RESPAWN_DELAY_TICKS};
 
 use crate::admission::AdmissionConfig;
 use crate::fleet::FleetConfig;
+use crate::records::RecordsTarget;
 use crate::web::guard::{mbps_to_bytes, WebLimits, DEFAULT_ADDRESS_SHARE};
 
 /// Default UDP address the server listens on.
@@ -178,6 +179,9 @@ pub struct ServerConfig {
     /// Browsers: the web port and WebTransport (`--web-bind`); `None`
     /// (the default): no web port.
     pub web: Option<WebConfig>,
+    /// Where finished runs are stored (`--records`); `None` (the
+    /// default): [`crate::records::DEFAULT_FILE`] in `cert_dir`.
+    pub records: Option<RecordsTarget>,
 }
 
 /// Where browsers connect (docs/SERVER.md, "Browsers").
@@ -237,11 +241,20 @@ impl Default for ServerConfig {
             record_ticks: None,
             agones: None,
             web: None,
+            records: None,
         }
     }
 }
 
 impl ServerConfig {
+    /// Where the records go: `--records`, or the default file in the
+    /// certificate directory.
+    pub fn records_target(&self) -> RecordsTarget {
+        self.records
+            .clone()
+            .unwrap_or_else(|| RecordsTarget::in_state_dir(&self.cert_dir))
+    }
+
     /// The game's configuration: the defaults with this server's respawn
     /// delay in ticks.
     pub fn game_config(&self) -> GameConfig {
@@ -503,6 +516,11 @@ pub struct Cli {
     /// No WebTransport: browsers use WebSocket only.
     #[arg(long)]
     pub no_webtransport: bool,
+    /// Where finished runs are stored: an SQLite file (created if
+    /// missing), a postgres:// URL (a fleet sharing one store), or `off`
+    /// [default: records.sqlite in --cert-dir].
+    #[arg(long, value_name = "PATH|URL|off")]
+    pub records: Option<String>,
     /// The host's upload budget for the web port's downloads (the page,
     /// the level), Mbit/s, all addresses together [default: 100].
     #[arg(long, value_name = "MBPS")]
@@ -551,6 +569,8 @@ struct FileConfig {
     /// `false`: as `--no-webtransport`.
     webtransport: Option<bool>,
     web_limits: Option<FileWebLimits>,
+    /// As `--records`.
+    records: Option<String>,
 }
 
 /// The file's `[web_limits]`: every key optional (docs/SERVER.md).
@@ -752,6 +772,15 @@ impl Cli {
                 _ => Some(wt_bind.unwrap_or(bind)),
             };
             c.web = Some(web);
+        }
+        if let Some(r) = self.records.as_deref().or(file.records.as_deref()) {
+            c.records = Some(match RecordsTarget::parse(r) {
+                // A relative file in the configuration file is relative to it.
+                RecordsTarget::Sqlite(p) if self.records.is_none() => {
+                    RecordsTarget::Sqlite(relative(p))
+                }
+                target => target,
+            });
         }
         c.validate()?;
         Ok(c)

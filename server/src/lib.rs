@@ -60,6 +60,7 @@ pub mod metrics;
 pub mod quic_cert;
 pub mod ratelimit;
 pub mod record;
+pub mod records;
 pub mod room;
 pub mod room_logic;
 pub mod room_registry;

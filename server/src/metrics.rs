@@ -246,6 +246,13 @@ pub struct Metrics {
     /// Bytes of downloads (the level, the page's larger files) sent by the
     /// web port, by the class of the address they went to.
     pub web_download_bytes: Family<AddressClassLabel, Counter>,
+    /// Finished runs stored in the records.
+    pub records_stored: Counter,
+    /// Finished runs not stored (records off or failing, queue full).
+    pub records_failed: Counter,
+    /// Time to store a batch of runs (first try to commit), in fine
+    /// buckets.
+    pub records_write_seconds: Histogram,
     /// Bytes received per client.
     pub client_bytes_in: Family<ClientLabel, Counter>,
     /// Bytes sent per client.
@@ -350,6 +357,9 @@ impl Metrics {
             web_addresses: Gauge::default(),
             web_refused: Family::default(),
             web_download_bytes: Family::default(),
+            records_stored: Counter::default(),
+            records_failed: Counter::default(),
+            records_write_seconds: Histogram::new(fine_buckets()),
             client_bytes_in: Family::default(),
             client_bytes_out: Family::default(),
             bytes_in: Family::default(),
@@ -443,6 +453,21 @@ impl Metrics {
             "web_download_bytes",
             "Bytes of downloads sent by the web port, by address class",
             self.web_download_bytes.clone(),
+        );
+        r.register(
+            "records_stored",
+            "Finished runs stored in the records",
+            self.records_stored.clone(),
+        );
+        r.register(
+            "records_failed",
+            "Finished runs not stored in the records",
+            self.records_failed.clone(),
+        );
+        r.register(
+            "records_write_seconds",
+            "Time to store a batch of finished runs, first try to commit",
+            self.records_write_seconds.clone(),
         );
         r.register(
             "retries",

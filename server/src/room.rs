@@ -17,7 +17,10 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use ledge_shared::game::Game;
-use ledge_shared::protocol::{CloseCode, Outgoing, PlayerId, RejectReason};
+use ledge_shared::protocol::{
+    clip_text, write_frame, CloseCode, Outgoing, PlayerId, RejectReason, ServerControl, Standing,
+    MAX_REASON_LEN,
+};
 use prometheus_client::metrics::counter::Counter;
 use prometheus_client::metrics::gauge::Gauge;
 use prometheus_client::metrics::histogram::Histogram;
@@ -225,6 +228,31 @@ pub fn spawn(
         status,
     };
     (handle, tokio::spawn(room.run()))
+}
+
+/// Milliseconds since the Unix epoch (0 if the clock is before it).
+fn unix_millis() -> i64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| i64::try_from(d.as_millis()).unwrap_or(i64::MAX))
+}
+
+/// Queues where a player's run stands (or why it was not recorded) on its
+/// control stream; a full queue drops it (the run is stored all the same).
+fn tell_standing(control: &mpsc::Sender<Outbound>, result: Result<Standing, String>) {
+    let message = match result {
+        Ok(standing) => ServerControl::RunRecorded(standing),
+        Err(reason) => ServerControl::RunNotRecorded {
+            reason: clip_text(&reason, MAX_REASON_LEN),
+        },
+    };
+    let mut frame = Vec::new();
+    match write_frame(&message, &mut frame) {
+        Ok(()) => {
+            let _ = control.try_send(Outbound::Frame(frame));
+        }
+        Err(e) => warn!("a run's standing could not be encoded: {e}"),
+    }
 }
 
 /// Counts a snapshot datagram sent to a client.
@@ -514,6 +542,18 @@ impl Room {
                 }
                 Action::Left(id) => {
                     self.peers.remove(&id);
+                }
+                Action::RunFinished { to, mut run } => {
+                    run.finished_at_ms = unix_millis();
+                    let control = self.peers.get(&to).map(|p| p.link.control.clone());
+                    self.logic.config().records.submit(
+                        run,
+                        Box::new(move |result| {
+                            if let Some(control) = control {
+                                tell_standing(&control, result);
+                            }
+                        }),
+                    );
                 }
             }
         }

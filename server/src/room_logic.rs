@@ -27,7 +27,7 @@ use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-use ledge_shared::game::Game;
+use ledge_shared::game::{Game, GameEvent};
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
     encode_sim_config, name_key, write_frame, InputPacket, LevelOffer, NetTiming, NoticeKind,
@@ -40,6 +40,7 @@ use tracing::{error, info, warn};
 use crate::inputs::{InputBuffer, Received};
 use crate::metrics::{DropReason, KickLabel, KickReason, Metrics, RoomLabel, SnapshotKind};
 use crate::record::Recorder;
+use crate::records::{FinishedRun, RecordsHandle};
 use crate::snapshots::RoomSnapshots;
 use crate::tls::DATAGRAM_SEND_BUFFER;
 
@@ -83,6 +84,11 @@ pub struct RoomConfig {
     /// A player sending no input for this long is removed (half of it
     /// while the room is full).
     pub idle_kick: Duration,
+    /// This server's instance (random at start): with the room, player
+    /// and tick, the key of a finished run in the records.
+    pub instance: String,
+    /// Where finished runs go ([`crate::records`]).
+    pub records: RecordsHandle,
 }
 
 /// The room's progress, published after every tick.
@@ -213,6 +219,14 @@ pub enum Action {
     },
     /// The player has left the room: its connection is the room's no more.
     Left(PlayerId),
+    /// A player's run finished: store it in the records and tell the
+    /// player where it stands.
+    RunFinished {
+        /// The player.
+        to: PlayerId,
+        /// The run (its finishing time still 0: the I/O side sets it).
+        run: FinishedRun,
+    },
 }
 
 /// A player in the room.
@@ -467,6 +481,7 @@ impl RoomLogic {
         self.take_inputs(tick);
         self.remove_idle(tick);
         self.game.step(&self.inputs);
+        self.collect_finished(tick);
         if let Some(r) = &self.config.record {
             r.tick(tick, &self.inputs, || self.game.state_hash());
         }
@@ -480,6 +495,38 @@ impl RoomLogic {
         let interval = u64::from(self.config.snapshot_interval.max(1));
         if self.game.tick() % interval == 0 && !self.members.is_empty() {
             self.send_snapshots(now, &datagram_size);
+        }
+    }
+
+    /// Hands each run that finished in `tick` to the records.
+    fn collect_finished(&mut self, tick: u64) {
+        for event in self.game.events() {
+            let GameEvent::Finished {
+                player,
+                ticks,
+                place,
+            } = *event
+            else {
+                continue;
+            };
+            let Some(m) = self.members.get(&player) else {
+                continue;
+            };
+            let view = self.game.player(player);
+            let c = &self.config;
+            let run = FinishedRun {
+                key: format!("{}/{}/{}/{tick}", c.instance, c.name, player.0),
+                level_hash: c.level.hex(),
+                level_name: self.game.level_name().to_owned(),
+                player: m.name.clone(),
+                ticks,
+                tick_rate: c.tick_rate,
+                deaths: view.as_ref().map_or(0, |v| v.deaths),
+                coins: view.as_ref().map_or(0, |v| v.coins),
+                place,
+                finished_at_ms: 0,
+            };
+            self.actions.push(Action::RunFinished { to: player, run });
         }
     }
 
@@ -760,6 +807,8 @@ mod tests {
             level: LevelOffer::default(),
             record: None,
             idle_kick: Duration::from_secs(30),
+            instance: "test".into(),
+            records: RecordsHandle::default(),
         }
     }
 

@@ -235,6 +235,8 @@ mod tests {
             level: Default::default(),
             record: None,
             idle_kick: std::time::Duration::from_secs(30),
+            instance: "test".into(),
+            records: Default::default(),
         };
         let (metrics, _registry) = Metrics::new();
         Rooms::new(game, template, max_rooms, metrics)

@@ -25,6 +25,8 @@ use crate::link::Incoming;
 use crate::metrics::{self, Metrics};
 use crate::quic_cert::{CertError, Identity};
 use crate::record::Recorder;
+use crate::records::writer::WriterMetrics;
+use crate::records::{RecordStore, RecordsHandle};
 use crate::room_logic::RoomConfig;
 use crate::room_registry::Rooms;
 use crate::sessions::Sessions;
@@ -502,7 +504,15 @@ impl Server {
             ..
         } = self;
         let mut stop = shutdown.subscribe();
-        let rooms = open_rooms(&config, &level, level_offer, &recorders, metrics.clone())?;
+        let (records, records_task) = open_records(&config, &metrics).await;
+        let rooms = open_rooms(
+            &config,
+            &level,
+            level_offer,
+            &recorders,
+            metrics.clone(),
+            records.clone(),
+        )?;
         let metrics_task = metrics_listener.map(|(listener, addr)| {
             info!(%addr, "serving metrics at /metrics");
             tokio::spawn(metrics::serve(listener, registry, stop.clone()))
@@ -516,6 +526,7 @@ impl Server {
             next_player: AtomicU32::new(1),
             admission: Admission::new(config.admission, config.max_connections),
             shutdown: stop.clone(),
+            records,
         });
         #[cfg(feature = "agones")]
         let agones_task = join_fleet(&config, fingerprint, &shared, &stop, &shutdown).await?;
@@ -554,12 +565,69 @@ impl Server {
             let _ = tokio::task::spawn_blocking(move || thread.join()).await;
         }
         stop_rooms(serving.shared).await;
+        if let Some(task) = records_task {
+            // Every room is gone, so the writer stores what is queued and
+            // ends.
+            if tokio::time::timeout(RECORDS_GRACE, task).await.is_err() {
+                warn!("records still being written after {RECORDS_GRACE:?}; stopping anyway");
+            }
+        }
         if let Some(task) = metrics_task {
             let _ = task.await;
         }
         drop(shutdown);
         info!("stopped");
         Ok(())
+    }
+}
+
+/// A random id of this server's run (hex), unique enough that finished
+/// runs of two servers, or of one server before and after a restart, never
+/// share a key.
+fn instance_id() -> String {
+    let mut bytes = [0u8; 12];
+    if ring::rand::SecureRandom::fill(&ring::rand::SystemRandom::new(), &mut bytes).is_err() {
+        // No system randomness: the time keeps restarts apart.
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        bytes.copy_from_slice(&nanos.to_le_bytes()[..12]);
+    }
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// How long shutdown waits for the records writer to store what is queued.
+pub const RECORDS_GRACE: Duration = Duration::from_secs(10);
+
+/// Opens the records (`--records`) and starts their writer; if they cannot
+/// be opened, says so and plays on without them.
+async fn open_records(
+    config: &ServerConfig,
+    metrics: &Metrics,
+) -> (RecordsHandle, Option<tokio::task::JoinHandle<()>>) {
+    let target = config.records_target();
+    match RecordStore::open(&target).await {
+        Ok(Some(store)) => {
+            info!(records = %store.target(), "storing finished runs");
+            let writer = WriterMetrics {
+                stored: metrics.records_stored.clone(),
+                failed: metrics.records_failed.clone(),
+                write_seconds: Some(metrics.records_write_seconds.clone()),
+            };
+            let (handle, task) = RecordsHandle::spawn(store, writer);
+            (handle, Some(task))
+        }
+        Ok(None) => {
+            info!("records are off (--records off): finished runs are not stored");
+            (RecordsHandle::off("this server keeps no records"), None)
+        }
+        Err(e) => {
+            error!("{e}");
+            (
+                RecordsHandle::off("the server's records database could not be opened"),
+                None,
+            )
+        }
     }
 }
 
@@ -571,6 +639,7 @@ fn open_rooms(
     level_offer: LevelOffer,
     recorders: &[Recorder],
     metrics: Arc<Metrics>,
+    records: RecordsHandle,
 ) -> Result<Rooms, ServerError> {
     let template = RoomConfig {
         name: String::new(),
@@ -586,6 +655,8 @@ fn open_rooms(
         level: level_offer,
         record: None,
         idle_kick: config.idle_kick,
+        instance: instance_id(),
+        records,
     };
     let rooms = Rooms::new(
         Game::with_config(level, config.game_config())?,

@@ -14,6 +14,7 @@ use tokio::sync::watch;
 use crate::admission::Admission;
 use crate::config::Limits;
 use crate::metrics::Metrics;
+use crate::records::RecordsHandle;
 use crate::room_registry::Rooms;
 use crate::sessions::Sessions;
 
@@ -37,4 +38,7 @@ pub struct Shared {
     pub admission: Arc<Admission>,
     /// Turns true when the server shuts down.
     pub shutdown: watch::Receiver<bool>,
+    /// The records: where rooms send finished runs, and what the web port
+    /// reads.
+    pub records: RecordsHandle,
 }

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use ledge_shared::game::state::player_flags;
 use ledge_shared::game::RUN_ID_BASE;
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::{NoticeKind, PlayerId};
+use ledge_shared::protocol::{NoticeKind, PlayerId, Standing};
 
 use super::brain::Brain;
 use crate::game::ClientGame;
@@ -25,6 +25,9 @@ const TRANSPORT_EVERY: Duration = Duration::from_millis(250);
 /// done: the server runs the ticks we predicted a few ticks later, and
 /// leaving at once could remove our player before it gets there.
 pub const LINGER: Duration = Duration::from_millis(500);
+/// With `stop_when_done`, how long at most a bot that reached the goal
+/// waits for the server to say its run is recorded.
+pub const RECORD_WAIT: Duration = Duration::from_secs(3);
 
 /// How a bot plays.
 #[derive(Debug, Clone)]
@@ -96,6 +99,9 @@ pub struct BotReport {
     /// The run's time in ticks at its first finish, as the server's run
     /// record said.
     pub finish_ticks: Option<u32>,
+    /// Where its finished run stands in the server's records (`Err`: why
+    /// it was not recorded), once the server said.
+    pub standing: Option<Result<Standing, String>>,
     /// The brain's progress note.
     pub progress: String,
     /// Why it stopped early (connection refused, closed by the server...).
@@ -237,13 +243,21 @@ pub async fn run_bot(
     let mut deadline = started + options.duration;
     let mut next_transport = started;
     let mut lingering = false;
+    let mut linger_started = Instant::now();
     let ended = loop {
         let now = Instant::now();
         if options.stop_when_done && brain.done() && !lingering {
             lingering = true;
+            linger_started = now;
             deadline = deadline.min(now + LINGER);
         }
-        if now >= deadline {
+        // A bot at the goal waits a little longer for its record.
+        let until = if lingering && report.won && report.standing.is_none() {
+            deadline.max(linger_started + RECORD_WAIT)
+        } else {
+            deadline
+        };
+        if now >= until {
             break None;
         }
         if now >= next_transport {
@@ -266,7 +280,7 @@ pub async fn run_bot(
         let wait = game
             .clock()
             .until_next_tick(Instant::now())
-            .min(deadline.saturating_duration_since(Instant::now()));
+            .min(until.saturating_duration_since(Instant::now()));
         let event = tokio::select! {
             event = session.recv() => event,
             () = tokio::time::sleep(wait) => continue,
@@ -294,6 +308,7 @@ pub async fn run_bot(
                 }
             }
             Ok(SessionEvent::Pong { rtt: Some(rtt), .. }) => game.on_rtt(rtt),
+            Ok(SessionEvent::RunRecorded(standing)) => report.standing = Some(standing),
             Ok(SessionEvent::Notice(NoticeKind::Kick { reason })) => {
                 break Some(format!("kicked: {reason}"))
             }

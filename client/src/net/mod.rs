@@ -51,7 +51,7 @@ use std::time::Duration;
 
 use ledge_levels::LevelBundle;
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::{NoticeKind, PlayerId, Welcome};
+use ledge_shared::protocol::{NoticeKind, PlayerId, Standing, Welcome};
 
 use crate::net::download::Fetched;
 use crate::net::session::{SessionEvent, SnapshotUpdate};
@@ -116,6 +116,9 @@ pub enum NetEvent {
         /// Its id.
         id: PlayerId,
     },
+    /// Our finished run is in the server's records (`Ok`: where it stands),
+    /// or why not (`Err`).
+    RunRecorded(Result<Standing, String>),
     /// Connecting failed; the thread has ended.
     Failed(String),
     /// Connecting failed because the server's certificate is not the one
@@ -145,6 +148,7 @@ impl NetEvent {
             SessionEvent::Pong { rtt: None, .. } => return None,
             SessionEvent::PlayerJoined { id, name } => NetEvent::PlayerJoined { id, name },
             SessionEvent::PlayerLeft { id, .. } => NetEvent::PlayerLeft { id },
+            SessionEvent::RunRecorded(r) => NetEvent::RunRecorded(r),
         })
     }
 }
@@ -201,7 +205,8 @@ impl NetStatus {
                 | NetEvent::Chat { .. }
                 | NetEvent::Notice(_)
                 | NetEvent::PlayerJoined { .. }
-                | NetEvent::PlayerLeft { .. },
+                | NetEvent::PlayerLeft { .. }
+                | NetEvent::RunRecorded(_),
             ) => status,
             (_, NetEvent::Failed(reason) | NetEvent::Untrusted(reason)) => {
                 NetStatus::Failed(reason)

@@ -35,7 +35,7 @@ use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
 #[cfg(not(target_arch = "wasm32"))]
 use ledge_shared::protocol::Fingerprint;
-use ledge_shared::protocol::{NoticeKind, PlayerId, StateSnapshot};
+use ledge_shared::protocol::{NoticeKind, PlayerId, Standing, StateSnapshot};
 
 use crate::game::ClientGame;
 #[cfg(not(target_arch = "wasm32"))]
@@ -118,6 +118,9 @@ pub struct OnlineGame<
     fetched: Option<Fetched>,
     /// The newest authoritative state.
     latest: Option<StateSnapshot>,
+    /// Where our last finished run stands in the server's records, or why
+    /// it was not recorded.
+    standing: Option<Result<Standing, String>>,
     /// Snapshots arrived since the last [`OnlineGame::take_arrivals`].
     arrivals: u32,
     /// When the last snapshot (or the welcome) arrived.
@@ -194,6 +197,7 @@ impl<N: Network> OnlineGame<N> {
             bundle: None,
             fetched: None,
             latest: None,
+            standing: None,
             arrivals: 0,
             last_news: None,
             fresh: false,
@@ -313,6 +317,7 @@ impl<N: Network> OnlineGame<N> {
                     game.on_player_left(*id);
                 }
             }
+            NetEvent::RunRecorded(r) => self.standing = Some(r.clone()),
             NetEvent::Untrusted(reason) => self.untrusted = Some(reason.clone()),
             NetEvent::Failed(_)
             | NetEvent::Disconnected(_)
@@ -320,6 +325,12 @@ impl<N: Network> OnlineGame<N> {
             | NetEvent::LevelProgress { .. }
             | NetEvent::Level(..) => {}
         }
+    }
+
+    /// Where our last finished run stands in the server's records (`Err`:
+    /// why it was not recorded), once the server said.
+    pub fn standing(&self) -> Option<&Result<Standing, String>> {
+        self.standing.as_ref()
     }
 
     /// What to draw, once the server welcomed us and we have its level.

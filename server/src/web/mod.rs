@@ -19,7 +19,9 @@
 pub mod files;
 pub mod guard;
 pub mod paced;
+pub mod records_pages;
 pub mod refusal;
+pub mod respond;
 pub mod webtransport_cert;
 pub mod webtransport_endpoint;
 
@@ -28,7 +30,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use axum::extract::ws::WebSocketUpgrade;
-use axum::extract::{ConnectInfo, Request, State};
+use axum::extract::{ConnectInfo, Path, Request, State};
 use axum::http::{header, StatusCode};
 use axum::response::Response;
 use axum::routing::get;
@@ -50,6 +52,7 @@ use crate::ratelimit::Throttle;
 use crate::shared::Shared;
 use files::WebRoot;
 use guard::{ConnectionPermit, Limited, WebGuard, WebRefusal, PACED_FROM};
+use respond::{answer, text};
 use webtransport_endpoint::WebCerts;
 
 /// Most HTTP connections served at once.
@@ -132,29 +135,27 @@ fn router(state: Arc<WebState>) -> Router {
         .route("/", get(index))
         .route("/web.json", get(web_json_route))
         .route("/level", get(level))
+        .route(
+            "/records",
+            get(|State(s): State<Arc<WebState>>, request: Request| async move {
+                let html = records_pages::wants_html(&request);
+                drop(request);
+                records_pages::levels(s.shared.records.store(), html).await
+            }),
+        )
+        .route(
+            "/records/:level",
+            get(
+                |State(s): State<Arc<WebState>>, Path(level): Path<String>, request: Request| async move {
+                    let query = request.uri().query().map(str::to_owned);
+                    drop(request);
+                    records_pages::level(s.shared.records.store(), &level, query.as_deref()).await
+                },
+            ),
+        )
         .route("/ws", get(websocket))
         .fallback(file)
         .with_state(state)
-}
-
-/// A response with a body, its type, and no caching (the page changes
-/// with the server).
-fn answer(status: StatusCode, content_type: &str, body: impl Into<axum::body::Body>) -> Response {
-    let mut response = Response::new(body.into());
-    *response.status_mut() = status;
-    let headers = response.headers_mut();
-    if let Ok(value) = content_type.parse() {
-        headers.insert(header::CONTENT_TYPE, value);
-    }
-    headers.insert(
-        header::CACHE_CONTROL,
-        header::HeaderValue::from_static("no-cache"),
-    );
-    response
-}
-
-fn text(status: StatusCode, body: String) -> Response {
-    answer(status, "text/plain; charset=utf-8", body)
 }
 
 /// Who is asking: the peer and its connection's permit (put in each

@@ -24,6 +24,9 @@ pub const MAX_SIM_CONFIG_LEN: usize = 4096;
 /// store. A full roster is at most about 10 KiB (checked at compile time).
 pub const MAX_ROSTER: usize = 256;
 
+/// Most runs one [`Standing::top`] lists: a level's top ten.
+pub const MAX_TOP: usize = 10;
+
 /// Most rooms one [`ServerControl::Rooms`] lists, and so most rooms a
 /// server may run at once (its room cap is checked against this).
 pub const MAX_ROOMS: usize = 256;
@@ -31,9 +34,27 @@ pub const MAX_ROOMS: usize = 256;
 // Worst-case roster frame: variant (1) + count (3) + per entry id (5) +
 // name length (1) + name (MAX_NAME_LEN).
 const _: () = assert!(1 + 3 + MAX_ROSTER * (5 + 1 + MAX_NAME_LEN) <= MAX_FRAME);
+// Worst-case standing: variant (1) + five numbers (10 each) + two flags +
+// count (1) + per run a name (1 + MAX_NAME_LEN) and a time (10).
+const _: () = assert!(1 + 52 + 1 + MAX_TOP * (1 + MAX_NAME_LEN + 10) <= MAX_FRAME);
 // Worst-case room list: variant (1) + count (3) + per room two strings
 // (1 + MAX_ID_LEN each) and two counts (5 each).
 const _: () = assert!(1 + 3 + MAX_ROOMS * (2 * (1 + MAX_ID_LEN) + 10) <= MAX_FRAME);
+
+/// `text` made fit for a text field of at most `max` bytes: control
+/// characters become spaces and it is cut at a character boundary (for
+/// messages made from errors, which may be long or span lines).
+pub fn clip_text(text: &str, max: usize) -> String {
+    let mut out = String::with_capacity(text.len().min(max));
+    for c in text.chars() {
+        let c = if c.is_control() { ' ' } else { c };
+        if out.len() + c.len_utf8() > max {
+            break;
+        }
+        out.push(c);
+    }
+    out
+}
 
 /// Checks a text field: `min..=max` bytes of UTF-8, no control characters
 /// (which covers newlines, escapes and NUL).
@@ -242,7 +263,7 @@ mod bounded {
     use serde::de::{Deserialize, Error, SeqAccess, Visitor};
     use serde::Deserializer;
 
-    use super::{RoomInfo, RosterEntry, MAX_ROOMS, MAX_ROSTER};
+    use super::{RoomInfo, RosterEntry, TopRun, MAX_ROOMS, MAX_ROSTER, MAX_TOP};
 
     struct Bounded<T> {
         max: usize,
@@ -278,6 +299,14 @@ mod bounded {
         })
     }
 
+    pub fn top<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<TopRun>, D::Error> {
+        d.deserialize_seq(Bounded {
+            max: MAX_TOP,
+            what: "top runs",
+            item: PhantomData,
+        })
+    }
+
     pub fn rooms<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<RoomInfo>, D::Error> {
         d.deserialize_seq(Bounded {
             max: MAX_ROOMS,
@@ -285,6 +314,54 @@ mod bounded {
             item: PhantomData,
         })
     }
+}
+
+/// One player's best run on a level, as [`Standing::top`] lists it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TopRun {
+    /// The player's name (records go by name), checked by [`check_name`].
+    pub name: String,
+    /// Its best time, milliseconds.
+    pub millis: u64,
+}
+
+/// Where a finished run stands in the server's records, once stored
+/// ([`ServerControl::RunRecorded`]).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Standing {
+    /// This run's time, milliseconds.
+    pub millis: u64,
+    /// The player's best time on the level, this run included.
+    pub personal_best: u64,
+    /// This run beat the player's earlier best (or is its first).
+    pub new_personal_best: bool,
+    /// This run beat every earlier run on the level.
+    pub new_record: bool,
+    /// The player's place among the level's players by best time (1:
+    /// first).
+    pub rank: u32,
+    /// The level's best players, fastest first, at most [`MAX_TOP`].
+    #[serde(deserialize_with = "bounded::top")]
+    pub top: Vec<TopRun>,
+}
+
+/// Checks a standing's list: at most [`MAX_TOP`] entries, fastest first,
+/// names valid.
+pub fn check_standing(standing: &Standing) -> Result<(), ProtocolError> {
+    if standing.top.len() > MAX_TOP {
+        return Err(ProtocolError::too_large(
+            "top runs",
+            standing.top.len(),
+            MAX_TOP,
+        ));
+    }
+    if standing.top.windows(2).any(|w| w[0].millis > w[1].millis) {
+        return Err(ProtocolError::InvalidString {
+            field: "top runs",
+            problem: "not fastest first",
+        });
+    }
+    standing.top.iter().try_for_each(|t| check_name(&t.name))
 }
 
 /// Messages a client sends on the control stream.
@@ -621,6 +698,16 @@ pub enum ServerControl {
         #[serde(deserialize_with = "bounded::rooms")]
         rooms: Vec<RoomInfo>,
     },
+    /// The receiver's run finished and is stored in the server's records
+    /// (sent only once it is: a run the server says is recorded survives
+    /// the server being killed). Added in protocol version 9.
+    RunRecorded(Standing),
+    /// The receiver's run finished but was not stored: why (the records
+    /// are off, or the database failed). Added in protocol version 9.
+    RunNotRecorded {
+        /// Why, for the results card.
+        reason: String,
+    },
 }
 
 impl ServerControl {
@@ -638,6 +725,8 @@ impl ServerControl {
             ServerControl::PlayerJoined(_) => "PlayerJoined",
             ServerControl::PlayerLeft { .. } => "PlayerLeft",
             ServerControl::Rooms { .. } => "Rooms",
+            ServerControl::RunRecorded(_) => "RunRecorded",
+            ServerControl::RunNotRecorded { .. } => "RunNotRecorded",
         }
     }
 }
@@ -678,6 +767,10 @@ impl Message for ServerControl {
             ServerControl::Roster { players } => check_roster(players),
             ServerControl::PlayerJoined(entry) => check_name(&entry.name),
             ServerControl::Rooms { rooms } => check_rooms(rooms),
+            ServerControl::RunRecorded(standing) => check_standing(standing),
+            ServerControl::RunNotRecorded { reason } => {
+                check_text("not recorded reason", reason, 0, MAX_REASON_LEN)
+            }
         }
     }
 }

@@ -31,11 +31,11 @@ pub mod web;
 
 pub use codec::Message;
 pub use control::{
-    check_name, check_rooms, check_roster, check_text, check_version, decode_sim_config,
-    encode_sim_config, name_key, ClientControl, CloseCode, LevelOffer, NetTiming, NoticeKind,
-    PlayerId, RejectReason, RoomInfo, RosterEntry, ServerControl, SessionToken, Welcome,
-    MAX_CHAT_LEN, MAX_ID_LEN, MAX_LEVEL_BUNDLE, MAX_NAME_LEN, MAX_REASON_LEN, MAX_ROOMS,
-    MAX_ROSTER, MAX_SIM_CONFIG_LEN,
+    check_name, check_rooms, check_roster, check_standing, check_text, check_version, clip_text,
+    decode_sim_config, encode_sim_config, name_key, ClientControl, CloseCode, LevelOffer,
+    NetTiming, NoticeKind, PlayerId, RejectReason, RoomInfo, RosterEntry, ServerControl,
+    SessionToken, Standing, TopRun, Welcome, MAX_CHAT_LEN, MAX_ID_LEN, MAX_LEVEL_BUNDLE,
+    MAX_NAME_LEN, MAX_REASON_LEN, MAX_ROOMS, MAX_ROSTER, MAX_SIM_CONFIG_LEN, MAX_TOP,
 };
 pub use datagram::{input_timing, InputPacket, Snapshot};
 pub use error::ProtocolError;
@@ -69,7 +69,9 @@ pub use snapshot::{
 /// applies held buttons to the ticks a quiet client sends none for) and
 /// `Snapshot::since_previous` (the server sends no snapshot that would
 /// change nothing for a client that sent nothing).
-pub const PROTOCOL_VERSION: u32 = 8;
+/// 9: records: `ServerControl::RunRecorded` (where a finished run stands,
+/// sent once it is stored) and `ServerControl::RunNotRecorded`.
+pub const PROTOCOL_VERSION: u32 = 9;
 
 /// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
 /// an unrelated QUIC peer. It names the application, not the version:

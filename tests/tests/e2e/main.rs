@@ -23,6 +23,7 @@ mod names;
 mod page_session_quic;
 mod prediction;
 mod prediction_crowd;
+mod records;
 mod remote_players;
 mod resume;
 mod robustness;

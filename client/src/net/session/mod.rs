@@ -22,7 +22,7 @@
 use std::time::Duration;
 
 use ledge_shared::protocol::{
-    ClientControl, NoticeKind, PlayerId, SessionToken, StateSnapshot, PROTOCOL_VERSION,
+    ClientControl, NoticeKind, PlayerId, SessionToken, Standing, StateSnapshot, PROTOCOL_VERSION,
 };
 
 use crate::time::Instant;
@@ -151,6 +151,9 @@ pub enum SessionEvent {
         /// Its name, if we knew it.
         name: Option<String>,
     },
+    /// Our finished run is stored in the server's records: where it
+    /// stands (`Ok`), or why it was not stored (`Err`).
+    RunRecorded(Result<Standing, String>),
 }
 
 /// Counters of what the session received and sent.

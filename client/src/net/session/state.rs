@@ -433,6 +433,12 @@ impl SessionState {
             }
             ServerControl::PlayerJoined(entry) => self.player_joined(entry),
             ServerControl::PlayerLeft { id } => self.player_left(id),
+            ServerControl::RunRecorded(standing) => {
+                self.push(SessionEvent::RunRecorded(Ok(standing)));
+            }
+            ServerControl::RunNotRecorded { reason } => {
+                self.push(SessionEvent::RunRecorded(Err(reason)));
+            }
             ServerControl::Welcome(_)
             | ServerControl::Reject { .. }
             | ServerControl::Rooms { .. } => {

@@ -1,0 +1,481 @@
+//! The records database: a pool of connections (sqlx's Any driver, SQLite
+//! or PostgreSQL by the target), the queries that store runs and read the
+//! top times.
+//!
+//! SQLite runs in WAL mode with `synchronous = FULL`: a committed run is
+//! on disk before the player is told. Times compare in milliseconds, so
+//! servers at other tick rates share a level's table; players go by name.
+
+use std::time::Duration;
+
+use ledge_shared::protocol::{Standing, TopRun, MAX_TOP};
+use sqlx::any::{AnyConnectOptions, AnyPoolOptions};
+use sqlx::{Acquire, Any, Row, Transaction};
+use sqlx::{AnyConnection, AnyPool, Connection};
+
+use super::schema::{self, Migrated, SCHEMA_VERSION};
+use super::{FinishedRun, RecordsError, RecordsTarget};
+
+/// How long opening or reaching the database may take.
+pub const CONNECT_TIMEOUT: Duration = Duration::from_secs(10);
+/// Connections in the pool.
+const POOL_SIZE: u32 = 4;
+/// Most top entries one query returns.
+pub const MAX_TOP_QUERY: u32 = 100;
+
+/// One player's best on a level.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct TopEntry {
+    /// 1: the fastest.
+    pub place: u32,
+    /// The player's name.
+    pub player: String,
+    /// Its best time, milliseconds.
+    pub millis: u64,
+    /// That run's ticks and tick rate.
+    pub ticks: u64,
+    /// Ticks a second of that run.
+    pub tick_rate: u64,
+    /// Its deaths and coins.
+    pub deaths: u64,
+    /// Coins of that run.
+    pub coins: u64,
+    /// When that run finished, milliseconds since the Unix epoch.
+    pub finished_at_ms: i64,
+    /// The player's finished runs on the level.
+    pub runs: u64,
+}
+
+/// A level with records.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct LevelSummary {
+    /// Its content hash (hex).
+    pub hash: String,
+    /// Its name (the latest run's).
+    pub name: String,
+    /// Finished runs.
+    pub runs: u64,
+    /// Players who finished.
+    pub players: u64,
+    /// The record, milliseconds.
+    pub best_millis: u64,
+}
+
+/// The records database.
+#[derive(Debug, Clone)]
+pub struct RecordStore {
+    pool: AnyPool,
+    target: String,
+}
+
+/// The Any driver's URL of an SQLite file (created if missing).
+fn sqlite_url(path: &std::path::Path) -> Result<String, String> {
+    let text = path
+        .to_str()
+        .ok_or_else(|| format!("{}: not UTF-8", path.display()))?;
+    let escaped = text
+        .replace('%', "%25")
+        .replace('?', "%3F")
+        .replace('#', "%23");
+    Ok(format!("sqlite://{escaped}?mode=rwc"))
+}
+
+impl RecordStore {
+    /// Opens (creating and migrating) the records at `target`; `None` when
+    /// it is [`RecordsTarget::Off`].
+    pub async fn open(target: &RecordsTarget) -> Result<Option<RecordStore>, RecordsError> {
+        let described = target.describe();
+        let open_err = |source| RecordsError::Open {
+            target: described.clone(),
+            source,
+        };
+        let url = match target {
+            RecordsTarget::Off => return Ok(None),
+            RecordsTarget::Sqlite(path) => {
+                if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                    std::fs::create_dir_all(dir).map_err(|e| open_err(sqlx::Error::Io(e)))?;
+                }
+                sqlite_url(path).map_err(|e| open_err(sqlx::Error::Configuration(e.into())))?
+            }
+            RecordsTarget::Url(url) => url.clone(),
+        };
+        sqlx::any::install_default_drivers();
+        let options: AnyConnectOptions = url.parse().map_err(open_err)?;
+        // One connection first: a bad file or an unreachable server fails
+        // at once (the pool would retry until its timeout).
+        let mut conn = tokio::time::timeout(CONNECT_TIMEOUT, AnyConnection::connect_with(&options))
+            .await
+            .map_err(|_| open_err(sqlx::Error::PoolTimedOut))?
+            .map_err(open_err)?;
+        set_up(&mut conn).await.map_err(open_err)?;
+        let migrated = schema::migrate(&mut conn).await.map_err(open_err)?;
+        let _ = conn.close().await;
+        match migrated {
+            Migrated::Current { from } => {
+                if from != SCHEMA_VERSION {
+                    tracing::info!(records = %described, from, to = SCHEMA_VERSION, "records schema made");
+                }
+            }
+            Migrated::Newer(found) => {
+                return Err(RecordsError::NewerSchema {
+                    target: described,
+                    found,
+                    known: SCHEMA_VERSION,
+                })
+            }
+        }
+        let pool = AnyPoolOptions::new()
+            .max_connections(POOL_SIZE)
+            .acquire_timeout(CONNECT_TIMEOUT)
+            .after_connect(|conn, _| Box::pin(set_up(conn)))
+            .connect_lazy_with(options);
+        Ok(Some(RecordStore {
+            pool,
+            target: described,
+        }))
+    }
+
+    /// The file or URL (without a password), for messages.
+    pub fn target(&self) -> &str {
+        &self.target
+    }
+
+    fn query_err(&self) -> impl Fn(sqlx::Error) -> RecordsError + '_ {
+        |source| RecordsError::Query {
+            target: self.target.clone(),
+            source,
+        }
+    }
+
+    /// Stores `runs` in one transaction and says where each stands (a run
+    /// stored before, by its key, is not stored again and stands as it
+    /// did). Nothing is stored unless everything is.
+    pub async fn store(&self, runs: &[FinishedRun]) -> Result<Vec<Standing>, RecordsError> {
+        let err = self.query_err();
+        let mut conn = self.pool.acquire().await.map_err(&err)?;
+        let mut tx = conn.begin().await.map_err(&err)?;
+        let mut news = Vec::with_capacity(runs.len());
+        for run in runs {
+            news.push(insert(&mut tx, run).await.map_err(&err)?);
+        }
+        let mut standings = Vec::with_capacity(runs.len());
+        for (run, (new_personal_best, new_record)) in runs.iter().zip(news) {
+            standings.push(
+                standing(&mut tx, run, new_personal_best, new_record)
+                    .await
+                    .map_err(&err)?,
+            );
+        }
+        tx.commit().await.map_err(&err)?;
+        Ok(standings)
+    }
+
+    /// The level's best `n` players (at most [`MAX_TOP_QUERY`]), fastest
+    /// first.
+    pub async fn top(&self, level_hash: &str, n: u32) -> Result<Vec<TopEntry>, RecordsError> {
+        let rows = sqlx::query(
+            "SELECT r.player, r.millis, r.ticks, r.tick_rate, r.deaths, r.coins, r.finished_at, \
+                    b.runs \
+             FROM runs r \
+             JOIN (SELECT player, MIN(millis) AS best, COUNT(*) AS runs FROM runs \
+                   WHERE level_hash = $1 GROUP BY player) b \
+               ON r.player = b.player AND r.millis = b.best \
+             WHERE r.level_hash = $1 \
+             ORDER BY r.millis ASC, r.finished_at ASC, r.player ASC",
+        )
+        .bind(level_hash)
+        .fetch_all(&self.pool)
+        .await
+        .map_err(self.query_err())?;
+        let mut out: Vec<TopEntry> = Vec::new();
+        for row in rows {
+            let player: String = row.try_get("player").map_err(self.query_err())?;
+            // A player's best may be tied by its own runs: the first one.
+            if out.iter().any(|e| e.player == player) {
+                continue;
+            }
+            if out.len() as u32 >= n.min(MAX_TOP_QUERY) {
+                break;
+            }
+            let get = |c: &str| row.try_get::<i64, _>(c).map(|v| v.max(0) as u64);
+            let entry = (|| {
+                Ok::<_, sqlx::Error>(TopEntry {
+                    place: out.len() as u32 + 1,
+                    player: player.clone(),
+                    millis: get("millis")?,
+                    ticks: get("ticks")?,
+                    tick_rate: get("tick_rate")?,
+                    deaths: get("deaths")?,
+                    coins: get("coins")?,
+                    finished_at_ms: row.try_get("finished_at")?,
+                    runs: get("runs")?,
+                })
+            })()
+            .map_err(self.query_err())?;
+            out.push(entry);
+        }
+        Ok(out)
+    }
+
+    /// Every level with records, by name.
+    pub async fn levels(&self) -> Result<Vec<LevelSummary>, RecordsError> {
+        let rows = sqlx::query(
+            "SELECT level_hash, MAX(level_name) AS name, COUNT(*) AS runs, \
+                    COUNT(DISTINCT player) AS players, MIN(millis) AS best \
+             FROM runs GROUP BY level_hash ORDER BY MAX(level_name), level_hash",
+        )
+        .fetch_all(&self.pool)
+        .await
+        .map_err(self.query_err())?;
+        rows.iter()
+            .map(|row| {
+                let get = |c: &str| row.try_get::<i64, _>(c).map(|v| v.max(0) as u64);
+                Ok(LevelSummary {
+                    hash: row.try_get("level_hash")?,
+                    name: row.try_get("name")?,
+                    runs: get("runs")?,
+                    players: get("players")?,
+                    best_millis: get("best")?,
+                })
+            })
+            .collect::<Result<_, sqlx::Error>>()
+            .map_err(self.query_err())
+    }
+
+    /// Runs stored under `key` (0 or 1: for the tests).
+    pub async fn count_key(&self, key: &str) -> Result<u64, RecordsError> {
+        let row = sqlx::query("SELECT COUNT(*) AS n FROM runs WHERE run_key = $1")
+            .bind(key)
+            .fetch_one(&self.pool)
+            .await
+            .map_err(self.query_err())?;
+        let n: i64 = row.try_get("n").map_err(self.query_err())?;
+        Ok(n.max(0) as u64)
+    }
+
+    /// Closes the pool (waits for connections to return).
+    pub async fn close(&self) {
+        self.pool.close().await;
+    }
+}
+
+/// Sets a new connection up: on SQLite, the write-ahead log and a sync at
+/// every commit (a stored run survives a crash), and a wait for the lock.
+async fn set_up(conn: &mut AnyConnection) -> Result<(), sqlx::Error> {
+    if conn.backend_name() == "SQLite" {
+        for pragma in [
+            "PRAGMA journal_mode = WAL",
+            "PRAGMA synchronous = FULL",
+            "PRAGMA busy_timeout = 5000",
+        ] {
+            sqlx::query(pragma).execute(&mut *conn).await?;
+        }
+    }
+    Ok(())
+}
+
+/// Inserts `run` unless its key is stored; whether it is a new personal
+/// best and a new record (both false for a run stored before).
+async fn insert(
+    tx: &mut Transaction<'_, Any>,
+    run: &FinishedRun,
+) -> Result<(bool, bool), sqlx::Error> {
+    let millis = run.millis() as i64;
+    let own: Option<i64> =
+        sqlx::query("SELECT MIN(millis) AS best FROM runs WHERE level_hash = $1 AND player = $2")
+            .bind(run.level_hash.clone())
+            .bind(run.player.clone())
+            .fetch_one(&mut **tx)
+            .await?
+            .try_get("best")?;
+    let level: Option<i64> =
+        sqlx::query("SELECT MIN(millis) AS best FROM runs WHERE level_hash = $1")
+            .bind(run.level_hash.clone())
+            .fetch_one(&mut **tx)
+            .await?
+            .try_get("best")?;
+    let inserted = sqlx::query(
+        "INSERT INTO runs (run_key, level_hash, level_name, player, ticks, tick_rate, millis, \
+                           deaths, coins, place, finished_at, replay_id) \
+         VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, NULL) \
+         ON CONFLICT (run_key) DO NOTHING",
+    )
+    .bind(run.key.clone())
+    .bind(run.level_hash.clone())
+    .bind(run.level_name.clone())
+    .bind(run.player.clone())
+    .bind(i64::from(run.ticks))
+    .bind(i64::from(run.tick_rate))
+    .bind(millis)
+    .bind(i64::from(run.deaths))
+    .bind(i64::from(run.coins))
+    .bind(i64::from(run.place))
+    .bind(run.finished_at_ms)
+    .execute(&mut **tx)
+    .await?
+    .rows_affected()
+        == 1;
+    Ok((
+        inserted && own.is_none_or(|b| millis < b),
+        inserted && level.is_none_or(|b| millis < b),
+    ))
+}
+
+/// Where `run` stands now (its player's best, rank and the top ten).
+async fn standing(
+    tx: &mut Transaction<'_, Any>,
+    run: &FinishedRun,
+    new_personal_best: bool,
+    new_record: bool,
+) -> Result<Standing, sqlx::Error> {
+    let conn = tx.acquire().await?;
+    let best: Option<i64> =
+        sqlx::query("SELECT MIN(millis) AS best FROM runs WHERE level_hash = $1 AND player = $2")
+            .bind(run.level_hash.clone())
+            .bind(run.player.clone())
+            .fetch_one(&mut *conn)
+            .await?
+            .try_get("best")?;
+    let personal_best = best.unwrap_or(run.millis() as i64);
+    let ahead: i64 = sqlx::query(
+        "SELECT COUNT(*) AS n FROM (SELECT player, MIN(millis) AS best FROM runs \
+         WHERE level_hash = $1 GROUP BY player) b WHERE b.best < $2",
+    )
+    .bind(run.level_hash.clone())
+    .bind(personal_best)
+    .fetch_one(&mut *conn)
+    .await?
+    .try_get("n")?;
+    let rows = sqlx::query(
+        "SELECT player, MIN(millis) AS best FROM runs WHERE level_hash = $1 \
+         GROUP BY player ORDER BY MIN(millis) ASC, player ASC LIMIT $2",
+    )
+    .bind(run.level_hash.clone())
+    .bind(MAX_TOP as i64)
+    .fetch_all(&mut *conn)
+    .await?;
+    let top = rows
+        .iter()
+        .map(|row| {
+            Ok(TopRun {
+                name: row.try_get("player")?,
+                millis: row.try_get::<i64, _>("best")?.max(0) as u64,
+            })
+        })
+        .collect::<Result<_, sqlx::Error>>()?;
+    Ok(Standing {
+        millis: run.millis(),
+        personal_best: personal_best.max(0) as u64,
+        new_personal_best,
+        new_record,
+        rank: (ahead.max(0) as u32).saturating_add(1),
+        top,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(key: &str, player: &str, ticks: u32) -> FinishedRun {
+        FinishedRun {
+            key: key.into(),
+            level_hash: "aa".repeat(32),
+            level_name: "default".into(),
+            player: player.into(),
+            ticks,
+            tick_rate: 60,
+            deaths: 1,
+            coins: 2,
+            place: 1,
+            finished_at_ms: 1_700_000_000_000,
+        }
+    }
+
+    async fn open(dir: &tempfile::TempDir) -> RecordStore {
+        let target = RecordsTarget::Sqlite(dir.path().join("sub/records.sqlite"));
+        RecordStore::open(&target).await.unwrap().expect("on")
+    }
+
+    #[tokio::test]
+    async fn runs_are_stored_once_ranked_and_a_slower_run_keeps_the_best() {
+        let dir = tempfile::tempdir().unwrap();
+        let store = open(&dir).await;
+        let s = store.store(&[run("a1", "ann", 600)]).await.unwrap();
+        assert!(s[0].new_record && s[0].new_personal_best);
+        assert_eq!(
+            (s[0].millis, s[0].personal_best, s[0].rank),
+            (10_000, 10_000, 1)
+        );
+        // Two in one batch: bob is faster (a record), ann slower (no best).
+        let s = store
+            .store(&[run("b1", "bob", 540), run("a2", "ann", 660)])
+            .await
+            .unwrap();
+        assert!(s[0].new_record && s[0].new_personal_best && s[0].rank == 1);
+        assert!(!s[1].new_record && !s[1].new_personal_best);
+        assert_eq!((s[1].personal_best, s[1].rank), (10_000, 2));
+        let names: Vec<&str> = s[1].top.iter().map(|t| t.name.as_str()).collect();
+        assert_eq!(names, ["bob", "ann"]);
+        // The same finish again (a retry after a lost commit): stored once.
+        let again = store.store(&[run("b1", "bob", 540)]).await.unwrap();
+        assert!(!again[0].new_record && !again[0].new_personal_best);
+        assert_eq!(store.count_key("b1").await.unwrap(), 1);
+        let top = store.top(&"aa".repeat(32), 10).await.unwrap();
+        assert_eq!(top.len(), 2);
+        assert_eq!(
+            (top[0].player.as_str(), top[0].millis, top[0].runs),
+            ("bob", 9_000, 1)
+        );
+        assert_eq!(
+            (top[1].player.as_str(), top[1].millis, top[1].runs),
+            ("ann", 10_000, 2)
+        );
+        assert_eq!(store.top(&"aa".repeat(32), 1).await.unwrap().len(), 1);
+        let levels = store.levels().await.unwrap();
+        assert_eq!(levels.len(), 1);
+        assert_eq!(
+            (levels[0].runs, levels[0].players, levels[0].best_millis),
+            (3, 2, 9_000)
+        );
+        store.close().await;
+        // Reopened: everything is still there.
+        let store = open(&dir).await;
+        assert_eq!(store.top(&"aa".repeat(32), 10).await.unwrap(), top);
+        store.close().await;
+    }
+
+    #[tokio::test]
+    async fn a_newer_or_broken_database_is_refused_saying_what_to_do() {
+        let dir = tempfile::tempdir().unwrap();
+        let store = open(&dir).await;
+        sqlx::query("UPDATE ledge_schema SET version = 99")
+            .execute(&store.pool)
+            .await
+            .unwrap();
+        store.close().await;
+        let target = RecordsTarget::Sqlite(dir.path().join("sub/records.sqlite"));
+        let e = RecordStore::open(&target).await.unwrap_err();
+        assert!(
+            matches!(e, RecordsError::NewerSchema { found: 99, .. }),
+            "{e}"
+        );
+        assert!(e.to_string().contains("newer ledge-server"), "{e}");
+        // Not a database at all.
+        let junk = dir.path().join("junk.sqlite");
+        std::fs::write(&junk, vec![0x55; 8192]).unwrap();
+        let e = RecordStore::open(&RecordsTarget::Sqlite(junk))
+            .await
+            .unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("junk.sqlite") && text.contains("--records"),
+            "{text}"
+        );
+        // Off is off.
+        assert!(RecordStore::open(&RecordsTarget::Off)
+            .await
+            .unwrap()
+            .is_none());
+    }
+}

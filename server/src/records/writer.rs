@@ -1,0 +1,158 @@
+//! The records writer: a task that takes finished runs from the rooms
+//! (through a bounded queue, so a slow database never holds up a tick),
+//! stores them in batches of one transaction each, retrying a failed batch
+//! a few times, and only then answers each run's player.
+
+use std::time::{Duration, Instant};
+
+use ledge_shared::protocol::Standing;
+use prometheus_client::metrics::counter::Counter;
+use prometheus_client::metrics::histogram::Histogram;
+use tokio::sync::mpsc;
+use tokio::task::JoinHandle;
+use tracing::{error, warn};
+
+use super::{FinishedRun, RecordStore};
+
+/// Runs waiting to be stored, at most; more are answered "not recorded"
+/// at once (and counted).
+pub const WRITE_QUEUE: usize = 4096;
+/// Most runs stored in one transaction.
+pub const BATCH: usize = 256;
+/// Waits before each retry of a failed batch.
+const RETRIES: [Duration; 3] = [
+    Duration::from_millis(200),
+    Duration::from_secs(1),
+    Duration::from_secs(3),
+];
+
+/// What a run's player is told: where it stands, or why it was not
+/// stored.
+pub type Reply = Box<dyn FnOnce(Result<Standing, String>) + Send>;
+
+struct Pending {
+    run: FinishedRun,
+    reply: Reply,
+}
+
+/// The writer's counters (in [`crate::metrics::Metrics`]).
+#[derive(Debug, Clone, Default)]
+pub struct WriterMetrics {
+    /// Runs stored.
+    pub stored: Counter,
+    /// Runs not stored (queue full, or the database failed).
+    pub failed: Counter,
+    /// Time from a batch's first try to its commit, seconds.
+    pub write_seconds: Option<Histogram>,
+}
+
+/// Where rooms send finished runs (cheap to clone). Off: every run is
+/// answered "not recorded" with the reason.
+#[derive(Clone)]
+pub struct RecordsHandle {
+    queue: Option<mpsc::Sender<Pending>>,
+    store: Option<RecordStore>,
+    off: String,
+    metrics: WriterMetrics,
+}
+
+impl std::fmt::Debug for RecordsHandle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RecordsHandle")
+            .field("store", &self.store.as_ref().map(RecordStore::target))
+            .field("off", &self.off)
+            .finish()
+    }
+}
+
+impl Default for RecordsHandle {
+    fn default() -> RecordsHandle {
+        RecordsHandle::off("this server keeps no records")
+    }
+}
+
+impl RecordsHandle {
+    /// No records; runs are answered with `reason`.
+    pub fn off(reason: &str) -> RecordsHandle {
+        RecordsHandle {
+            queue: None,
+            store: None,
+            off: reason.to_owned(),
+            metrics: WriterMetrics::default(),
+        }
+    }
+
+    /// Starts the writer for `store`: the handle and the task, which ends
+    /// once every handle is gone and the queue is stored.
+    pub fn spawn(store: RecordStore, metrics: WriterMetrics) -> (RecordsHandle, JoinHandle<()>) {
+        let (tx, rx) = mpsc::channel(WRITE_QUEUE);
+        let task = tokio::spawn(write(store.clone(), rx, metrics.clone()));
+        let handle = RecordsHandle {
+            queue: Some(tx),
+            store: Some(store),
+            off: String::new(),
+            metrics,
+        };
+        (handle, task)
+    }
+
+    /// The store, for reading (`None`: records are off).
+    pub fn store(&self) -> Option<&RecordStore> {
+        self.store.as_ref()
+    }
+
+    /// Queues `run`; `reply` is called once it is stored or not.
+    pub fn submit(&self, run: FinishedRun, reply: Reply) {
+        let Some(queue) = &self.queue else {
+            reply(Err(self.off.clone()));
+            return;
+        };
+        if let Err(e) = queue.try_send(Pending { run, reply }) {
+            self.metrics.failed.inc();
+            let (reason, pending) = match e {
+                mpsc::error::TrySendError::Full(p) => ("too many runs waiting to be stored", p),
+                mpsc::error::TrySendError::Closed(p) => ("the records writer has stopped", p),
+            };
+            warn!(player = %pending.run.player, "run not recorded: {reason}");
+            (pending.reply)(Err(reason.into()));
+        }
+    }
+}
+
+/// The writer task: batches from `rx` until every sender is gone.
+async fn write(store: RecordStore, mut rx: mpsc::Receiver<Pending>, metrics: WriterMetrics) {
+    let mut batch: Vec<Pending> = Vec::with_capacity(BATCH);
+    while rx.recv_many(&mut batch, BATCH).await > 0 {
+        let runs: Vec<FinishedRun> = batch.iter().map(|p| p.run.clone()).collect();
+        let started = Instant::now();
+        let mut result = store.store(&runs).await;
+        for wait in RETRIES {
+            let Err(e) = &result else { break };
+            warn!(
+                "records: storing {} runs failed, retrying in {wait:?}: {e}",
+                runs.len()
+            );
+            tokio::time::sleep(wait).await;
+            result = store.store(&runs).await;
+        }
+        match result {
+            Ok(standings) => {
+                if let Some(h) = &metrics.write_seconds {
+                    h.observe(started.elapsed().as_secs_f64());
+                }
+                metrics.stored.inc_by(runs.len() as u64);
+                for (p, standing) in batch.drain(..).zip(standings) {
+                    (p.reply)(Ok(standing));
+                }
+            }
+            Err(e) => {
+                error!("records: {} runs not stored: {e}", runs.len());
+                metrics.failed.inc_by(runs.len() as u64);
+                let reason = format!("the records database failed: {e}");
+                for p in batch.drain(..) {
+                    (p.reply)(Err(reason.clone()));
+                }
+            }
+        }
+    }
+}
