@@ -506,6 +506,7 @@ impl PredictedClient {
 pub mod attack;
 pub mod browser;
 pub mod e2e;
+pub mod server_process;
 pub mod web;
 
 /// A file of the level corpus (`target/level-corpus`, made by

@@ -99,9 +99,16 @@ pub struct BotReport {
     /// The run's time in ticks at its first finish, as the server's run
     /// record said.
     pub finish_ticks: Option<u32>,
-    /// Where its finished run stands in the server's records (`Err`: why
-    /// it was not recorded), once the server said.
+    /// Where its last finished run stands in the server's records (`Err`:
+    /// why it was not recorded), once the server said.
     pub standing: Option<Result<Standing, String>>,
+    /// Runs the server said it recorded.
+    pub recorded: u32,
+    /// Runs the server said it did not record.
+    pub not_recorded: u32,
+    /// Runs the server's snapshots showed finishing (our player's goal
+    /// flag turning on).
+    pub finishes: u32,
     /// The brain's progress note.
     pub progress: String,
     /// Why it stopped early (connection refused, closed by the server...).
@@ -244,6 +251,7 @@ pub async fn run_bot(
     let mut next_transport = started;
     let mut lingering = false;
     let mut linger_started = Instant::now();
+    let mut won_before = false;
     let ended = loop {
         let now = Instant::now();
         if options.stop_when_done && brain.done() && !lingering {
@@ -289,7 +297,12 @@ pub async fn run_bot(
             Ok(SessionEvent::Snapshot(update)) => {
                 report.snapshot(&update);
                 if let Some(mine) = update.state.get(me.0) {
-                    if mine.flags & player_flags::WON != 0 && !report.won {
+                    let won = mine.flags & player_flags::WON != 0;
+                    if won && !won_before {
+                        report.finishes += 1;
+                    }
+                    won_before = won;
+                    if won && !report.won {
                         report.won = true;
                         report.won_at_tick = Some(update.state.tick);
                     }
@@ -308,7 +321,13 @@ pub async fn run_bot(
                 }
             }
             Ok(SessionEvent::Pong { rtt: Some(rtt), .. }) => game.on_rtt(rtt),
-            Ok(SessionEvent::RunRecorded(standing)) => report.standing = Some(standing),
+            Ok(SessionEvent::RunRecorded(standing)) => {
+                match &standing {
+                    Ok(_) => report.recorded += 1,
+                    Err(_) => report.not_recorded += 1,
+                }
+                report.standing = Some(standing);
+            }
             Ok(SessionEvent::Notice(NoticeKind::Kick { reason })) => {
                 break Some(format!("kicked: {reason}"))
             }

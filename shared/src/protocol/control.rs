@@ -46,7 +46,7 @@ const _: () = assert!(1 + 3 + MAX_ROOMS * (2 * (1 + MAX_ID_LEN) + 10) <= MAX_FRA
 /// messages made from errors, which may be long or span lines).
 pub fn clip_text(text: &str, max: usize) -> String {
     let mut out = String::with_capacity(text.len().min(max));
-    for c in text.chars() {
+    for c in text.chars().filter(|&c| !is_hidden(c)) {
         let c = if c.is_control() { ' ' } else { c };
         if out.len() + c.len_utf8() > max {
             break;
@@ -82,7 +82,41 @@ pub fn check_text(
             problem: "contains control characters",
         });
     }
+    if text.chars().any(is_hidden) {
+        return Err(ProtocolError::InvalidString {
+            field,
+            problem: "contains a direction override or an invisible character",
+        });
+    }
     Ok(())
+}
+
+/// Characters that change how the text around them reads without showing
+/// themselves: direction overrides and isolates (U+202E turns what follows
+/// around, so a line could show another player something its sender did
+/// not type), zero-width characters, invisible operators, the byte order
+/// mark and tag characters. No text field may carry them.
+pub fn is_hidden(c: char) -> bool {
+    matches!(
+        c,
+        '\u{00AD}'
+            | '\u{034F}'
+            | '\u{061C}'
+            | '\u{115F}'
+            | '\u{1160}'
+            | '\u{17B4}'
+            | '\u{17B5}'
+            | '\u{180B}'..='\u{180F}'
+            | '\u{200B}'..='\u{200F}'
+            | '\u{202A}'..='\u{202E}'
+            | '\u{2060}'..='\u{206F}'
+            | '\u{3164}'
+            | '\u{FE00}'..='\u{FE0F}'
+            | '\u{FEFF}'
+            | '\u{FFA0}'
+            | '\u{FFF0}'..='\u{FFF8}'
+            | '\u{E0000}'..='\u{E0FFF}'
+    )
 }
 
 /// Checks a player name: 1..=[`MAX_NAME_LEN`] bytes, no control

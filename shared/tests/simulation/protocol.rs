@@ -801,6 +801,32 @@ fn invalid_strings_are_rejected_both_ways() {
             problem: "contains control characters"
         }
     );
+    // A direction override would turn around what others read, and an
+    // invisible character hide what a line says: refused both ways.
+    for hidden in [
+        "evil\u{202E}gnp.exe",
+        "a\u{200B}b",
+        "\u{2066}x\u{2069}",
+        "tag\u{E0041}",
+    ] {
+        let line = ClientControl::Chat {
+            text: hidden.into(),
+        };
+        assert!(line.encode().is_err(), "{hidden:?}");
+        assert_eq!(
+            ClientControl::decode(&raw(&line)).unwrap_err(),
+            ProtocolError::InvalidString {
+                field: "chat text",
+                problem: "contains a direction override or an invisible character"
+            },
+            "{hidden:?}"
+        );
+    }
+    assert_eq!(
+        ledge_shared::protocol::clip_text("a\u{202E}b\nc", 256),
+        "ab c",
+        "made fit: hidden characters dropped, controls spaced"
+    );
     let long = raw(&ClientControl::Hello {
         version: 1,
         name: "é".repeat(17),

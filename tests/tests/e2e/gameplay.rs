@@ -129,6 +129,32 @@ async fn chat_is_relayed_to_the_room() {
         .expect("the chat line arrives");
         assert_eq!(heard, (ada_id, "hello, bob".to_owned()));
     }
+    // A line with a direction override is refused before it leaves; sent
+    // anyway (raw), the server drops it and nobody hears it.
+    let evil = "look at this \u{202E}gnp.exe";
+    let refused = ada.chat(evil).await.unwrap_err();
+    assert!(
+        refused.to_string().contains("direction override"),
+        "{refused}"
+    );
+    // `ClientControl::Chat` is variant 1; a string is its length (one
+    // byte below 251) and its bytes (docs/PROTOCOL.md, "Encodings").
+    let mut raw = vec![1u8, evil.len() as u8];
+    raw.extend_from_slice(evil.as_bytes());
+    let mut frame = (raw.len() as u32).to_le_bytes().to_vec();
+    frame.extend_from_slice(&raw);
+    ada.send_raw_control(&frame).await.unwrap();
+    ada.chat("still here").await.unwrap();
+    let next = tokio::time::timeout(WAIT, async {
+        loop {
+            if let SessionEvent::Chat { text, .. } = bob.recv().await.unwrap() {
+                return text;
+            }
+        }
+    })
+    .await
+    .expect("the next line arrives");
+    assert_eq!(next, "still here", "the hidden line was not relayed");
     ada.close().await;
     bob.close().await;
     server.stop().await.unwrap();
