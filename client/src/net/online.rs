@@ -121,6 +121,9 @@ pub struct OnlineGame<
     /// Where our last finished run stands in the server's records, or why
     /// it was not recorded.
     standing: Option<Result<Standing, String>>,
+    /// How many standings (or refusals) the server sent: tells a new one
+    /// from the last when both say the same.
+    standings: u64,
     /// Snapshots arrived since the last [`OnlineGame::take_arrivals`].
     arrivals: u32,
     /// When the last snapshot (or the welcome) arrived.
@@ -198,6 +201,7 @@ impl<N: Network> OnlineGame<N> {
             fetched: None,
             latest: None,
             standing: None,
+            standings: 0,
             arrivals: 0,
             last_news: None,
             fresh: false,
@@ -317,7 +321,10 @@ impl<N: Network> OnlineGame<N> {
                     game.on_player_left(*id);
                 }
             }
-            NetEvent::RunRecorded(r) => self.standing = Some(r.clone()),
+            NetEvent::RunRecorded(r) => {
+                self.standing = Some(r.clone());
+                self.standings += 1;
+            }
             NetEvent::Untrusted(reason) => self.untrusted = Some(reason.clone()),
             NetEvent::Failed(_)
             | NetEvent::Disconnected(_)
@@ -331,6 +338,15 @@ impl<N: Network> OnlineGame<N> {
     /// why it was not recorded), once the server said.
     pub fn standing(&self) -> Option<&Result<Standing, String>> {
         self.standing.as_ref()
+    }
+
+    /// How many times the server said where a finished run of ours stands
+    /// (or that it was not recorded) this session: a front end that
+    /// remembers this count when a run starts knows that a
+    /// [`OnlineGame::standing`] is that run's once the count has grown,
+    /// even when it reads the same as the run before's.
+    pub fn standings(&self) -> u64 {
+        self.standings
     }
 
     /// What to draw, once the server welcomed us and we have its level.
@@ -423,5 +439,67 @@ impl<N: Network> OnlineGame<N> {
     /// The network driver.
     pub fn network(&self) -> &N {
         &self.net
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::{BTreeMap, VecDeque};
+
+    use ledge_shared::input::Buttons;
+    use ledge_shared::protocol::{PlayerId, Standing};
+
+    use super::OnlineGame;
+    use crate::net::{NetEvent, Network};
+    use crate::netstats::TransportSample;
+    use crate::time::Instant;
+
+    /// A network that hands over the events queued in it.
+    struct Queued(VecDeque<NetEvent>);
+
+    impl Network for Queued {
+        fn try_recv(&mut self) -> Option<NetEvent> {
+            self.0.pop_front()
+        }
+        fn send_input(&mut self, _: u64, _: Buttons) -> bool {
+            true
+        }
+        fn chat(&mut self, _: &str) -> bool {
+            true
+        }
+        fn transport(&self) -> Option<TransportSample> {
+            None
+        }
+        fn players(&self) -> BTreeMap<PlayerId, String> {
+            BTreeMap::new()
+        }
+    }
+
+    /// Two equal standings in a row are two: the count tells them apart.
+    #[test]
+    fn every_standing_the_server_sends_is_counted() {
+        let standing = Standing {
+            millis: 9_950,
+            personal_best: 9_950,
+            new_personal_best: false,
+            new_record: false,
+            rank: 1,
+            top: Vec::new(),
+        };
+        let mut game = OnlineGame::with_network(Queued(VecDeque::new()), "server", "ada");
+        assert_eq!((game.standings(), game.standing()), (0, None));
+        game.net.0.extend([
+            NetEvent::RunRecorded(Ok(standing.clone())),
+            NetEvent::RunRecorded(Ok(standing.clone())),
+        ]);
+        game.update(Instant::now(), Buttons::NONE);
+        assert_eq!(game.standings(), 2);
+        assert_eq!(game.standing(), Some(&Ok(standing)));
+        game.net
+            .0
+            .push_back(NetEvent::RunRecorded(Err("records are off".into())));
+        game.update(Instant::now(), Buttons::NONE);
+        assert_eq!(game.standings(), 3);
+        assert_eq!(game.standing(), Some(&Err("records are off".into())));
     }
 }

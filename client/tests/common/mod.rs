@@ -16,7 +16,9 @@ pub struct TestServer {
     shutdown: ShutdownHandle,
     runtime: tokio::runtime::Runtime,
     task: tokio::task::JoinHandle<Result<(), ledge_server::ServerError>>,
-    _certs: tempfile::TempDir,
+    /// The certificate directory: the server's state, its records
+    /// database included (`records.sqlite`, unless configured otherwise).
+    certs: tempfile::TempDir,
 }
 
 impl TestServer {
@@ -56,8 +58,14 @@ impl TestServer {
             shutdown,
             runtime,
             task,
-            _certs: certs,
+            certs,
         }
+    }
+
+    /// The server's certificate directory, where its records are by
+    /// default ([`ledge_server::records::RecordsTarget::in_state_dir`]).
+    pub fn cert_dir(&self) -> &std::path::Path {
+        self.certs.path()
     }
 
     /// Runs `future` on the server's runtime (e.g. a session of a player

@@ -19,6 +19,7 @@ use common::{run_to_end, Png, TestServer};
 use ledge_client::bot::{connect_and_run, BotOptions, Brain, Runner};
 use ledge_client::Trust;
 use ledge_levels::{default_level, default_route};
+use ledge_server::records::{RecordStore, RecordsTarget, TopEntry};
 use ledge_shared::game::{Game, PlayerView};
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::PlayerId;
@@ -65,22 +66,39 @@ fn script_of(buttons: &[Buttons]) -> String {
 /// the player after the last.
 fn play(
     limit: u64,
-    mut brain: impl FnMut(&Game, u64) -> Buttons,
+    brain: impl FnMut(&Game, u64) -> Buttons,
     stop: impl Fn(&PlayerView) -> bool,
 ) -> (Vec<Buttons>, PlayerView) {
+    play_as(PlayerId(1), 0, limit, brain, stop)
+        .unwrap_or_else(|| panic!("not done within {limit} ticks"))
+}
+
+/// [`play`] as player `id` (its spawn spot is its id's) in a game that
+/// ran `before` ticks without players first; `None` if not done within
+/// `limit` ticks.
+fn play_as(
+    id: PlayerId,
+    before: u64,
+    limit: u64,
+    mut brain: impl FnMut(&Game, u64) -> Buttons,
+    stop: impl Fn(&PlayerView) -> bool,
+) -> Option<(Vec<Buttons>, PlayerView)> {
     let mut game = Game::from_level(&default_level()).expect("the default level loads");
-    game.add_player(PlayerId(1)).expect("player 1 joins");
+    for _ in 0..before {
+        game.step(&[]);
+    }
+    game.add_player(id).expect("the player joins");
     let mut buttons = Vec::new();
     for t in 0..limit {
         let b = brain(&game, t);
         buttons.push(b);
-        game.step(&[(PlayerId(1), b)]);
-        let me = game.player(PlayerId(1)).expect("player 1 plays");
+        game.step(&[(id, b)]);
+        let me = game.player(id).expect("the player plays");
         if stop(&me) {
-            return (buttons, me);
+            return Some((buttons, me));
         }
     }
-    panic!("not done within {limit} ticks");
+    None
 }
 
 /// Runs the client offline with `script` for `ticks` ticks as "ada", and
@@ -232,6 +250,16 @@ fn a_run_to_the_goal_ends_on_the_results_card_with_the_simulations_time() {
     assert_eq!(hud["results_table"], false, "{json}");
     assert_eq!(hud["results"].as_array().unwrap().len(), 1, "{json}");
     assert_eq!(hud["results"][0]["ours"], true, "{json}");
+    // Offline there are no records: the card tells the run alone.
+    let card = &hud["card"];
+    assert!(card["records"].is_null(), "{card}");
+    let kinds: Vec<&str> = card["lines"]
+        .as_array()
+        .expect("the card's lines")
+        .iter()
+        .map(|l| l["kind"].as_str().unwrap())
+        .collect();
+    assert_eq!(kinds, ["place", "time", "tally", "again"], "{card}");
     // The card: a dark panel across the middle column in the upper half,
     // with gold words on it.
     let mid = img.width / 2;
@@ -321,5 +349,217 @@ fn a_room_shows_who_finished_with_the_servers_time() {
     assert_eq!(rows[0]["ticks"], finish, "{json}");
     // We did not finish: no card of ours.
     assert!(hud["place"].is_null(), "{json}");
+    assert!(hud["card"].is_null(), "{json}");
     eprintln!("bob finished in {finish} ticks: {}", hud["results"]);
+}
+
+/// Still ticks before an online script moves: by then the client's clock
+/// has settled on the server's, so no input of the run comes late.
+const LEAD: u64 = 60;
+/// Ticks the client plays on after the finish: the server stores the run
+/// and says where it stands well within them (3 s).
+const AFTER_FINISH: u64 = 180;
+
+/// A script to the goal for player `id` online: [`LEAD`] still ticks, then
+/// the route runner's buttons. Checked offline to reach the goal whatever
+/// the room's clock says when we join (walkers and platforms go by it);
+/// returns the buttons and the player at the goal.
+fn script_to_goal(id: PlayerId) -> (Vec<Buttons>, PlayerView) {
+    let mut runner = Runner::new(default_route());
+    let brain = |game: &Game, t: u64| {
+        if t < LEAD {
+            Buttons::NONE
+        } else {
+            runner.buttons(game, id)
+        }
+    };
+    let (buttons, me) =
+        play_as(id, 0, 60 * 60, brain, |me| me.won).expect("the runner reaches the goal");
+    for before in (1..1200).step_by(53) {
+        let mut replay = buttons.iter().copied();
+        let later = play_as(
+            id,
+            before,
+            buttons.len() as u64,
+            |_, _| replay.next().expect("within the script"),
+            |me| me.won,
+        );
+        let ticks = later.map(|(_, later)| later.run_ticks);
+        assert_eq!(ticks, Some(me.run_ticks), "{id} joining at tick {before}");
+    }
+    (buttons, me)
+}
+
+/// The server's records of the one level played, from its database: the
+/// top ten, fastest first.
+fn stored_top(server: &TestServer) -> Vec<TopEntry> {
+    let target = RecordsTarget::in_state_dir(server.cert_dir());
+    server.block_on(async {
+        let store = RecordStore::open(&target)
+            .await
+            .expect("the records database opens")
+            .expect("records are on");
+        let levels = store.levels().await.expect("the levels with records");
+        assert_eq!(levels.len(), 1, "{levels:?}");
+        let top = store.top(&levels[0].hash, 10).await.expect("the top ten");
+        store.close().await;
+        top
+    })
+}
+
+/// `ms` as the card writes record times, `m:ss.mmm`.
+fn time_ms(ms: u64) -> String {
+    format!("{}:{:02}.{:03}", ms / 60_000, ms / 1000 % 60, ms % 1000)
+}
+
+/// Gold pixels (the card's gold words) on the card's `line`.
+fn gold_in(img: &Png, card: &Value, line: &Value) -> usize {
+    let panel: Vec<f64> = card["panel"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let (baseline, size) = (
+        line["baseline"].as_f64().unwrap(),
+        line["size"].as_f64().unwrap(),
+    );
+    let rows = (baseline - size * 0.8) as u32..baseline as u32;
+    // Inside the card's gold rim.
+    let across = (panel[0] + 4.0) as u32..(panel[0] + panel[2] - 4.0) as u32;
+    rows.flat_map(|y| across.clone().map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let [r, g, b, _] = img.at(x, y);
+            r >= 230 && (190..=235).contains(&g) && b <= 110
+        })
+        .count()
+}
+
+#[test]
+fn a_finished_online_run_shows_where_it_stands_in_the_records() {
+    let Some(xvfb) = common::xvfb_or_skip("the records card screenshot test") else {
+        return;
+    };
+    let server = TestServer::start();
+    let (addr, fingerprint) = (server.addr.to_string(), server.fingerprint);
+    // First "bob", a runner bot, to the goal: his run is the level's first.
+    let mut runner = Runner::new(default_route());
+    let options = BotOptions {
+        stop_when_done: true,
+        ..BotOptions::new("bob", Duration::from_secs(40))
+    };
+    let bob = server.block_on(connect_and_run(
+        &addr,
+        &Trust::Pinned(fingerprint),
+        &mut runner as &mut dyn Brain,
+        &options,
+    ));
+    assert!(matches!(bob.standing, Some(Ok(_))), "bob's run: {bob}");
+    // Then we, "ada", the next player, run the route in the window.
+    let ada = PlayerId(bob.player.expect("bob joined").0 + 1);
+    let (buttons, me) = script_to_goal(ada);
+    let tmp = tempfile::tempdir().unwrap();
+    let script = tmp.path().join("records.script");
+    std::fs::write(&script, script_of(&buttons)).unwrap();
+    let png = common::screenshot_dir(tmp.path()).join("records_card.png");
+    let ticks = buttons.len() as u64 + AFTER_FINISH;
+    let mut command =
+        common::client_under_xvfb(&xvfb, env!("CARGO_BIN_EXE_ledge-client"), ticks, &png);
+    command
+        .args(["--connect", &addr])
+        .args(["--cert-hash", &fingerprint.to_string()])
+        .args(["--name", "ada"])
+        .arg("--script")
+        .arg(&script);
+    let out = run_to_end(command, CLIENT_TIMEOUT);
+    assert!(
+        out.status.success(),
+        "the client failed: {}; stderr:\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let top = stored_top(&server);
+    server.stop();
+    let (img, json) = load(&png);
+    assert_eq!(
+        json["player"]["id"], ada.0,
+        "the script is for {ada}: {json}"
+    );
+    let hud = &json["hud"];
+    assert!(
+        hud["place"].as_u64().is_some(),
+        "ada did not finish (offline in {} ticks): {json}",
+        me.run_ticks
+    );
+    check_records_card(&img, hud, &top);
+}
+
+/// The card of ada's finished run says what the server's records (`top`,
+/// read from its database) say: our best and rank, the headline it earned,
+/// the level's top runs with our row (and only ours) in gold.
+fn check_records_card(img: &Png, hud: &Value, top: &[TopEntry]) {
+    let card = &hud["card"];
+    assert_eq!(card["records"], "recorded", "{card}");
+    let lines = card["lines"].as_array().expect("the card's lines");
+    let of = |kind: &str| -> Vec<&Value> { lines.iter().filter(|l| l["kind"] == kind).collect() };
+    // Every run stored: bob's and ours.
+    let ours = top
+        .iter()
+        .find(|e| e.player == "ada")
+        .expect("ada's run stored");
+    assert!(top.iter().any(|e| e.player == "bob"), "{top:?}");
+    assert_eq!(ours.ticks, hud["run_ticks"], "{top:?}");
+    let drawn: Vec<(u64, &str, u64, bool)> = of("top")
+        .iter()
+        .map(|l| {
+            (
+                l["place"].as_u64().unwrap(),
+                l["name"].as_str().unwrap(),
+                l["millis"].as_u64().unwrap(),
+                l["ours"].as_bool().unwrap(),
+            )
+        })
+        .collect();
+    let stored: Vec<(u64, &str, u64, bool)> = top
+        .iter()
+        .map(|e| {
+            (
+                u64::from(e.place),
+                e.player.as_str(),
+                e.millis,
+                e.player == "ada",
+            )
+        })
+        .collect();
+    assert_eq!(drawn, stored, "{card}");
+    let best = of("best");
+    assert_eq!(best.len(), 1, "{card}");
+    assert_eq!(best[0]["millis"], ours.millis, "{card}");
+    assert_eq!(best[0]["rank"], ours.place, "{card}");
+    let expected = format!(
+        "best {} \u{b7} #{} on this level",
+        time_ms(ours.millis),
+        ours.place
+    );
+    assert_eq!(best[0]["text"], expected.as_str(), "{card}");
+    // Our first run on the level: a personal best, and the record when
+    // first.
+    assert_eq!(ours.runs, 1, "{top:?}");
+    let headline = if ours.place == 1 {
+        "NEW RECORD!"
+    } else {
+        "new personal best!"
+    };
+    let said: Vec<&Value> = of("headline").iter().map(|l| &l["text"]).collect();
+    assert_eq!(said, [headline], "{card}");
+    // Drawn: our row in gold, the others not.
+    for line in of("top") {
+        let gold = gold_in(img, card, line);
+        if line["ours"] == true {
+            assert!(gold >= 20, "our row has {gold} gold pixels: {line}");
+        } else {
+            assert_eq!(gold, 0, "another's row is gold: {line}");
+        }
+    }
+    eprintln!("the card: {card}");
 }

@@ -25,7 +25,7 @@ use macroquad::prelude::*;
 use crate::draw::art::ArtView;
 use crate::draw::camera::{self, Camera};
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
-use crate::draw::{debug, fx, hud};
+use crate::draw::{card, debug, fx, hud};
 use crate::input::keys::{Bindings, Gamepads};
 use crate::input::script::Script;
 use crate::outcome::{fail, EXIT_FAILED, EXIT_JOIN_TIMEOUT, EXIT_UNTRUSTED};
@@ -183,6 +183,8 @@ struct Hud {
     run: Option<hud::RunInfo>,
     name: String,
     results: Vec<hud::ResultRow>,
+    /// The results card, once our run is finished.
+    card: Option<card::Card>,
 }
 
 impl GameLoop {
@@ -481,7 +483,7 @@ impl GameLoop {
             .map(|p| p.name.as_deref().unwrap_or(&self.setup.name))
     }
 
-    /// Draws a failure over the scene; our run, name and the room's results for the HUD.
+    /// Draws a failure over the scene; our run, name, the room's results and the results card for the HUD.
     fn hud_info(&self, scene: &Scene) -> Hud {
         // A failure covers the scene; the HUD's figures mean nothing then.
         let failure = self.failed.as_deref().map(hud::failure);
@@ -499,15 +501,38 @@ impl GameLoop {
             .and_then(|p| p.name.as_deref())
             .unwrap_or(&self.setup.name)
             .to_owned();
-        // The room's results table, names from the roster.
-        let results: Vec<hud::ResultRow> = self.setup.play.game().map_or_else(Vec::new, |g| {
+        let results = self.room_results(&name);
+        // Once finished: the card, with the records online.
+        let card = run.filter(|r| r.place.is_some()).map(|run| {
+            card::Card::new(
+                &run,
+                &self.restart_key,
+                self.setup.play.records(),
+                &name,
+                vec2(screen_width(), screen_height()),
+                hud::measure,
+            )
+        });
+        Hud {
+            failure,
+            run,
+            name,
+            results,
+            card,
+        }
+    }
+
+    /// The room's results table: everyone in the game who finished, names
+    /// from the roster (ours: `name`).
+    fn room_results(&self, name: &str) -> Vec<hud::ResultRow> {
+        self.setup.play.game().map_or_else(Vec::new, |g| {
             g.game()
                 .results()
                 .iter()
                 .map(|r| hud::ResultRow {
                     place: r.place.unwrap_or(0),
                     name: if r.id == g.me() {
-                        name.clone()
+                        name.to_owned()
                     } else {
                         g.player_names()
                             .get(&r.id)
@@ -519,13 +544,7 @@ impl GameLoop {
                     ours: r.id == g.me(),
                 })
                 .collect()
-        });
-        Hud {
-            failure,
-            run,
-            name,
-            results,
-        }
+        })
     }
 
     /// "sound off: why", for the first seconds after the start.
@@ -554,6 +573,9 @@ impl GameLoop {
                 results: &hud.results,
             };
             hud::draw(&info, &self.graph, now);
+            if let Some(card) = &hud.card {
+                card::draw(card);
+            }
         }
         if let (None, Some(text)) = (&hud.failure, self.setup.play.banner()) {
             hud::banner(&text);
@@ -642,6 +664,7 @@ impl GameLoop {
                 muted: self.audio.is_muted(),
                 sound_notice: self.sound_notice(now),
                 results: &hud.results,
+                card: hud.card.as_ref(),
             }),
             failure: self.failed.as_deref().zip(hud.failure.as_ref()),
             fx: shot::FxShot {

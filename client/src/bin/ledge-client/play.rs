@@ -6,6 +6,7 @@
 use std::time::Duration;
 
 use crate::draw::anim::{spread, Animator, Pose};
+use crate::draw::card::Records;
 use glam::IVec2;
 use ledge_client::game::ClientGame;
 use ledge_client::net::NetStatus;
@@ -93,6 +94,42 @@ enum Mode {
     Online(Box<OnlineGame>),
 }
 
+/// Which of the server's standings speak of our current run: those it
+/// sent after the run was last seen unfinished (a standing is sent once
+/// the finished run is stored, so after we see the finish; one the run
+/// before left behind must not be shown as this run's, even if it reads
+/// the same).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RunStandings {
+    /// [`ledge_client::OnlineGame::standings`] when our run was last seen
+    /// unfinished.
+    before: u64,
+}
+
+impl RunStandings {
+    /// Notes the server's count of standings so far, `count`, while our
+    /// run is not `finished`.
+    pub fn watch(&mut self, finished: bool, count: u64) {
+        if !finished {
+            self.before = count;
+        }
+    }
+
+    /// What the card says of the records: `standing`, the newest (its
+    /// count `count`), once it is our current run's; saving until then.
+    pub fn records<'a>(
+        &self,
+        count: u64,
+        standing: Option<&'a Result<ledge_shared::protocol::Standing, String>>,
+    ) -> Records<'a> {
+        match standing {
+            Some(Ok(standing)) if count > self.before => Records::Recorded(standing),
+            Some(Err(reason)) if count > self.before => Records::NotRecorded(reason),
+            _ => Records::Saving,
+        }
+    }
+}
+
 /// What is being played.
 pub struct Play {
     /// The level drawn until the server's is known.
@@ -101,6 +138,8 @@ pub struct Play {
     /// The server's address as the player gave it (online).
     server: String,
     started: Instant,
+    /// Which standings are our current run's (online).
+    standings: RunStandings,
 }
 
 impl Play {
@@ -113,6 +152,7 @@ impl Play {
             mode: Mode::Offline(Box::new(game)),
             server: String::new(),
             started: Instant::now(),
+            standings: RunStandings::default(),
         })
     }
 
@@ -128,6 +168,7 @@ impl Play {
             mode: Mode::Online(Box::new(online)),
             server,
             started: Instant::now(),
+            standings: RunStandings::default(),
         })
     }
 
@@ -140,6 +181,7 @@ impl Play {
             mode: Mode::Online(Box::new(OnlineGame::with_network(net, server, name))),
             server: server.to_owned(),
             started: Instant::now(),
+            standings: RunStandings::default(),
         }
     }
 
@@ -148,10 +190,26 @@ impl Play {
     /// this call. Returns the ticks run.
     pub fn update(&mut self, remaining: u64, buttons: impl FnMut(u64) -> Buttons) -> u64 {
         let now = Instant::now();
-        match &mut self.mode {
+        let ran = match &mut self.mode {
             Mode::Online(online) => online.update_ticks(now, remaining, buttons),
             Mode::Offline(game) => game.update(now, remaining, buttons, |_, _| {}),
+        };
+        let finished = self.me().is_some_and(|me| me.place.is_some());
+        if let Some(count) = self.connection().map(OnlineGame::standings) {
+            self.standings.watch(finished, count);
         }
+        ran
+    }
+
+    /// Where our finished run stands in the server's records, for the
+    /// results card: `None` offline (no records), saving until the server
+    /// speaks of this run.
+    pub fn records(&self) -> Option<Records<'_>> {
+        let online = self.connection()?;
+        Some(
+            self.standings
+                .records(online.standings(), online.standing()),
+        )
     }
 
     /// Waits up to `timeout` for the network thread's first word (joined,
@@ -338,5 +396,61 @@ impl Play {
             )),
             _ => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::RunStandings;
+    use crate::draw::card::Records;
+    use ledge_shared::protocol::Standing;
+
+    fn standing(millis: u64) -> Standing {
+        Standing {
+            millis,
+            personal_best: millis,
+            new_personal_best: true,
+            new_record: false,
+            rank: 2,
+            top: Vec::new(),
+        }
+    }
+
+    /// A standing counts for the run it came after: saving until the
+    /// server speaks of the run seen finishing, even when what it said of
+    /// the run before reads the same.
+    #[test]
+    fn only_a_standing_sent_after_the_run_shows_on_its_card() {
+        let first = Ok(standing(9_950));
+        let mut runs = RunStandings::default();
+        // Running, then finished: nothing from the server yet.
+        runs.watch(false, 0);
+        runs.watch(true, 0);
+        assert_eq!(runs.records(0, None), Records::Saving);
+        // The server's word on it: shown.
+        runs.watch(true, 1);
+        assert_eq!(
+            runs.records(1, Some(&first)),
+            Records::Recorded(&standing(9_950))
+        );
+        // Run again: that word belongs to the first run, even read the
+        // same as the next one's will.
+        runs.watch(false, 1);
+        runs.watch(true, 1);
+        assert_eq!(runs.records(1, Some(&first)), Records::Saving);
+        let refused = Err("the records are off".to_owned());
+        runs.watch(true, 2);
+        assert_eq!(
+            runs.records(2, Some(&refused)),
+            Records::NotRecorded("the records are off")
+        );
+        // A word that came in the same frame as the finish counts.
+        let mut late = RunStandings::default();
+        late.watch(false, 3);
+        late.watch(true, 4);
+        assert_eq!(
+            late.records(4, Some(&first)),
+            Records::Recorded(&standing(9_950))
+        );
     }
 }

@@ -28,6 +28,18 @@
 //!     "name": "ada", "coins": 2, "coins_total": 10, "deaths": 1,
 //!     "run_ticks": 412, "tick_rate": 60, "time": "0:06.86",
 //!     "place": null, "results_card": false,
+//!     "card": {                        // the results card; null unless drawn
+//!       "panel": [330.0, 40.0, 348.0, 420.0],  // x, y, w, h
+//!       "records": "recorded",         // "saving", "not_recorded"; null offline
+//!       "lines": [                     // top to bottom, as drawn
+//!         {"kind": "place", "text": "finished 1st", "baseline": 78.0, "size": 30.0},
+//!         {"kind": "headline", "text": "new personal best!", "record": false},
+//!         {"kind": "best", "text": "best 0:11.016 · #2 on this level",
+//!          "millis": 11016, "time": "0:11.016", "rank": 2},
+//!         {"kind": "top", "text": "1. bob 0:09.950", "place": 1, "name": "bob",
+//!          "millis": 9950, "time": "0:09.950", "ours": false}, ...
+//!       ]                              // kinds: place, time, tally, headline, best,
+//!     },                               // top_title, top, saving, not_recorded, again
 //!     "net_panel": false, "muted": false, "sound_notice": "sound off: ...",
 //!     "results": [                     // the room's: everyone who finished
 //!       {"place": 1, "name": "bob", "ticks": 598, "deaths": 0, "ours": false}
@@ -57,6 +69,7 @@ use macroquad::math::{Rect, Vec2};
 use macroquad::texture::get_screen_data;
 
 use crate::draw::camera::View;
+use crate::draw::card::{millis_time, Card, Says};
 use crate::draw::hud::{BannerLayout, FAILURE_PANEL};
 use crate::draw::render::palette;
 
@@ -114,6 +127,8 @@ pub struct HudShot<'a> {
     /// The room's results (the table is drawn when someone besides us is
     /// in it).
     pub results: &'a [crate::draw::hud::ResultRow],
+    /// The results card as drawn, once our run is finished.
+    pub card: Option<&'a Card>,
 }
 
 /// A remote player as drawn.
@@ -288,8 +303,9 @@ fn describe_hud(s: &mut String, hud: Option<&HudShot>) {
                 let _ = writeln!(s, "    \"time\": {},", json_string(&time));
                 let place = r.place.map_or("null".to_owned(), |p| p.to_string());
                 let _ = writeln!(s, "    \"place\": {place},");
-                let _ = writeln!(s, "    \"results_card\": {},", r.place.is_some());
+                let _ = writeln!(s, "    \"results_card\": {},", h.card.is_some());
             }
+            describe_card(s, h.card);
             let _ = writeln!(s, "    \"net_panel\": {},", h.net_panel);
             let _ = writeln!(s, "    \"muted\": {},", h.muted);
             let notice = h.sound_notice.map_or("null".to_owned(), json_string);
@@ -320,6 +336,62 @@ fn describe_hud(s: &mut String, hud: Option<&HudShot>) {
             let _ = writeln!(s, "  \"hud\": null,");
         }
     }
+}
+
+/// The results card as drawn (`null` when it is not): its panel, what it
+/// says of the records (`null` offline) and its lines, each with its
+/// kind, text, baseline and font size, and a top run's place, name (as drawn), time and whether
+/// it is ours, our best's time and rank.
+fn describe_card(s: &mut String, card: Option<&Card>) {
+    let Some(card) = card else {
+        let _ = writeln!(s, "    \"card\": null,");
+        return;
+    };
+    let p = card.panel;
+    let records = card.records.map_or("null".to_owned(), json_string);
+    let lines: Vec<String> = card.lines.iter().map(describe_card_line).collect();
+    let _ = writeln!(s, "    \"card\": {{");
+    let _ = writeln!(
+        s,
+        "      \"panel\": [{:.3}, {:.3}, {:.3}, {:.3}],",
+        p.x, p.y, p.w, p.h
+    );
+    let _ = writeln!(s, "      \"records\": {records},");
+    let _ = writeln!(
+        s,
+        "      \"lines\": [\n        {}\n      ]",
+        lines.join(",\n        ")
+    );
+    let _ = writeln!(s, "    }},");
+}
+
+/// One line of the card, as a JSON object.
+fn describe_card_line(line: &crate::draw::card::Line) -> String {
+    let extra = match &line.says {
+        Says::Top {
+            place,
+            name,
+            millis,
+            ours,
+        } => format!(
+            ", \"place\": {place}, \"name\": {}, \"millis\": {millis}, \"time\": {}, \"ours\": {ours}",
+            json_string(name),
+            json_string(&millis_time(*millis))
+        ),
+        Says::Best { millis, rank } => format!(
+            ", \"millis\": {millis}, \"time\": {}, \"rank\": {rank}",
+            json_string(&millis_time(*millis))
+        ),
+        Says::Headline { record } => format!(", \"record\": {record}"),
+        _ => String::new(),
+    };
+    format!(
+        "{{\"kind\": \"{}\", \"text\": {}, \"baseline\": {:.3}, \"size\": {:.3}{extra}}}",
+        line.says.kind(),
+        json_string(&line.text),
+        line.baseline,
+        line.size
+    )
 }
 
 /// The session's failure and its panel (`null` unless it failed).
@@ -404,6 +476,7 @@ mod tests {
                         ours: true,
                     },
                 ],
+                card: None,
             }),
             failure: None,
             fx: FxShot {
@@ -498,5 +571,123 @@ mod tests {
         let json: serde_json::Value =
             serde_json::from_str(&describe(&none, Path::new("f.png"), 480, 270)).expect("JSON");
         assert!(json["failure"].is_null());
+    }
+
+    /// The card's lines as laid out: kinds, texts, the top runs' names and
+    /// times, our row, our best and rank; `null` without a card.
+    #[test]
+    fn json_tells_what_the_card_says_of_the_records() {
+        use crate::draw::card::Records;
+        use crate::draw::hud::RunInfo;
+        use ledge_shared::protocol::{Standing, TopRun};
+        let view = View {
+            zoom: 1.0,
+            offset: Vec2::ZERO,
+            screen: Vec2::new(960.0, 540.0),
+        };
+        let run = RunInfo {
+            coins: 1,
+            coins_total: 13,
+            deaths: 2,
+            run_ticks: 661,
+            tick_rate: 60,
+            place: Some(1),
+        };
+        let standing = Standing {
+            millis: 11_016,
+            personal_best: 11_016,
+            new_personal_best: true,
+            new_record: false,
+            rank: 2,
+            top: vec![
+                TopRun {
+                    name: "bo \"b\"".into(),
+                    millis: 9_950,
+                },
+                TopRun {
+                    name: "ada".into(),
+                    millis: 11_016,
+                },
+            ],
+        };
+        let width = |t: &str, size: f32| t.chars().count() as f32 * size * 0.5;
+        let card = Card::new(
+            &run,
+            "R",
+            Some(Records::Recorded(&standing)),
+            "ada",
+            view.screen,
+            width,
+        );
+        let hud = |card| HudShot {
+            name: "ada",
+            run: Some(run),
+            net_panel: false,
+            muted: false,
+            sound_notice: None,
+            results: &[],
+            card,
+        };
+        let shot = |hud| Shot {
+            tick: 0,
+            view: &view,
+            level_px: Rect::new(0.0, 0.0, 1.0, 1.0),
+            tile_px: 16,
+            server: None,
+            drawn: None,
+            remotes: Vec::new(),
+            hud: Some(hud),
+            failure: None,
+            fx: FxShot {
+                particles: 0,
+                shake: 0.0,
+                flash: 0.0,
+                recent: &[],
+                dead: false,
+            },
+        };
+        let json = describe(&shot(hud(Some(&card))), Path::new("c.png"), 960, 540);
+        let json: serde_json::Value = serde_json::from_str(&json).expect("JSON");
+        let c = &json["hud"]["card"];
+        assert_eq!(json["hud"]["results_card"], true);
+        assert_eq!(c["records"], "recorded");
+        assert_eq!(c["panel"][2], card.panel.w);
+        let kinds: Vec<&str> = c["lines"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|l| l["kind"].as_str().unwrap())
+            .collect();
+        assert_eq!(
+            kinds,
+            [
+                "place",
+                "time",
+                "tally",
+                "headline",
+                "best",
+                "top_title",
+                "top",
+                "top",
+                "again"
+            ]
+        );
+        let lines = &c["lines"];
+        assert_eq!(lines[3]["text"], "new personal best!");
+        assert_eq!(lines[3]["record"], false);
+        assert_eq!(lines[4]["millis"], 11_016);
+        assert_eq!(lines[4]["time"], "0:11.016");
+        assert_eq!(lines[4]["rank"], 2);
+        assert_eq!(lines[6]["name"], "bo \"b\"");
+        assert_eq!(lines[6]["time"], "0:09.950");
+        assert_eq!(lines[6]["ours"], false);
+        assert_eq!(lines[7]["place"], 2);
+        assert_eq!(lines[7]["ours"], true);
+        let baseline = lines[7]["baseline"].as_f64().unwrap();
+        assert!((baseline - f64::from(card.lines[7].baseline)).abs() < 0.001);
+        let json = describe(&shot(hud(None)), Path::new("c.png"), 960, 540);
+        let json: serde_json::Value = serde_json::from_str(&json).expect("JSON");
+        assert!(json["hud"]["card"].is_null());
+        assert_eq!(json["hud"]["results_card"], false);
     }
 }

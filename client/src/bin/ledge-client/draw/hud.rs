@@ -1,5 +1,6 @@
 //! The heads-up display: by default our name, coins (of the level's),
-//! deaths and the run timer, and a results card once finished; behind F3
+//! deaths and the run timer (the results card once finished is
+//! [`super::card`]'s, and uses the formats here); behind F3
 //! the network panel (connection, ping, loss, fps, bandwidth, corrections)
 //! and a net graph of the last two seconds (round-trip time and snapshot
 //! arrivals); the controls hint, fading after the first moves.
@@ -14,7 +15,8 @@ pub const GRAPH_SECONDS: f64 = 2.0;
 
 const FONT: f32 = 18.0;
 const PANEL: Color = Color::new(0.05, 0.06, 0.1, 0.62);
-const DIM: Color = Color::new(0.75, 0.8, 0.9, 1.0);
+/// Titles, hints and secondary figures.
+pub const DIM: Color = Color::new(0.75, 0.8, 0.9, 1.0);
 
 /// The last seconds of network measurements.
 #[derive(Debug, Default)]
@@ -185,7 +187,22 @@ pub fn ordinal(n: u32) -> String {
     format!("{n}{suffix}")
 }
 
-const GOLD: Color = Color::new(1.0, 0.85, 0.25, 1.0);
+/// Our figures, our place, our row.
+pub const GOLD: Color = Color::new(1.0, 0.85, 0.25, 1.0);
+
+/// Draws `text` with its baseline at `y`, every character on a whole
+/// pixel: the font is a pixel font, and a character drawn between pixels
+/// (one line's characters advance by fractions of a pixel) comes out
+/// smeared, at 960x540 the figure after `deaths` looked half hidden.
+pub fn crisp_text(text: &str, x: f32, y: f32, size: f32, color: Color) {
+    let y = y.round();
+    let mut pen = x;
+    let mut buf = [0u8; 4];
+    for c in text.chars() {
+        let glyph: &str = c.encode_utf8(&mut buf);
+        pen += draw_text(glyph, pen.round(), y, size, color).width;
+    }
+}
 
 /// A panel of `lines` with its top-left corner at `(x, y)`; returns its
 /// height.
@@ -199,14 +216,14 @@ fn panel(lines: &[(String, Color, f32)], x: f32, y: f32) -> f32 {
     let mut baseline = y + 5.0;
     for (l, c, size) in lines {
         baseline += size + 2.0;
-        draw_text(l, x + 8.0, baseline - size * 0.22, *size, *c);
+        crisp_text(l, x + 8.0, baseline - size * 0.22, *size, *c);
     }
     height
 }
 
 /// Draws the HUD: our name, coins, deaths and run timer; the network
-/// panel and graph when `show_net`; the controls hint; the results card
-/// once finished; sound notices.
+/// panel and graph when `show_net`; the room's results table; the
+/// controls hint; sound notices.
 pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
     let mut lines: Vec<(String, Color, f32)> = vec![(info.name.to_owned(), WHITE, 22.0)];
     if let Some(run) = &info.run {
@@ -290,9 +307,6 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
         };
         results_table(info.results, rate, top);
     }
-    if let Some(run) = info.run.filter(|r| r.place.is_some()) {
-        results_card(&run, info.restart_key);
-    }
     if info.hint_alpha > 0.0 {
         // A page has no quit key: its tab is closed.
         let quit = if cfg!(target_arch = "wasm32") {
@@ -317,7 +331,7 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
                 ..PANEL
             },
         );
-        draw_text(&help, x, y, 16.0, Color { a, ..DIM });
+        crisp_text(&help, x, y, 16.0, Color { a, ..DIM });
     }
 }
 
@@ -353,47 +367,6 @@ fn results_table(rows: &[ResultRow], rate: u32, top: f32) {
         .map(|(l, _, size)| measure_text(l, None, *size as u16, 1.0).width)
         .fold(0.0, f32::max);
     panel(&lines, screen_width() - width - 24.0, top);
-}
-
-/// The results card, centred: time, deaths, coins, place, how to run again.
-fn results_card(run: &RunInfo, restart_key: &str) {
-    let place = run.place.unwrap_or(0);
-    let lines = [
-        (format!("finished {}", ordinal(place)), GOLD, 30.0),
-        (run_time(run.run_ticks, run.tick_rate), WHITE, 40.0),
-        (
-            format!(
-                "deaths {}   coins {} of {}",
-                run.deaths, run.coins, run.coins_total
-            ),
-            WHITE,
-            20.0,
-        ),
-        (format!("{restart_key}: run again"), DIM, 18.0),
-    ];
-    let widest = lines
-        .iter()
-        .map(|(l, _, size)| measure_text(l, None, *size as u16, 1.0).width)
-        .fold(0.0f32, f32::max);
-    let (w, h) = (
-        widest + 48.0,
-        lines.iter().map(|l| l.2 * 1.3).sum::<f32>() + 24.0,
-    );
-    let (x, y) = ((screen_width() - w) / 2.0, (screen_height() - h) * 0.3);
-    draw_rectangle(x, y, w, h, Color::new(0.05, 0.06, 0.1, 0.85));
-    draw_rectangle_lines(x, y, w, h, 2.0, GOLD);
-    let mut baseline = y + 12.0;
-    for (l, c, size) in &lines {
-        baseline += size * 1.3;
-        let lw = measure_text(l, None, *size as u16, 1.0).width;
-        draw_text(
-            l,
-            (screen_width() - lw) / 2.0,
-            baseline - size * 0.3,
-            *size,
-            *c,
-        );
-    }
 }
 
 /// Font sizes a banner tries, largest first, until its text fits the
@@ -472,7 +445,8 @@ impl BannerLayout {
     }
 }
 
-fn measure(text: &str, size: f32) -> f32 {
+/// How wide `text` is drawn at font size `size`, pixels.
+pub fn measure(text: &str, size: f32) -> f32 {
     measure_text(text, None, size as u16, 1.0).width
 }
 
@@ -483,7 +457,7 @@ fn draw_banner(layout: &BannerLayout, panel: Color) {
     for (i, (paragraph, line)) in layout.lines.iter().enumerate() {
         let x = (screen_width() - measure(line, layout.size)) / 2.0;
         let colour = if *paragraph == 0 { WHITE } else { DIM };
-        draw_text(line, x, layout.baseline(i), layout.size, colour);
+        crisp_text(line, x, layout.baseline(i), layout.size, colour);
     }
 }
 

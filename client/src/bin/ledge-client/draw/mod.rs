@@ -1,8 +1,9 @@
 //! What the window draws, each frame, from the game's views: where it looks
 //! ([`camera`]), the world and the players ([`render`], the level's own art
 //! in [`art`]), how the players move between ticks ([`anim`]), particles,
-//! shake and flashes ([`fx`]), the heads-up display ([`hud`]) and the
-//! debug overlay ([`debug`]).
+//! shake and flashes ([`fx`]), the heads-up display ([`hud`]), the results
+//! card once our run is finished ([`card`]) and the debug overlay
+//! ([`debug`]).
 //!
 //! Grouped so that the front end's layout says what it does; this module
 //! only declares them.
@@ -10,6 +11,7 @@
 pub mod anim;
 pub mod art;
 pub mod camera;
+pub mod card;
 pub mod debug;
 pub mod fx;
 pub mod hud;
