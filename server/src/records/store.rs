@@ -6,11 +6,12 @@
 //! on disk before the player is told. Times compare in milliseconds, so
 //! servers at other tick rates share a level's table; players go by name.
 
+use std::collections::BTreeMap;
 use std::time::Duration;
 
 use ledge_shared::protocol::{Standing, TopRun, MAX_TOP};
 use sqlx::any::{AnyConnectOptions, AnyPoolOptions};
-use sqlx::{Acquire, Any, Row, Transaction};
+use sqlx::{Any, Row, Transaction};
 use sqlx::{AnyConnection, AnyPool, Connection};
 
 use super::schema::{self, Migrated, SCHEMA_VERSION};
@@ -149,25 +150,53 @@ impl RecordStore {
 
     /// Stores `runs` in one transaction and says where each stands (a run
     /// stored before, by its key, is not stored again and stands as it
-    /// did). Nothing is stored unless everything is.
+    /// did). Nothing is stored unless everything is. Each level's players'
+    /// bests are read once per batch and kept up to date in memory, so a
+    /// batch costs its inserts and one query per level.
     pub async fn store(&self, runs: &[FinishedRun]) -> Result<Vec<Standing>, RecordsError> {
         let err = self.query_err();
         let mut conn = self.pool.acquire().await.map_err(&err)?;
         let mut tx = conn.begin().await.map_err(&err)?;
+        let mut bests: BTreeMap<&str, Bests> = BTreeMap::new();
+        for run in runs {
+            if !bests.contains_key(run.level_hash.as_str()) {
+                let level = Bests::read(&mut tx, &run.level_hash).await.map_err(&err)?;
+                bests.insert(&run.level_hash, level);
+            }
+        }
         let mut news = Vec::with_capacity(runs.len());
         for run in runs {
-            news.push(insert(&mut tx, run).await.map_err(&err)?);
-        }
-        let mut standings = Vec::with_capacity(runs.len());
-        for (run, (new_personal_best, new_record)) in runs.iter().zip(news) {
-            standings.push(
-                standing(&mut tx, run, new_personal_best, new_record)
-                    .await
-                    .map_err(&err)?,
-            );
+            let inserted = insert(&mut tx, run).await.map_err(&err)?;
+            let level = bests.get_mut(run.level_hash.as_str()).expect("read above");
+            news.push(level.add(run, inserted));
         }
         tx.commit().await.map_err(&err)?;
-        Ok(standings)
+        let ranked: BTreeMap<&str, Vec<(u64, &str)>> =
+            bests.iter().map(|(&h, b)| (h, b.ranked())).collect();
+        Ok(runs
+            .iter()
+            .zip(news)
+            .map(|(run, (new_personal_best, new_record))| {
+                let level = &bests[run.level_hash.as_str()];
+                let ranked = &ranked[run.level_hash.as_str()];
+                let personal_best = level.of(&run.player).unwrap_or(run.millis());
+                Standing {
+                    millis: run.millis(),
+                    personal_best,
+                    new_personal_best,
+                    new_record,
+                    rank: ranked.partition_point(|&(b, _)| b < personal_best) as u32 + 1,
+                    top: ranked
+                        .iter()
+                        .take(MAX_TOP)
+                        .map(|&(millis, name)| TopRun {
+                            name: name.to_owned(),
+                            millis,
+                        })
+                        .collect(),
+                }
+            })
+            .collect())
     }
 
     /// The level's best `n` players (at most [`MAX_TOP_QUERY`]), fastest
@@ -274,26 +303,59 @@ async fn set_up(conn: &mut AnyConnection) -> Result<(), sqlx::Error> {
     Ok(())
 }
 
-/// Inserts `run` unless its key is stored; whether it is a new personal
-/// best and a new record (both false for a run stored before).
-async fn insert(
-    tx: &mut Transaction<'_, Any>,
-    run: &FinishedRun,
-) -> Result<(bool, bool), sqlx::Error> {
-    let millis = run.millis() as i64;
-    let own: Option<i64> =
-        sqlx::query("SELECT MIN(millis) AS best FROM runs WHERE level_hash = $1 AND player = $2")
-            .bind(run.level_hash.clone())
-            .bind(run.player.clone())
-            .fetch_one(&mut **tx)
-            .await?
-            .try_get("best")?;
-    let level: Option<i64> =
-        sqlx::query("SELECT MIN(millis) AS best FROM runs WHERE level_hash = $1")
-            .bind(run.level_hash.clone())
-            .fetch_one(&mut **tx)
-            .await?
-            .try_get("best")?;
+/// Every player's best time on one level, in milliseconds.
+#[derive(Debug, Default)]
+struct Bests(BTreeMap<String, u64>);
+
+impl Bests {
+    /// The level's bests as stored.
+    async fn read(tx: &mut Transaction<'_, Any>, level_hash: &str) -> Result<Bests, sqlx::Error> {
+        let rows = sqlx::query(
+            "SELECT player, MIN(millis) AS best FROM runs WHERE level_hash = $1 GROUP BY player",
+        )
+        .bind(level_hash.to_owned())
+        .fetch_all(&mut **tx)
+        .await?;
+        let mut bests = Bests::default();
+        for row in rows {
+            let best: i64 = row.try_get("best")?;
+            bests.0.insert(row.try_get("player")?, best.max(0) as u64);
+        }
+        Ok(bests)
+    }
+
+    /// `player`'s best.
+    fn of(&self, player: &str) -> Option<u64> {
+        self.0.get(player).copied()
+    }
+
+    /// Counts `run` (if it was `inserted`): whether it beat its player's
+    /// best and the level's record.
+    fn add(&mut self, run: &FinishedRun, inserted: bool) -> (bool, bool) {
+        let millis = run.millis();
+        let record = self.0.values().min().copied();
+        let own = self.of(&run.player);
+        if !inserted {
+            return (false, false);
+        }
+        self.0
+            .insert(run.player.clone(), own.map_or(millis, |b| b.min(millis)));
+        (
+            own.is_none_or(|b| millis < b),
+            record.is_none_or(|b| millis < b),
+        )
+    }
+
+    /// (best, player), fastest first (then by name).
+    fn ranked(&self) -> Vec<(u64, &str)> {
+        let mut v: Vec<(u64, &str)> = self.0.iter().map(|(p, &b)| (b, p.as_str())).collect();
+        v.sort();
+        v
+    }
+}
+
+/// Inserts `run` unless its key is stored; whether it was.
+async fn insert(tx: &mut Transaction<'_, Any>, run: &FinishedRun) -> Result<bool, sqlx::Error> {
     let inserted = sqlx::query(
         "INSERT INTO runs (run_key, level_hash, level_name, player, ticks, tick_rate, millis, \
                            deaths, coins, place, finished_at, replay_id) \
@@ -306,71 +368,15 @@ async fn insert(
     .bind(run.player.clone())
     .bind(i64::from(run.ticks))
     .bind(i64::from(run.tick_rate))
-    .bind(millis)
+    .bind(run.millis() as i64)
     .bind(i64::from(run.deaths))
     .bind(i64::from(run.coins))
     .bind(i64::from(run.place))
     .bind(run.finished_at_ms)
     .execute(&mut **tx)
     .await?
-    .rows_affected()
-        == 1;
-    Ok((
-        inserted && own.is_none_or(|b| millis < b),
-        inserted && level.is_none_or(|b| millis < b),
-    ))
-}
-
-/// Where `run` stands now (its player's best, rank and the top ten).
-async fn standing(
-    tx: &mut Transaction<'_, Any>,
-    run: &FinishedRun,
-    new_personal_best: bool,
-    new_record: bool,
-) -> Result<Standing, sqlx::Error> {
-    let conn = tx.acquire().await?;
-    let best: Option<i64> =
-        sqlx::query("SELECT MIN(millis) AS best FROM runs WHERE level_hash = $1 AND player = $2")
-            .bind(run.level_hash.clone())
-            .bind(run.player.clone())
-            .fetch_one(&mut *conn)
-            .await?
-            .try_get("best")?;
-    let personal_best = best.unwrap_or(run.millis() as i64);
-    let ahead: i64 = sqlx::query(
-        "SELECT COUNT(*) AS n FROM (SELECT player, MIN(millis) AS best FROM runs \
-         WHERE level_hash = $1 GROUP BY player) b WHERE b.best < $2",
-    )
-    .bind(run.level_hash.clone())
-    .bind(personal_best)
-    .fetch_one(&mut *conn)
-    .await?
-    .try_get("n")?;
-    let rows = sqlx::query(
-        "SELECT player, MIN(millis) AS best FROM runs WHERE level_hash = $1 \
-         GROUP BY player ORDER BY MIN(millis) ASC, player ASC LIMIT $2",
-    )
-    .bind(run.level_hash.clone())
-    .bind(MAX_TOP as i64)
-    .fetch_all(&mut *conn)
-    .await?;
-    let top = rows
-        .iter()
-        .map(|row| {
-            Ok(TopRun {
-                name: row.try_get("player")?,
-                millis: row.try_get::<i64, _>("best")?.max(0) as u64,
-            })
-        })
-        .collect::<Result<_, sqlx::Error>>()?;
-    Ok(Standing {
-        millis: run.millis(),
-        personal_best: personal_best.max(0) as u64,
-        new_personal_best,
-        new_record,
-        rank: (ahead.max(0) as u32).saturating_add(1),
-        top,
-    })
+    .rows_affected();
+    Ok(inserted == 1)
 }
 
 #[cfg(test)]
