@@ -109,6 +109,8 @@ pub struct BotReport {
     /// Runs the server's snapshots showed finishing (our player's goal
     /// flag turning on).
     pub finishes: u32,
+    /// Our player's goal flag in the newest snapshot.
+    pub(crate) was_won: bool,
     /// The brain's progress note.
     pub progress: String,
     /// Why it stopped early (connection refused, closed by the server...).
@@ -121,6 +123,37 @@ pub struct BotReport {
 
 impl BotReport {
     /// Counts a snapshot received ([`BotReport::snapshots`],
+    /// Follows our player's run in a server snapshot: the goal flag turning
+    /// on (a finish), the first finish's tick and time.
+    fn observe_run(&mut self, update: &SnapshotUpdate, me: PlayerId) {
+        if let Some(mine) = update.state.get(me.0) {
+            let won = mine.flags & player_flags::WON != 0;
+            if won && !self.was_won {
+                self.finishes += 1;
+            }
+            self.was_won = won;
+            if won && !self.won {
+                self.won = true;
+                self.won_at_tick = Some(update.state.tick);
+            }
+        }
+        if let Some(run) = update.state.get(RUN_ID_BASE + me.0) {
+            // A finished run has its order; its ticks are final.
+            if run.aux != 0 && self.finish_ticks.is_none() {
+                self.finish_ticks = u32::try_from(run.pos.x).ok();
+            }
+        }
+    }
+
+    /// Takes what the server said about our finished run's record.
+    fn told(&mut self, standing: Result<Standing, String>) {
+        match &standing {
+            Ok(_) => self.recorded += 1,
+            Err(_) => self.not_recorded += 1,
+        }
+        self.standing = Some(standing);
+    }
+
     /// [`BotReport::covered_ticks`]).
     pub fn snapshot(&mut self, update: &SnapshotUpdate) {
         self.snapshots += 1;
@@ -251,7 +284,6 @@ pub async fn run_bot(
     let mut next_transport = started;
     let mut lingering = false;
     let mut linger_started = Instant::now();
-    let mut won_before = false;
     let ended = loop {
         let now = Instant::now();
         if options.stop_when_done && brain.done() && !lingering {
@@ -296,23 +328,7 @@ pub async fn run_bot(
         match event {
             Ok(SessionEvent::Snapshot(update)) => {
                 report.snapshot(&update);
-                if let Some(mine) = update.state.get(me.0) {
-                    let won = mine.flags & player_flags::WON != 0;
-                    if won && !won_before {
-                        report.finishes += 1;
-                    }
-                    won_before = won;
-                    if won && !report.won {
-                        report.won = true;
-                        report.won_at_tick = Some(update.state.tick);
-                    }
-                }
-                if let Some(run) = update.state.get(RUN_ID_BASE + me.0) {
-                    // A finished run has its order; its ticks are final.
-                    if run.aux != 0 && report.finish_ticks.is_none() {
-                        report.finish_ticks = u32::try_from(run.pos.x).ok();
-                    }
-                }
+                report.observe_run(&update, me);
                 if let Some(r) = game.on_snapshot(&update) {
                     if r.mispredicted || r.correction_px > 0.0 {
                         brain.on_correction();
@@ -321,13 +337,7 @@ pub async fn run_bot(
                 }
             }
             Ok(SessionEvent::Pong { rtt: Some(rtt), .. }) => game.on_rtt(rtt),
-            Ok(SessionEvent::RunRecorded(standing)) => {
-                match &standing {
-                    Ok(_) => report.recorded += 1,
-                    Err(_) => report.not_recorded += 1,
-                }
-                report.standing = Some(standing);
-            }
+            Ok(SessionEvent::RunRecorded(standing)) => report.told(standing),
             Ok(SessionEvent::Notice(NoticeKind::Kick { reason })) => {
                 break Some(format!("kicked: {reason}"))
             }
