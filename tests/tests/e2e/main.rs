@@ -24,6 +24,7 @@ mod page_session_quic;
 mod prediction;
 mod prediction_crowd;
 mod records;
+mod records_postgres;
 mod remote_players;
 mod resume;
 mod robustness;
