@@ -622,7 +622,7 @@ async fn open_records(
             (RecordsHandle::off("this server keeps no records"), None)
         }
         Err(e) => {
-            error!("{e}");
+            error!("records are off: {e}");
             (
                 RecordsHandle::off("the server's records database could not be opened"),
                 None,

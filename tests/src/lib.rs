@@ -10,7 +10,8 @@
 //! [`PredictedClient`] drives a predicting client ([`ClientGame`]) in real
 //! time with a scripted input, the way a player or bot would.
 //! [`browser`] drives headless Chromium over the DevTools protocol, for
-//! the browser client's tests.
+//! the browser client's tests. [`postgres`] runs a throwaway PostgreSQL
+//! cluster for a test; [`logs`] keeps the in-process server's log.
 
 use std::collections::BTreeSet;
 use std::net::SocketAddr;
@@ -506,6 +507,8 @@ impl PredictedClient {
 pub mod attack;
 pub mod browser;
 pub mod e2e;
+pub mod logs;
+pub mod postgres;
 pub mod server_process;
 pub mod web;
 

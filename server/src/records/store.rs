@@ -17,8 +17,13 @@ use sqlx::{AnyConnection, AnyPool, Connection};
 use super::schema::{self, Migrated, SCHEMA_VERSION};
 use super::{FinishedRun, RecordsError, RecordsTarget};
 
-/// How long opening or reaching the database may take.
+/// How long opening the database at start may take.
 pub const CONNECT_TIMEOUT: Duration = Duration::from_secs(10);
+/// How long a query waits for a connection: a pooled one, or a new one.
+/// A refused connection is retried until then (sqlx takes it for a
+/// database starting up), so while the database is down each of the
+/// writer's tries, and each records page, fails after this long.
+pub const ACQUIRE_TIMEOUT: Duration = Duration::from_secs(2);
 /// Connections in the pool.
 const POOL_SIZE: u32 = 4;
 /// Most top entries one query returns.
@@ -127,7 +132,7 @@ impl RecordStore {
         }
         let pool = AnyPoolOptions::new()
             .max_connections(POOL_SIZE)
-            .acquire_timeout(CONNECT_TIMEOUT)
+            .acquire_timeout(ACQUIRE_TIMEOUT)
             .after_connect(|conn, _| Box::pin(set_up(conn)))
             .connect_lazy_with(options);
         Ok(Some(RecordStore {

@@ -19,8 +19,10 @@ use super::{FinishedRun, RecordStore};
 pub const WRITE_QUEUE: usize = 4096;
 /// Most runs stored in one transaction.
 pub const BATCH: usize = 256;
-/// Waits before each retry of a failed batch.
-const RETRIES: [Duration; 3] = [
+/// Waits before each retry of a failed batch; then its runs are answered
+/// "not recorded". While the database is down, each try fails after
+/// [`super::store::ACQUIRE_TIMEOUT`].
+pub const RETRIES: [Duration; 3] = [
     Duration::from_millis(200),
     Duration::from_secs(1),
     Duration::from_secs(3),

@@ -25,6 +25,7 @@ mod prediction;
 mod prediction_crowd;
 mod records;
 mod records_kill;
+mod records_postgres;
 mod remote_players;
 mod resume;
 mod robustness;

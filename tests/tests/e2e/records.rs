@@ -13,7 +13,7 @@ use ledge_tests::TestServer;
 use crate::web_transports::{page, web_server};
 
 /// Runs `names` as runner bots at once, until each is done.
-async fn race(server: &TestServer, names: &[&str]) -> Vec<BotReport> {
+pub(crate) async fn race(server: &TestServer, names: &[&str]) -> Vec<BotReport> {
     let mut bots = Vec::new();
     for name in names {
         let session = server.join(name).await;
@@ -37,7 +37,7 @@ async fn race(server: &TestServer, names: &[&str]) -> Vec<BotReport> {
 }
 
 /// A run's time as the records keep it: milliseconds at 60 ticks a second.
-fn millis(ticks: u32) -> u64 {
+pub(crate) fn millis(ticks: u32) -> u64 {
     u64::from(ticks) * 1000 / 60
 }
 
