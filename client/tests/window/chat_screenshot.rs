@@ -34,22 +34,31 @@ struct Heard {
     lines: Vec<String>,
 }
 
-/// Bob: joins, greets ada once she is in the room, then listens for
-/// `listen` (ada's lines, until the window has long closed).
+/// After ada's line, bob listens this long more (her refused line would
+/// come a second after it).
+const AFTER_REPLY: Duration = Duration::from_secs(3);
+
+/// Bob: joins, greets ada once she is in the room, then listens to her
+/// (at most `listen`; [`AFTER_REPLY`] after her line).
 async fn bob(server: &TestServer, listen: Duration) -> Heard {
     let mut bob = connect(server.addr, "localhost", server.fingerprint, "bob")
         .await
         .expect("bob is welcomed");
     let mut ada: Option<PlayerId> = None;
     let mut lines = Vec::new();
-    let until = tokio::time::Instant::now() + listen;
+    let mut until = tokio::time::Instant::now() + listen;
     while let Ok(event) = tokio::time::timeout_at(until, bob.recv()).await {
         match event.expect("bob's session holds") {
             SessionEvent::PlayerJoined { id, name } if name == "ada" => {
                 ada = Some(id);
                 bob.chat(GREETING).await.expect("bob's line goes");
             }
-            SessionEvent::Chat { from, text } if Some(from) == ada => lines.push(text),
+            SessionEvent::Chat { from, text } if Some(from) == ada => {
+                if text == REPLY {
+                    until = until.min(tokio::time::Instant::now() + AFTER_REPLY);
+                }
+                lines.push(text);
+            }
             _ => {}
         }
     }
@@ -68,7 +77,7 @@ fn the_window_shows_chat_from_the_room_and_sends_typed_lines() {
     let script = tmp.path().join("chat.script");
     std::fs::write(&script, SCRIPT).unwrap();
     let (out, heard) = std::thread::scope(|s| {
-        let bob = s.spawn(|| server.block_on(bob(&server, Duration::from_secs(25))));
+        let bob = s.spawn(|| server.block_on(bob(&server, Duration::from_secs(60))));
         // Bob first (the roster names him to ada).
         std::thread::sleep(Duration::from_millis(500));
         let mut command =
@@ -112,10 +121,9 @@ fn the_window_shows_chat_from_the_room_and_sends_typed_lines() {
     // The refused line stays open, showing the override, saying why.
     let typing = &chat["typing"];
     assert_eq!(typing["text"], "say: sneaky [U+202E]txt.exe_", "{chat}");
-    let error = typing["error"].as_str().expect("the refusal");
-    assert!(
-        error.starts_with("not sent:") && error.contains("U+202E"),
-        "{error}"
+    assert_eq!(
+        typing["error"], "not sent: U+202E is a direction override or an invisible character",
+        "{chat}"
     );
     eprintln!("chat: {chat}");
 }

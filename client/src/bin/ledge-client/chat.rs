@@ -258,16 +258,20 @@ fn fade(age: f64) -> f32 {
     (1.0 - (age - STAYS) / FADE).clamp(0.0, 1.0) as f32
 }
 
-/// Why the protocol would refuse `text` as a chat line, if it would: the
-/// protocol's words, and the first such character.
+/// Why the protocol would refuse `text` as a chat line ([`check_text`]),
+/// if it would: the first character it refuses and what it is, else the
+/// protocol's words.
 pub fn refusal(text: &str) -> Option<String> {
     let e = check_text("chat text", text, 1, MAX_CHAT_LEN).err()?;
-    let culprit = text
-        .chars()
-        .find(|&c| c.is_control() || is_hidden(c))
-        .map(|c| format!(" ({}: not allowed)", code(c)))
-        .unwrap_or_default();
-    Some(format!("not sent: {e}{culprit}"))
+    let why = match text.chars().find(|&c| c.is_control() || is_hidden(c)) {
+        Some(c) if c.is_control() => format!("{} is a control character", code(c)),
+        Some(c) => format!(
+            "{} is a direction override or an invisible character",
+            code(c)
+        ),
+        None => e.to_string(),
+    };
+    Some(format!("not sent: {why}"))
 }
 
 /// `c` as `U+XXXX`.
