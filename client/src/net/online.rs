@@ -106,6 +106,8 @@ pub struct OnlineGame<
     level_file: Option<std::path::PathBuf>,
     name: String,
     chat: VecDeque<(PlayerId, String)>,
+    /// Chat lines received in all ([`OnlineGame::chat_count`]).
+    chat_count: u64,
     notices: VecDeque<NoticeKind>,
     /// A problem with the game itself (wrong level): shown, not fatal to
     /// the connection.
@@ -194,6 +196,7 @@ impl<N: Network> OnlineGame<N> {
             level_file: None,
             name: name.to_owned(),
             chat: VecDeque::new(),
+            chat_count: 0,
             notices: VecDeque::new(),
             error: None,
             untrusted: None,
@@ -304,6 +307,7 @@ impl<N: Network> OnlineGame<N> {
                     self.chat.pop_front();
                 }
                 self.chat.push_back((*from, text.clone()));
+                self.chat_count += 1;
             }
             NetEvent::Notice(kind) => {
                 if self.notices.len() == CHAT_LINES {
@@ -424,6 +428,13 @@ impl<N: Network> OnlineGame<N> {
     /// The last chat lines, oldest first.
     pub fn chat_lines(&self) -> impl Iterator<Item = &(PlayerId, String)> {
         self.chat.iter()
+    }
+
+    /// How many chat lines were received in all (more than
+    /// [`OnlineGame::chat_lines`] keeps, [`CHAT_LINES`]): a front end
+    /// takes the lines that came since it last looked.
+    pub fn chat_count(&self) -> u64 {
+        self.chat_count
     }
 
     /// The last notices, oldest first.

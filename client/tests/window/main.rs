@@ -6,6 +6,7 @@
 mod common;
 
 mod art_screenshot;
+mod chat_screenshot;
 mod failure_screenshot;
 mod rooms_cli;
 mod run_screenshots;

@@ -22,12 +22,14 @@ use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
 use macroquad::prelude::*;
 
+use crate::chat::{Chat, Key};
 use crate::draw::art::ArtView;
 use crate::draw::camera::{self, Camera};
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
-use crate::draw::{card, debug, fx, hud};
+use crate::draw::{card, chat as chat_view, debug, fx, hud};
 use crate::input::keys::{Bindings, Gamepads};
 use crate::input::script::Script;
+use crate::input::typing;
 use crate::outcome::{fail, EXIT_FAILED, EXIT_JOIN_TIMEOUT, EXIT_UNTRUSTED};
 use crate::{play, shot};
 
@@ -159,6 +161,10 @@ struct GameLoop {
     /// player quits.
     failed: Option<String>,
     failed_frames: u32,
+    /// The chat: the line typed, the lines received, who is muted.
+    chat: Chat,
+    /// Chat lines taken from the game so far ([`play::Play::chat_since`]).
+    chat_seen: u64,
 }
 
 /// What a frame shows, and from where.
@@ -185,6 +191,9 @@ struct Hud {
     results: Vec<hud::ResultRow>,
     /// The results card, once our run is finished.
     card: Option<card::Card>,
+    /// The chat as laid out: the lines received (with the HUD) and the
+    /// line typed.
+    chat: chat_view::ChatView,
 }
 
 impl GameLoop {
@@ -232,38 +241,103 @@ impl GameLoop {
             server_art: false,
             failed: None,
             failed_frames: 0,
+            chat: Chat::default(),
+            chat_seen: 0,
             setup,
         }
     }
 
     /// One frame, step by step; false once the game is over.
     fn frame(&mut self) -> bool {
-        if self.quit_asked() {
+        // While typing, the keys are the chat line's (Escape closes it).
+        let chatting = self.chat.is_open();
+        if self.quit_asked(chatting) {
             return false;
         }
         self.adopt_server_art();
-        self.toggle_overlays();
         let now = self.started.elapsed().as_secs_f64();
+        self.type_chat(now);
+        if !chatting && !self.chat.is_open() {
+            self.toggle_overlays();
+        }
         let dt = self.frame_time();
+        let before = self.played;
         self.simulate(now);
+        self.script_chat(before, now);
+        self.receive_chat(now);
         let cued = self.play_sounds();
         let stats = self.watch_network(now);
         self.check_failure();
         let mut scene = self.compose(dt);
         self.animate_effects(&cued, &mut scene, dt);
         self.draw_world(&scene, now);
-        let hud = self.hud_info(&scene);
+        let hud = self.hud_info(&scene, now);
         self.draw_hud(&scene, &hud, stats.as_ref(), now);
         #[cfg(target_arch = "wasm32")]
         self.report_to_page(&scene);
         !self.finished(&scene, &hud, now)
     }
 
-    /// Esc (natively only: a page is left by closing its tab) or the window closed.
-    fn quit_asked(&self) -> bool {
-        let quit =
-            cfg!(not(target_arch = "wasm32")) && Bindings::pressed(&self.setup.bindings.quit);
+    /// Esc (natively only, and not while `chatting`: a page is left by closing its tab) or the window closed.
+    fn quit_asked(&self, chatting: bool) -> bool {
+        let quit = cfg!(not(target_arch = "wasm32"))
+            && !chatting
+            && Bindings::pressed(&self.setup.bindings.quit);
         quit || is_quit_requested()
+    }
+
+    /// The chat line: opened by its key (what was typed before is the
+    /// game's), then fed the keys typed; a line Enter sends goes out.
+    fn type_chat(&mut self, now: f64) {
+        if !self.chat.is_open() {
+            if Bindings::pressed(&self.setup.bindings.chat) {
+                self.chat.open();
+            }
+            typing::forget();
+            return;
+        }
+        for key in typing::keys() {
+            if let Some(text) = self.chat.key(key, now) {
+                self.send_chat(&text, now);
+            }
+        }
+    }
+
+    /// Sends a chat line; the chat says why not if it cannot.
+    fn send_chat(&mut self, text: &str, now: f64) {
+        if let Err(why) = self.setup.play.say(text) {
+            self.chat.not_sent(&why, now);
+        }
+    }
+
+    /// The script's chat lines of the ticks just played (from tick
+    /// `before`), typed into the chat line and Enter pressed.
+    fn script_chat(&mut self, before: u64, now: f64) {
+        let Some(script) = &self.setup.script else {
+            return;
+        };
+        let lines: Vec<String> = script
+            .said(before..self.played)
+            .map(str::to_owned)
+            .collect();
+        for line in lines {
+            self.chat.open();
+            for c in line.chars() {
+                self.chat.key(Key::Char(c), now);
+            }
+            if let Some(text) = self.chat.key(Key::Enter, now) {
+                self.send_chat(&text, now);
+            }
+        }
+    }
+
+    /// Takes the chat lines received since the last frame.
+    fn receive_chat(&mut self, now: f64) {
+        let (seen, lines) = self.setup.play.chat_since(self.chat_seen);
+        self.chat_seen = seen;
+        for (from, text) in lines {
+            self.chat.receive(&from, &text, now);
+        }
     }
 
     /// Swaps in the server's level art once joined (it comes with its level).
@@ -311,9 +385,12 @@ impl GameLoop {
         let pads = &mut self.pads;
         let base = self.played;
         let mut moved = false;
+        // While typing, the player's buttons are released.
+        let chatting = self.chat.is_open();
         self.played += self.setup.play.update(remaining, |i| {
             let b = match script {
                 Some(script) => script.at(base + i),
+                None if chatting => Buttons::NONE,
                 None => Buttons(bindings.held().0 | pads.held().0),
             };
             moved |= b.0 & Buttons::PLAY != 0;
@@ -484,7 +561,7 @@ impl GameLoop {
     }
 
     /// Draws a failure over the scene; our run, name, the room's results and the results card for the HUD.
-    fn hud_info(&self, scene: &Scene) -> Hud {
+    fn hud_info(&self, scene: &Scene, now: f64) -> Hud {
         // A failure covers the scene; the HUD's figures mean nothing then.
         let failure = self.failed.as_deref().map(hud::failure);
         let run = scene.me.as_ref().map(|m| hud::RunInfo {
@@ -513,12 +590,24 @@ impl GameLoop {
                 hud::measure,
             )
         });
+        let shown = if self.show_hud {
+            self.chat.shown(now)
+        } else {
+            Vec::new()
+        };
+        let chat = chat_view::layout(
+            &shown,
+            self.chat.line(),
+            vec2(screen_width(), screen_height()),
+            |t| hud::measure(t, chat_view::SIZE),
+        );
         Hud {
             failure,
             run,
             name,
             results,
             card,
+            chat,
         }
     }
 
@@ -576,6 +665,9 @@ impl GameLoop {
             if let Some(card) = &hud.card {
                 card::draw(card);
             }
+        }
+        if hud.failure.is_none() {
+            chat_view::draw(&hud.chat);
         }
         if let (None, Some(text)) = (&hud.failure, self.setup.play.banner()) {
             hud::banner(&text);
@@ -667,6 +759,10 @@ impl GameLoop {
                 card: hud.card.as_ref(),
             }),
             failure: self.failed.as_deref().zip(hud.failure.as_ref()),
+            chat: hud.failure.is_none().then_some(shot::ChatShot {
+                view: &hud.chat,
+                muted: self.chat.muted().collect(),
+            }),
             fx: shot::FxShot {
                 particles: self.effects.particles().len(),
                 shake: self.effects.shake().length(),

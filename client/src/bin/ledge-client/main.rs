@@ -35,15 +35,17 @@
 //! three groups that do one thing each for it: [`draw`] (the camera, the
 //! world, the players' animation, effects, the HUD, the debug overlay),
 //! [`sound`] (which effects a frame cues, and playing them) and [`input`]
-//! (keys, gamepads, scripts); at the bottom the page's glue (`page`, in the
-//! browser), the gamepads' state ([`input::pad`]) and how a run ends
-//! ([`outcome`]). The presentation here (animation, sound, cues) is the
+//! (keys, gamepads, scripts, typing); at the bottom the page's glue (`page`, in the
+//! browser), the gamepads' state ([`input::pad`]), the chat's state
+//! ([`chat`]: the line typed, the lines received, who is muted) and how a
+//! run ends ([`outcome`]). The presentation here (animation, sound, cues) is the
 //! window's alone: the headless library leaves it out.
 
 // The browser build leaves out the command line, files and the network
 // thread, and with them some helpers the native build uses.
 #![cfg_attr(target_arch = "wasm32", allow(dead_code))]
 
+mod chat;
 mod draw;
 mod game_loop;
 mod input;

@@ -227,6 +227,48 @@ impl Play {
         &self.server
     }
 
+    /// Says `text` in the room (checked by [`crate::chat`] first); why
+    /// not, if it cannot be sent (offline, not joined, the queue full).
+    pub fn say(&mut self, text: &str) -> Result<(), String> {
+        match &mut self.mode {
+            Mode::Offline(_) => Err("offline: nobody to chat with".to_owned()),
+            Mode::Online(online) if online.game().is_none() => {
+                Err("not in a game yet: wait to join".to_owned())
+            }
+            Mode::Online(online) => {
+                if online.say(text) {
+                    Ok(())
+                } else {
+                    Err("the connection is busy: try again".to_owned())
+                }
+            }
+        }
+    }
+
+    /// The chat lines received since `seen` lines (a count from this
+    /// call, 0 at first), oldest first, each `(sender's name, text)`
+    /// with names from the roster; and the new count. Lines older than
+    /// the last [`ledge_client::net::online::CHAT_LINES`] are lost.
+    pub fn chat_since(&self, seen: u64) -> (u64, Vec<(String, String)>) {
+        let Some(online) = self.connection() else {
+            return (seen, Vec::new());
+        };
+        let count = online.chat_count();
+        let new = usize::try_from(count.saturating_sub(seen)).unwrap_or(usize::MAX);
+        let kept: Vec<_> = online.chat_lines().collect();
+        let name = |id: ledge_shared::protocol::PlayerId| {
+            online
+                .game()
+                .and_then(|g| g.player_names().get(&id).cloned())
+                .unwrap_or_else(|| format!("player #{}", id.0))
+        };
+        let lines = kept[kept.len().saturating_sub(new)..]
+            .iter()
+            .map(|(from, text)| (name(*from), text.clone()))
+            .collect();
+        (count, lines)
+    }
+
     /// The online game, if online.
     fn connection(&self) -> Option<&OnlineGame> {
         match &self.mode {

@@ -51,6 +51,15 @@
 //!     "recent": ["Jump", "Hurt"],      // effects started lately, oldest first
 //!     "dead": true                     // our player waits to respawn
 //!   },
+//!   "chat": {                          // null when a failure covers the screen
+//!     "lines": [                       // received lines drawn, oldest (top) first
+//!       {"from": "bob", "text": "hi ada", "baseline": 460.0, "alpha": 1.0},
+//!       {"from": null, "text": "muted eve (/unmute eve)", ...}  // the chat's own
+//!     ],                               // names and texts as drawn (cut to fit)
+//!     "typing": {"text": "say: hello_", "error": null, "baseline": 504.0},
+//!                                      // null unless the chat line is open
+//!     "muted": ["eve"]
+//!   },
 //!   "failure": {                       // null unless the session failed
 //!     "message": "cannot join ...",    // as printed on stderr
 //!     "font_size": 20.0,
@@ -94,8 +103,18 @@ pub struct Shot<'a> {
     pub hud: Option<HudShot<'a>>,
     /// The session's failure and its banner as drawn, if it failed.
     pub failure: Option<(&'a str, &'a BannerLayout)>,
+    /// The chat as drawn (`None` when a failure covers the screen).
+    pub chat: Option<ChatShot<'a>>,
     /// The visual effects on screen.
     pub fx: FxShot<'a>,
+}
+
+/// The chat when the frame was taken.
+pub struct ChatShot<'a> {
+    /// As laid out and drawn.
+    pub view: &'a crate::draw::chat::ChatView,
+    /// The players muted, by name.
+    pub muted: Vec<&'a str>,
 }
 
 /// The visual effects on screen when the frame was taken.
@@ -251,6 +270,7 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
         recent.join(", "),
         fx.dead
     );
+    describe_chat(&mut s, shot.chat.as_ref());
     describe_failure(&mut s, shot.failure);
     s.push_str("}\n");
     s
@@ -338,6 +358,47 @@ fn describe_hud(s: &mut String, hud: Option<&HudShot>) {
     }
 }
 
+/// The chat as drawn (`null` under a failure): the received lines, the
+/// line being typed, who is muted.
+fn describe_chat(s: &mut String, chat: Option<&ChatShot>) {
+    let Some(chat) = chat else {
+        let _ = writeln!(s, "  \"chat\": null,");
+        return;
+    };
+    let lines: Vec<String> = chat
+        .view
+        .lines
+        .iter()
+        .map(|l| {
+            format!(
+                "      {{\"from\": {}, \"text\": {}, \"baseline\": {:.1}, \"alpha\": {:.3}}}",
+                l.from.as_deref().map_or("null".to_owned(), json_string),
+                json_string(&l.text),
+                l.baseline,
+                l.alpha
+            )
+        })
+        .collect();
+    let typing = chat.view.typing.as_ref().map_or("null".to_owned(), |t| {
+        format!(
+            "{{\"text\": {}, \"error\": {}, \"baseline\": {:.1}}}",
+            json_string(&t.text),
+            t.error.as_deref().map_or("null".to_owned(), json_string),
+            t.baseline
+        )
+    });
+    let muted: Vec<String> = chat.muted.iter().map(|m| json_string(m)).collect();
+    let _ = writeln!(s, "  \"chat\": {{");
+    if lines.is_empty() {
+        let _ = writeln!(s, "    \"lines\": [],");
+    } else {
+        let _ = writeln!(s, "    \"lines\": [\n{}\n    ],", lines.join(",\n"));
+    }
+    let _ = writeln!(s, "    \"typing\": {typing},");
+    let _ = writeln!(s, "    \"muted\": [{}]", muted.join(", "));
+    let _ = writeln!(s, "  }},");
+}
+
 /// The results card as drawn (`null` when it is not): its panel, what it
 /// says of the records (`null` offline) and its lines, each with its
 /// kind, text, baseline and font size, and a top run's place, name (as drawn), time and whether
@@ -423,6 +484,67 @@ mod tests {
     use super::*;
 
     #[test]
+    fn json_lists_the_chat_lines_drawn() {
+        use crate::chat::Shown;
+        use crate::draw::chat::layout;
+        let view = View {
+            zoom: 2.0,
+            offset: Vec2::ZERO,
+            screen: Vec2::new(960.0, 540.0),
+        };
+        let shown = [
+            Shown {
+                from: Some("bob \"b\""),
+                text: "hi ada",
+                alpha: 0.5,
+            },
+            Shown {
+                from: None,
+                text: "muted eve (/unmute eve)",
+                alpha: 1.0,
+            },
+        ];
+        let chat = layout(
+            &shown,
+            Some(("gg".to_owned(), Some("not sent: why"))),
+            Vec2::new(960.0, 540.0),
+            |t| t.len() as f32 * 8.0,
+        );
+        let shot = Shot {
+            tick: 1,
+            view: &view,
+            level_px: Rect::new(0.0, 0.0, 100.0, 100.0),
+            tile_px: 16,
+            server: None,
+            drawn: None,
+            remotes: Vec::new(),
+            hud: None,
+            failure: None,
+            chat: Some(ChatShot {
+                view: &chat,
+                muted: vec!["eve"],
+            }),
+            fx: FxShot {
+                particles: 0,
+                shake: 0.0,
+                flash: 0.0,
+                recent: &[],
+                dead: false,
+            },
+        };
+        let json = describe(&shot, Path::new("c.png"), 960, 540);
+        let parsed: serde_json::Value = serde_json::from_str(&json).expect(&json);
+        let c = &parsed["chat"];
+        assert_eq!(c["lines"][0]["from"], "bob \"b\"");
+        assert_eq!(c["lines"][0]["text"], "hi ada");
+        assert_eq!(c["lines"][0]["alpha"], 0.5);
+        assert!(c["lines"][1]["from"].is_null());
+        assert_eq!(c["typing"]["text"], "say: gg_");
+        assert_eq!(c["typing"]["error"], "not sent: why");
+        assert_eq!(c["muted"][0], "eve");
+    }
+
+    #[test]
     fn json_names_the_player_on_screen() {
         let view = View {
             zoom: 2.0,
@@ -479,6 +601,7 @@ mod tests {
                 card: None,
             }),
             failure: None,
+            chat: None,
             fx: FxShot {
                 particles: 12,
                 shake: 1.5,
@@ -549,6 +672,7 @@ mod tests {
             remotes: Vec::new(),
             hud: None,
             failure: Some((message, &layout)),
+            chat: None,
             fx: FxShot {
                 particles: 0,
                 shake: 0.0,
@@ -566,6 +690,7 @@ mod tests {
         assert_eq!(failure["font_size"], 20.0);
         let none = Shot {
             failure: None,
+            chat: None,
             ..shot
         };
         let json: serde_json::Value =
@@ -638,6 +763,7 @@ mod tests {
             remotes: Vec::new(),
             hud: Some(hud),
             failure: None,
+            chat: None,
             fx: FxShot {
                 particles: 0,
                 shake: 0.0,

@@ -315,7 +315,7 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
             "   Esc quit"
         };
         let help = format!(
-            "arrows/WASD move   space/Z jump   down+jump drop   {} restart   M sound   F3 net   F2 HUD{quit}",
+            "arrows/WASD move   space/Z jump   down+jump drop   {} restart   T chat   M sound   F3 net   F2 HUD{quit}",
             info.restart_key
         );
         let dims = measure_text(&help, None, 16, 1.0);

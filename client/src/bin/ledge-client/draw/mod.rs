@@ -2,8 +2,8 @@
 //! ([`camera`]), the world and the players ([`render`], the level's own art
 //! in [`art`]), how the players move between ticks ([`anim`]), particles,
 //! shake and flashes ([`fx`]), the heads-up display ([`hud`]), the results
-//! card once our run is finished ([`card`]) and the debug overlay
-//! ([`debug`]).
+//! card once our run is finished ([`card`]), the chat ([`chat`]) and the
+//! debug overlay ([`debug`]).
 //!
 //! Grouped so that the front end's layout says what it does; this module
 //! only declares them.
@@ -12,6 +12,7 @@ pub mod anim;
 pub mod art;
 pub mod camera;
 pub mod card;
+pub mod chat;
 pub mod debug;
 pub mod fx;
 pub mod hud;

@@ -1,6 +1,7 @@
 //! What presses the game's buttons: the keyboard and gamepads through
 //! rebindable bindings ([`keys`]), one gamepad's state whatever reports it
-//! ([`pad`]), and scripted input for tests and demos ([`script`]).
+//! ([`pad`]), scripted input for tests and demos ([`script`]), and the
+//! keys typed into the chat line ([`typing`]).
 //!
 //! Grouped so that the front end's layout says what it does; this module
 //! only declares them.
@@ -8,3 +9,4 @@
 pub mod keys;
 pub mod pad;
 pub mod script;
+pub mod typing;

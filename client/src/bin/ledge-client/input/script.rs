@@ -17,6 +17,7 @@
 //! 0-59 -> right          # run right for a second
 //! 30..34 -> jump         # jumping on the way
 //! 120 -> down+jump       # drop through a one-way ledge
+//! 130 -> say made it     # a chat line
 //! ```
 
 use ledge_shared::input::Buttons;
@@ -33,6 +34,8 @@ struct Entry {
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Script {
     entries: Vec<Entry>,
+    /// `(tick, text)`: chat lines typed.
+    says: Vec<(u64, String)>,
 }
 
 impl Script {
@@ -52,6 +55,7 @@ impl Script {
     /// Parses script text (see the module documentation).
     pub fn parse(text: &str) -> Result<Script, String> {
         let mut entries = Vec::new();
+        let mut says = Vec::new();
         for (n, line) in text.lines().enumerate() {
             let line = line.split('#').next().unwrap_or("");
             for part in line.split(';') {
@@ -59,11 +63,22 @@ impl Script {
                 if part.is_empty() {
                     continue;
                 }
-                let entry = parse_entry(part).map_err(|e| format!("line {}: {e}", n + 1))?;
-                entries.push(entry);
+                let at = |e| format!("line {}: {e}", n + 1);
+                match parse_say(part).map_err(at)? {
+                    Some(say) => says.push(say),
+                    None => entries.push(parse_entry(part).map_err(at)?),
+                }
             }
         }
-        Ok(Script { entries })
+        Ok(Script { entries, says })
+    }
+
+    /// The chat lines typed at ticks `ticks`, in order.
+    pub fn said(&self, ticks: std::ops::Range<u64>) -> impl Iterator<Item = &str> {
+        self.says
+            .iter()
+            .filter(move |(t, _)| ticks.contains(t))
+            .map(|(_, text)| text.as_str())
     }
 
     /// The buttons held at `tick`.
@@ -89,6 +104,20 @@ fn parse_entry(part: &str) -> Result<Entry, String> {
         end,
         buttons,
     })
+}
+
+/// A `TICKS -> say TEXT` entry as `(first tick, TEXT)`; `None` if the
+/// entry is not a `say`.
+fn parse_say(part: &str) -> Result<Option<(u64, String)>, String> {
+    let Some((ticks, rest)) = part.split_once("->").or_else(|| part.split_once(':')) else {
+        return Ok(None);
+    };
+    let rest = rest.trim_start();
+    let Some(text) = rest.strip_prefix("say ") else {
+        return Ok(None);
+    };
+    let (start, _) = parse_ticks(ticks.trim())?;
+    Ok(Some((start, text.trim().to_owned())))
 }
 
 fn parse_ticks(s: &str) -> Result<(u64, u64), String> {
@@ -158,6 +187,17 @@ mod tests {
         assert!(e.contains("line 2") && e.contains("fly"), "{e}");
         assert!(Script::parse("9-3 -> right").is_err());
         assert!(Script::parse("right").is_err());
+    }
+
+    #[test]
+    fn say_entries_type_chat_lines() {
+        let s =
+            Script::parse("0-9 -> right; 30 -> say hello bob: gg!\n40..50 -> say  two ").unwrap();
+        assert_eq!(s.at(5), Buttons(Buttons::RIGHT));
+        assert_eq!(s.at(30), Buttons::NONE, "saying presses nothing");
+        assert_eq!(s.said(0..31).collect::<Vec<_>>(), ["hello bob: gg!"]);
+        assert_eq!(s.said(31..60).collect::<Vec<_>>(), ["two"]);
+        assert_eq!(s.said(41..60).count(), 0, "once, at the first tick");
     }
 
     #[test]
