@@ -92,10 +92,14 @@ pub fn check_text(
 }
 
 /// Characters that change how the text around them reads without showing
-/// themselves: direction overrides and isolates (U+202E turns what follows
-/// around, so a line could show another player something its sender did
-/// not type), zero-width characters, invisible operators, the byte order
-/// mark and tag characters. No text field may carry them.
+/// themselves: direction marks, overrides and isolates (U+202E turns what
+/// follows around, so a line could show another player something its
+/// sender did not type), zero-width spaces and word joiners, invisible
+/// operators, fillers that render as nothing, the byte order mark and tag
+/// characters (which can carry a hidden copy of any ASCII text). No text
+/// field may carry them. Joiners and variation selectors stay allowed:
+/// emoji (a heart with U+FE0F, families joined by U+200D) and scripts such
+/// as Persian (U+200C) need them.
 pub fn is_hidden(c: char) -> bool {
     matches!(
         c,
@@ -106,12 +110,13 @@ pub fn is_hidden(c: char) -> bool {
             | '\u{1160}'
             | '\u{17B4}'
             | '\u{17B5}'
-            | '\u{180B}'..='\u{180F}'
-            | '\u{200B}'..='\u{200F}'
+            | '\u{180E}'
+            | '\u{200B}'
+            | '\u{200E}'
+            | '\u{200F}'
             | '\u{202A}'..='\u{202E}'
             | '\u{2060}'..='\u{206F}'
             | '\u{3164}'
-            | '\u{FE00}'..='\u{FE0F}'
             | '\u{FEFF}'
             | '\u{FFA0}'
             | '\u{FFF0}'..='\u{FFF8}'

@@ -822,6 +822,19 @@ fn invalid_strings_are_rejected_both_ways() {
             "{hidden:?}"
         );
     }
+    // Emoji and scripts that need joiners and variation selectors pass.
+    for fine in [
+        "love \u{2764}\u{FE0F}",
+        "\u{1F468}\u{200D}\u{1F469}\u{200D}\u{1F467}",
+        "\u{0645}\u{06CC}\u{200C}\u{062E}\u{0648}\u{0627}\u{0645}",
+    ] {
+        let line = ClientControl::Chat { text: fine.into() };
+        assert_eq!(
+            ClientControl::decode(&line.encode().unwrap()).unwrap(),
+            line,
+            "{fine:?}"
+        );
+    }
     assert_eq!(
         ledge_shared::protocol::clip_text("a\u{202E}b\nc", 256),
         "ab c",
