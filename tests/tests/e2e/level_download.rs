@@ -170,6 +170,17 @@ async fn a_cut_download_resumes_and_a_tampered_one_is_refused() {
     server.stop().await.expect("clean stop");
 }
 
+/// Writes `pixels` (RGBA, `side` x `side`) as a PNG at `path`.
+pub(crate) fn write_png(path: &Path, side: u32, pixels: &[u8]) {
+    let file = std::fs::File::create(path).unwrap();
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), side, side);
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().unwrap();
+    writer.write_image_data(pixels).unwrap();
+    writer.finish().unwrap();
+}
+
 /// Writes a map whose tileset image is `side` x `side` pixels of noise
 /// (which no PNG compresses): `side * side * 4` bytes of image.
 pub(crate) fn noisy_map(dir: &Path, side: u32) -> PathBuf {
@@ -181,13 +192,7 @@ pub(crate) fn noisy_map(dir: &Path, side: u32) -> PathBuf {
         x ^= x << 17;
         pixels.push(x as u8);
     }
-    let file = std::fs::File::create(dir.join("noise.png")).unwrap();
-    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), side, side);
-    encoder.set_color(png::ColorType::Rgba);
-    encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header().unwrap();
-    writer.write_image_data(&pixels).unwrap();
-    writer.finish().unwrap();
+    write_png(&dir.join("noise.png"), side, &pixels);
     let map = dir.join("big.tmx");
     std::fs::write(
         &map,

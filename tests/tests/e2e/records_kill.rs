@@ -55,13 +55,7 @@ fn short_level(dir: &Path) -> std::path::PathBuf {
         ),
     )
     .unwrap();
-    let file = std::fs::File::create(dir.join("solid.png")).unwrap();
-    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), 16, 16);
-    encoder.set_color(png::ColorType::Rgba);
-    encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header().unwrap();
-    writer.write_image_data(&[90; 16 * 16 * 4]).unwrap();
-    writer.finish().unwrap();
+    crate::level_download::write_png(&dir.join("solid.png"), 16, &[90; 16 * 16 * 4]);
     path
 }
 
