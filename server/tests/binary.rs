@@ -274,13 +274,28 @@ fn one_thread_runs_the_whole_server() {
             break url.trim_end_matches("/metrics").to_owned();
         }
     };
-    // The process is one thread: the runtime's, which is main's.
-    let status = std::fs::read_to_string(format!("/proc/{}/status", child.id())).unwrap();
-    let threads = status
-        .lines()
-        .find_map(|l| l.strip_prefix("Threads:"))
-        .unwrap()
-        .trim();
+    // The process is one thread: the runtime's, which is main's. The
+    // records database's migration used an SQLite connection, whose worker
+    // thread (sqlx runs SQLite on one) ends just after the connection is
+    // closed: wait for it, a moment at most.
+    let threads_now = || {
+        let status = std::fs::read_to_string(format!("/proc/{}/status", child.id())).unwrap();
+        let threads = status
+            .lines()
+            .find_map(|l| l.strip_prefix("Threads:"))
+            .unwrap()
+            .trim()
+            .to_owned();
+        (threads, status)
+    };
+    let deadline = Instant::now() + Duration::from_secs(5);
+    let (threads, status) = loop {
+        let (threads, status) = threads_now();
+        if threads == "1" || Instant::now() > deadline {
+            break (threads, status);
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
     assert_eq!(threads, "1", "{status}");
     // Its room ticks on it: 60 a second.
     let ticks = |text: &str| metric(text, "ledge_tick_duration_seconds_count{room=\"room-1\"}");
