@@ -17,6 +17,7 @@
 //!   what a level uses; the editor importers (OGMO, Tiled) and the default
 //!   level are in the `ledge-levels` crate, not here;
 //! * [`game`]: the platformer rules over the world (what the server runs);
+//! * [`replay`]: matches and runs as inputs, played again exactly;
 //! * [`scene`]: built-in scenes (the warm-up room).
 #![deny(missing_docs)]
 
@@ -27,6 +28,7 @@ pub mod input;
 pub mod level;
 pub mod protocol;
 pub mod query;
+pub mod replay;
 pub mod scene;
 pub mod shape;
 pub mod tilemap;

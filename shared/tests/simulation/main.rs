@@ -24,6 +24,7 @@ mod platformer_polygon;
 mod platformer_world;
 mod protocol;
 mod ray;
+mod replay;
 mod runs;
 mod spawn_spread;
 mod stability;
