@@ -33,6 +33,7 @@ fn run(round: usize, i: usize) -> FinishedRun {
         coins: 0,
         place: 1,
         finished_at_ms: 0,
+        replay_id: None,
     }
 }
 

@@ -19,6 +19,7 @@ use ledge_shared::game::{GameConfig, MAX_RESPAWN_DELAY_TICKS};
 use crate::admission::AdmissionConfig;
 use crate::fleet::FleetConfig;
 use crate::records::RecordsTarget;
+use crate::replays::ReplaysTarget;
 use crate::web::guard::{mbps_to_bytes, WebLimits, DEFAULT_ADDRESS_SHARE};
 
 /// Default UDP address the server listens on.
@@ -182,6 +183,12 @@ pub struct ServerConfig {
     /// Where finished runs are stored (`--records`); `None` (the
     /// default): [`crate::records::DEFAULT_FILE`] in `cert_dir`.
     pub records: Option<RecordsTarget>,
+    /// Where replays are saved (`--replays`); `None` (the default):
+    /// [`crate::replays::DEFAULT_DIR`] in `cert_dir`.
+    pub replays: Option<ReplaysTarget>,
+    /// Most bytes the replays take (`--replays-cap-mib`); the oldest go
+    /// first, the records' own last.
+    pub replays_cap: u64,
 }
 
 /// Where browsers connect (docs/SERVER.md, "Browsers").
@@ -242,6 +249,8 @@ impl Default for ServerConfig {
             agones: None,
             web: None,
             records: None,
+            replays: None,
+            replays_cap: crate::replays::DEFAULT_CAP_MIB << 20,
         }
     }
 }
@@ -253,6 +262,14 @@ impl ServerConfig {
         self.records
             .clone()
             .unwrap_or_else(|| RecordsTarget::in_state_dir(&self.cert_dir))
+    }
+
+    /// Where the replays go: `--replays`, or the default folder in the
+    /// certificate directory.
+    pub fn replays_target(&self) -> ReplaysTarget {
+        self.replays
+            .clone()
+            .unwrap_or_else(|| ReplaysTarget::in_state_dir(&self.cert_dir))
     }
 
     /// The game's configuration: the defaults with this server's respawn
@@ -521,6 +538,15 @@ pub struct Cli {
     /// [default: records.sqlite in --cert-dir].
     #[arg(long, value_name = "PATH|URL|off")]
     pub records: Option<String>,
+    /// Folder where each finished run and each match is saved as a replay
+    /// (served at /replays/ID on the web port), or `off` [default: replays
+    /// in --cert-dir].
+    #[arg(long, value_name = "DIR|off")]
+    pub replays: Option<String>,
+    /// Most MiB the replays take; past it the oldest are deleted, except
+    /// those of each level's top ten [default: 1024].
+    #[arg(long, value_name = "MIB")]
+    pub replays_cap_mib: Option<u64>,
     /// The host's upload budget for the web port's downloads (the page,
     /// the level), Mbit/s, all addresses together [default: 100].
     #[arg(long, value_name = "MBPS")]
@@ -571,6 +597,10 @@ struct FileConfig {
     web_limits: Option<FileWebLimits>,
     /// As `--records`.
     records: Option<String>,
+    /// As `--replays`.
+    replays: Option<String>,
+    /// As `--replays-cap-mib`.
+    replays_cap_mib: Option<u64>,
 }
 
 /// The file's `[web_limits]`: every key optional (docs/SERVER.md).
@@ -638,6 +668,33 @@ fn seconds(secs: f64, key: &str) -> Result<Duration, ConfigError> {
 }
 
 impl Cli {
+    /// Where the records and the replays go: the flags, else the file (a
+    /// relative path in the file being relative to it).
+    fn resolve_stores(
+        &self,
+        file: &FileConfig,
+        c: &mut ServerConfig,
+        relative: &dyn Fn(PathBuf) -> PathBuf,
+    ) {
+        if let Some(r) = self.records.as_deref().or(file.records.as_deref()) {
+            c.records = Some(match RecordsTarget::parse(r) {
+                RecordsTarget::Sqlite(p) if self.records.is_none() => {
+                    RecordsTarget::Sqlite(relative(p))
+                }
+                target => target,
+            });
+        }
+        if let Some(r) = self.replays.as_deref().or(file.replays.as_deref()) {
+            c.replays = Some(match ReplaysTarget::parse(r) {
+                ReplaysTarget::Dir(p) if self.replays.is_none() => ReplaysTarget::Dir(relative(p)),
+                target => target,
+            });
+        }
+        if let Some(mib) = self.replays_cap_mib.or(file.replays_cap_mib) {
+            c.replays_cap = mib.saturating_mul(1 << 20);
+        }
+    }
+
     /// The configuration: defaults, then the file (if any), then the flags.
     pub fn resolve(&self) -> Result<ServerConfig, ConfigError> {
         let file = match &self.config {
@@ -657,6 +714,7 @@ impl Cli {
             Some(dir) if p.is_relative() => dir.join(p),
             _ => p,
         };
+        self.resolve_stores(&file, &mut c, &relative);
         if let Some(b) = &file.bind {
             c.bind = parse_bind(b).map_err(|message| ConfigError::Parse {
                 path: self.config.clone().unwrap_or_default(),
@@ -773,15 +831,6 @@ impl Cli {
             };
             c.web = Some(web);
         }
-        if let Some(r) = self.records.as_deref().or(file.records.as_deref()) {
-            c.records = Some(match RecordsTarget::parse(r) {
-                // A relative file in the configuration file is relative to it.
-                RecordsTarget::Sqlite(p) if self.records.is_none() => {
-                    RecordsTarget::Sqlite(relative(p))
-                }
-                target => target,
-            });
-        }
         c.validate()?;
         Ok(c)
     }
@@ -859,6 +908,38 @@ mod tests {
         assert_eq!(c.level, None);
         assert_eq!(c.metrics_bind, None);
         assert_eq!(c.threads, None, "one thread per core unless told");
+    }
+
+    #[test]
+    fn replays_go_beside_the_certificate_unless_told() {
+        let c = cli(&["--cert-dir", "/srv/ledge"]).resolve().unwrap();
+        assert_eq!(
+            c.replays_target(),
+            ReplaysTarget::Dir("/srv/ledge/replays".into())
+        );
+        assert_eq!(c.replays_cap, 1024 << 20);
+        let c = cli(&["--replays", "off", "--replays-cap-mib", "5"])
+            .resolve()
+            .unwrap();
+        assert_eq!(
+            (c.replays_target(), c.replays_cap),
+            (ReplaysTarget::Off, 5 << 20)
+        );
+        // In the file: relative to it; the flag wins.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("server.toml");
+        std::fs::write(&path, "replays = \"runs\"\nreplays_cap_mib = 7\n").unwrap();
+        let config = path.to_str().unwrap();
+        let c = cli(&["--config", config]).resolve().unwrap();
+        assert_eq!(
+            c.replays_target(),
+            ReplaysTarget::Dir(dir.path().join("runs"))
+        );
+        assert_eq!(c.replays_cap, 7 << 20);
+        let c = cli(&["--config", config, "--replays", "here"])
+            .resolve()
+            .unwrap();
+        assert_eq!(c.replays_target(), ReplaysTarget::Dir("here".into()));
     }
 
     #[test]

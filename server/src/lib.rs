@@ -61,6 +61,7 @@ pub mod quic_cert;
 pub mod ratelimit;
 pub mod record;
 pub mod records;
+pub mod replays;
 pub mod room;
 pub mod room_logic;
 pub mod room_registry;

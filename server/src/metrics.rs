@@ -253,6 +253,8 @@ pub struct Metrics {
     /// Time to store a batch of runs (first try to commit), in fine
     /// buckets.
     pub records_write_seconds: Histogram,
+    /// The replays writer's counters.
+    pub replays: crate::replays::writer::ReplayMetrics,
     /// Bytes received per client.
     pub client_bytes_in: Family<ClientLabel, Counter>,
     /// Bytes sent per client.
@@ -360,6 +362,7 @@ impl Metrics {
             records_stored: Counter::default(),
             records_failed: Counter::default(),
             records_write_seconds: Histogram::new(fine_buckets()),
+            replays: Default::default(),
             client_bytes_in: Family::default(),
             client_bytes_out: Family::default(),
             bytes_in: Family::default(),
@@ -468,6 +471,26 @@ impl Metrics {
             "records_write_seconds",
             "Time to store a batch of finished runs, first try to commit",
             self.records_write_seconds.clone(),
+        );
+        r.register(
+            "replays_saved",
+            "Replays saved (finished runs and matches)",
+            self.replays.saved.clone(),
+        );
+        r.register(
+            "replays_saved_bytes",
+            "Bytes of the replays saved",
+            self.replays.saved_bytes.clone(),
+        );
+        r.register(
+            "replays_failed",
+            "Replays not saved (queue full, disk failed)",
+            self.replays.failed.clone(),
+        );
+        r.register(
+            "replays_pruned",
+            "Replays deleted past --replays-cap-mib",
+            self.replays.pruned.clone(),
         );
         r.register(
             "retries",

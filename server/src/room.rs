@@ -230,13 +230,6 @@ pub fn spawn(
     (handle, tokio::spawn(room.run()))
 }
 
-/// Milliseconds since the Unix epoch (0 if the clock is before it).
-fn unix_millis() -> i64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| i64::try_from(d.as_millis()).unwrap_or(i64::MAX))
-}
-
 /// Queues where a player's run stands (or why it was not recorded) on its
 /// control stream; a full queue drops it (the run is stored all the same).
 fn tell_standing(control: &mpsc::Sender<Outbound>, result: Result<Standing, String>) {
@@ -392,6 +385,14 @@ impl Room {
             }
         }
         self.players_gauge.set(0);
+        // The match being recorded ends here: save it.
+        self.logic.stop();
+        self.logic.take_actions(&mut self.actions);
+        for action in self.actions.drain(..) {
+            if let Action::SaveReplay(replay) = action {
+                self.logic.config().replays.save(*replay);
+            }
+        }
         info!(room = %self.name(), tick = self.logic.game().tick(), "room stopped");
     }
 
@@ -543,8 +544,9 @@ impl Room {
                 Action::Left(id) => {
                     self.peers.remove(&id);
                 }
+                Action::SaveReplay(replay) => self.logic.config().replays.save(*replay),
                 Action::RunFinished { to, mut run } => {
-                    run.finished_at_ms = unix_millis();
+                    run.finished_at_ms = crate::records::unix_millis();
                     let control = self.peers.get(&to).map(|p| p.link.control.clone());
                     self.logic.config().records.submit(
                         run,

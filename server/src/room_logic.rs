@@ -30,10 +30,11 @@ use std::time::{Duration, Instant};
 use ledge_shared::game::{Game, GameEvent};
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
-    encode_sim_config, name_key, write_frame, InputPacket, LevelOffer, NetTiming, NoticeKind,
-    Outgoing, PlayerId, RejectReason, RosterEntry, ServerControl, SessionToken, Snapshot, Welcome,
-    MAX_ROSTER,
+    clip_text, encode_sim_config, name_key, write_frame, InputPacket, LevelOffer, NetTiming,
+    NoticeKind, Outgoing, PlayerId, RejectReason, RosterEntry, ServerControl, SessionToken,
+    Snapshot, Welcome, MAX_ROSTER,
 };
+use ledge_shared::replay::{ReplayHeader, ReplayKind, MAX_LEVEL_NAME_LEN};
 use prometheus_client::metrics::counter::Counter;
 use tracing::{error, info, warn};
 
@@ -41,6 +42,8 @@ use crate::inputs::{InputBuffer, Received};
 use crate::metrics::{DropReason, KickLabel, KickReason, Metrics, RoomLabel, SnapshotKind};
 use crate::record::Recorder;
 use crate::records::{FinishedRun, RecordsHandle};
+use crate::replays::recording::ToSave;
+use crate::replays::{MatchRecording, ReplaysHandle};
 use crate::snapshots::RoomSnapshots;
 use crate::tls::DATAGRAM_SEND_BUFFER;
 
@@ -89,6 +92,9 @@ pub struct RoomConfig {
     pub instance: String,
     /// Where finished runs go ([`crate::records`]).
     pub records: RecordsHandle,
+    /// Where replays go ([`crate::replays`]); the room records its
+    /// matches only when they are on.
+    pub replays: ReplaysHandle,
 }
 
 /// The room's progress, published after every tick.
@@ -227,6 +233,8 @@ pub enum Action {
         /// The run (its finishing time still 0: the I/O side sets it).
         run: FinishedRun,
     },
+    /// Save a replay (a run's, or a match's).
+    SaveReplay(Box<ToSave>),
 }
 
 /// A player in the room.
@@ -304,6 +312,8 @@ pub struct RoomLogic {
     metrics: Arc<Metrics>,
     starvation: Counter,
     actions: Vec<Action>,
+    /// The match, while anyone is in the room (replays on).
+    recording: Option<MatchRecording>,
 }
 
 impl RoomLogic {
@@ -313,7 +323,12 @@ impl RoomLogic {
         let label = RoomLabel {
             room: config.name.clone(),
         };
+        let recording = config
+            .replays
+            .is_on()
+            .then(|| MatchRecording::new(replay_header(&game, &config), config.instance.clone()));
         RoomLogic {
+            recording,
             starvation: metrics.input_starvation.get_or_create_owned(&label),
             snapshots: RoomSnapshots::new(config.history),
             game,
@@ -371,6 +386,9 @@ impl RoomLogic {
                 ),
             });
         }
+        if let Some(r) = &mut self.recording {
+            r.before_join(&self.game, names(&self.members));
+        }
         if let Err(e) = self.game.add_player(player_id) {
             warn!(%player_id, "game refused the player: {e}");
             return Err(RejectReason::Other {
@@ -379,6 +397,9 @@ impl RoomLogic {
         }
         if let Some(r) = &self.config.record {
             r.join(player_id);
+        }
+        if let Some(r) = &mut self.recording {
+            r.joined(player_id, &name);
         }
         let tick = self.game.tick();
         let inbox = Arc::new(Mutex::new(PlayerInbox::new(self.config.input_window, tick)));
@@ -469,6 +490,14 @@ impl RoomLogic {
         }
     }
 
+    /// The room stops: the match being recorded ends and is saved
+    /// ([`Action::SaveReplay`]).
+    pub fn stop(&mut self) {
+        if let Some(done) = self.recording.as_mut().and_then(|r| r.end(&self.game)) {
+            self.actions.push(Action::SaveReplay(Box::new(done)));
+        }
+    }
+
     /// Relays a chat line to everyone in the room.
     pub fn chat(&mut self, from: PlayerId, text: String) {
         self.broadcast(&ServerControl::Chat { from, text });
@@ -481,6 +510,11 @@ impl RoomLogic {
         self.take_inputs(tick);
         self.remove_idle(tick);
         self.game.step(&self.inputs);
+        if let Some(r) = &mut self.recording {
+            if let Some(full) = r.stepped(&self.game, &self.inputs, names(&self.members)) {
+                self.actions.push(Action::SaveReplay(Box::new(full)));
+            }
+        }
         self.collect_finished(tick);
         if let Some(r) = &self.config.record {
             r.tick(tick, &self.inputs, || self.game.state_hash());
@@ -514,8 +548,13 @@ impl RoomLogic {
             };
             let view = self.game.player(player);
             let c = &self.config;
+            let key = format!("{}/{}/{}/{tick}", c.instance, c.name, player.0);
+            let replay = self
+                .recording
+                .as_ref()
+                .and_then(|r| r.run(&self.game, &key, player, u64::from(ticks), place));
             let run = FinishedRun {
-                key: format!("{}/{}/{}/{tick}", c.instance, c.name, player.0),
+                key,
                 level_hash: c.level.hex(),
                 level_name: self.game.level_name().to_owned(),
                 player: m.name.clone(),
@@ -525,7 +564,12 @@ impl RoomLogic {
                 coins: view.as_ref().map_or(0, |v| v.coins),
                 place,
                 finished_at_ms: 0,
+                replay_id: replay.as_ref().map(|r| r.id.clone()),
             };
+            // Saved before the run is stored, so a record's replay exists.
+            if let Some(replay) = replay {
+                self.actions.push(Action::SaveReplay(Box::new(replay)));
+            }
             self.actions.push(Action::RunFinished { to: player, run });
         }
     }
@@ -604,6 +648,12 @@ impl RoomLogic {
             let removed = self.game.remove_player(player_id);
             if let (true, Some(r)) = (removed, &self.config.record) {
                 r.leave(player_id);
+            }
+            if let (true, Some(r)) = (removed, &mut self.recording) {
+                let empty = self.members.is_empty();
+                if let Some(done) = r.left(&self.game, player_id, empty) {
+                    self.actions.push(Action::SaveReplay(Box::new(done)));
+                }
             }
             info!(room = %self.config.name, %player_id, name = %member.name, "player left");
             self.broadcast(&ServerControl::PlayerLeft { id: player_id });
@@ -764,6 +814,27 @@ impl RoomLogic {
 }
 
 /// Whether a snapshot is a delta or a full one.
+/// The players in the room, by id and name.
+fn names(members: &BTreeMap<PlayerId, Member>) -> impl Iterator<Item = (PlayerId, &str)> {
+    members.iter().map(|(&id, m)| (id, m.name.as_str()))
+}
+
+/// What every replay of the room says it is of.
+fn replay_header(game: &Game, config: &RoomConfig) -> ReplayHeader {
+    ReplayHeader {
+        kind: ReplayKind::Match,
+        room: config.name.clone(),
+        level_id: config.level_id.clone(),
+        level_name: clip_text(game.level_name(), MAX_LEVEL_NAME_LEN),
+        level: config.level,
+        config: *game.config(),
+        tick_rate: config.tick_rate.min(u32::from(u16::MAX)) as u16,
+        hash_interval: config.tick_rate.max(1),
+        recorded_at_ms: 0,
+        names: Vec::new(),
+    }
+}
+
 fn snapshot_kind(snapshot: &Snapshot) -> SnapshotKind {
     if snapshot.baseline_tick.is_some() {
         SnapshotKind::Delta
@@ -809,6 +880,7 @@ mod tests {
             idle_kick: Duration::from_secs(30),
             instance: "test".into(),
             records: RecordsHandle::default(),
+            replays: Default::default(),
         }
     }
 
@@ -1309,5 +1381,52 @@ mod tests {
             text: "hi".into(),
         };
         assert_eq!(actions(&mut room), [control(A, &chat), control(B, &chat)]);
+    }
+
+    #[test]
+    fn a_match_is_recorded_from_the_first_join_and_saved_when_the_room_empties() {
+        let (replays, mut queue) = ReplaysHandle::channel(8);
+        let (mut room, _) = room_with(RoomConfig {
+            replays,
+            ..config(4)
+        });
+        let t0 = Instant::now();
+        ticks(&mut room, 20, None, t0);
+        let (a, b) = (PlayerId(1), PlayerId(2));
+        let ja = join(&mut room, a, "ann");
+        ticks(&mut room, 10, None, t0);
+        let jb = join(&mut room, b, "bob");
+        let right = [Buttons(Buttons::RIGHT); 40];
+        let jump = [Buttons(Buttons::JUMP | Buttons::LEFT); 40];
+        send(&ja, room.game().tick(), &right, None);
+        send(&jb, room.game().tick(), &jump, None);
+        ticks(&mut room, 100, None, t0);
+        room.leave(a, 0);
+        assert!(actions(&mut room)
+            .iter()
+            .all(|a| !matches!(a, Action::SaveReplay(_))));
+        ticks(&mut room, 5, None, t0);
+        room.leave(b, 0);
+        let saved: Vec<ToSave> = actions(&mut room)
+            .into_iter()
+            .filter_map(|a| match a {
+                Action::SaveReplay(s) => Some(*s),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(saved.len(), 1, "the match, when the room emptied");
+        let replay = saved[0].replay.clone();
+        assert_eq!(replay.start_tick(), 20);
+        assert_eq!(replay.ticks(), 115);
+        assert_eq!(replay.name_of(b), Some("bob"));
+        let mut playing =
+            ledge_shared::replay::Playback::new(&ledge_levels::default_level(), replay).unwrap();
+        playing.play_to_end().unwrap();
+        assert_eq!(playing.game().state_hash(), room.game().state_hash());
+        // Nothing went to the handle's queue: the room task sends them.
+        assert!(queue.try_recv().is_err());
+        // Stopping an empty room saves nothing more.
+        room.stop();
+        assert!(actions(&mut room).is_empty());
     }
 }

@@ -237,6 +237,7 @@ mod tests {
             idle_kick: std::time::Duration::from_secs(30),
             instance: "test".into(),
             records: Default::default(),
+            replays: Default::default(),
         };
         let (metrics, _registry) = Metrics::new();
         Rooms::new(game, template, max_rooms, metrics)

@@ -2,6 +2,7 @@
 //! graceful shutdown.
 
 use std::net::SocketAddr;
+use std::path::Path;
 use std::sync::atomic::AtomicU32;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -27,6 +28,7 @@ use crate::quic_cert::{CertError, Identity};
 use crate::record::Recorder;
 use crate::records::writer::WriterMetrics;
 use crate::records::{RecordStore, RecordsHandle};
+use crate::replays::{ReplayDir, ReplaysHandle, ReplaysTarget};
 use crate::room_logic::RoomConfig;
 use crate::room_registry::Rooms;
 use crate::sessions::Sessions;
@@ -505,13 +507,15 @@ impl Server {
         } = self;
         let mut stop = shutdown.subscribe();
         let (records, records_task) = open_records(&config, &metrics).await;
+        let (replays, replays_task) = open_replays(&config, &metrics, records.store().cloned());
+        let replays_dir = replays.dir().map(Path::to_owned);
         let rooms = open_rooms(
             &config,
             &level,
             level_offer,
             &recorders,
             metrics.clone(),
-            records.clone(),
+            (records.clone(), replays),
         )?;
         let metrics_task = metrics_listener.map(|(listener, addr)| {
             info!(%addr, "serving metrics at /metrics");
@@ -527,6 +531,7 @@ impl Server {
             admission: Admission::new(config.admission, config.max_connections),
             shutdown: stop.clone(),
             records,
+            replays_dir,
         });
         #[cfg(feature = "agones")]
         let agones_task = join_fleet(&config, fingerprint, &shared, &stop, &shutdown).await?;
@@ -565,6 +570,11 @@ impl Server {
             let _ = tokio::task::spawn_blocking(move || thread.join()).await;
         }
         stop_rooms(serving.shared).await;
+        if let Some(task) = replays_task {
+            if tokio::time::timeout(RECORDS_GRACE, task).await.is_err() {
+                warn!("replays still being saved after {RECORDS_GRACE:?}; stopping anyway");
+            }
+        }
         if let Some(task) = records_task {
             // Every room is gone, so the writer stores what is queued and
             // ends.
@@ -631,6 +641,40 @@ async fn open_records(
     }
 }
 
+/// Opens the replays folder (`--replays`) and starts its writer; if it
+/// cannot be opened, says so and plays on without replays.
+fn open_replays(
+    config: &ServerConfig,
+    metrics: &Metrics,
+    records: Option<RecordStore>,
+) -> (ReplaysHandle, Option<tokio::task::JoinHandle<()>>) {
+    let ReplaysTarget::Dir(dir) = config.replays_target() else {
+        info!("replays are off (--replays off)");
+        return (ReplaysHandle::off(), None);
+    };
+    match ReplayDir::open(&dir, config.replays_cap) {
+        Ok(d) => {
+            info!(
+                replays = %dir.display(),
+                kept = d.len(),
+                mib = d.total() >> 20,
+                cap_mib = config.replays_cap >> 20,
+                "saving replays"
+            );
+            let (handle, task) = ReplaysHandle::spawn(d, records, metrics.replays.clone());
+            (handle, Some(task))
+        }
+        Err(e) => {
+            error!(
+                "replays are off: cannot open the folder {}: {e}; fix it or pass --replays with \
+                 another folder (or --replays off)",
+                dir.display()
+            );
+            (ReplaysHandle::off(), None)
+        }
+    }
+}
+
 /// Makes the rooms from the configuration and level, and opens the
 /// permanent ones (`room-1` ..), each with its recorder if recording.
 fn open_rooms(
@@ -639,7 +683,7 @@ fn open_rooms(
     level_offer: LevelOffer,
     recorders: &[Recorder],
     metrics: Arc<Metrics>,
-    records: RecordsHandle,
+    (records, replays): (RecordsHandle, ReplaysHandle),
 ) -> Result<Rooms, ServerError> {
     let template = RoomConfig {
         name: String::new(),
@@ -657,6 +701,7 @@ fn open_rooms(
         idle_kick: config.idle_kick,
         instance: instance_id(),
         records,
+        replays,
     };
     let rooms = Rooms::new(
         Game::with_config(level, config.game_config())?,

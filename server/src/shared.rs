@@ -41,4 +41,6 @@ pub struct Shared {
     /// The records: where rooms send finished runs, and what the web port
     /// reads.
     pub records: RecordsHandle,
+    /// The replays folder the web port serves (`None`: replays are off).
+    pub replays_dir: Option<std::path::PathBuf>,
 }

@@ -122,6 +122,13 @@ pub enum RecordsError {
     },
 }
 
+/// Milliseconds since the Unix epoch (0 if the clock is before it).
+pub fn unix_millis() -> i64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| i64::try_from(d.as_millis()).unwrap_or(i64::MAX))
+}
+
 /// One finished run, as stored.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FinishedRun {
@@ -146,6 +153,8 @@ pub struct FinishedRun {
     pub place: u32,
     /// When it finished, milliseconds since the Unix epoch.
     pub finished_at_ms: i64,
+    /// Its replay's id ([`crate::replays::replay_id`]), if one is saved.
+    pub replay_id: Option<String>,
 }
 
 impl FinishedRun {
@@ -193,6 +202,7 @@ mod tests {
             coins: 0,
             place: 1,
             finished_at_ms: 0,
+            replay_id: None,
         };
         assert_eq!(run.millis(), 10_000);
         let fast = FinishedRun {

@@ -50,6 +50,8 @@ pub struct TopEntry {
     pub finished_at_ms: i64,
     /// The player's finished runs on the level.
     pub runs: u64,
+    /// The id of that run's replay (`/replays/ID`), if saved.
+    pub replay: Option<String>,
 }
 
 /// A level with records.
@@ -209,7 +211,7 @@ impl RecordStore {
     pub async fn top(&self, level_hash: &str, n: u32) -> Result<Vec<TopEntry>, RecordsError> {
         let rows = sqlx::query(
             "SELECT r.player, r.millis, r.ticks, r.tick_rate, r.deaths, r.coins, r.finished_at, \
-                    b.runs \
+                    r.replay_id, b.runs \
              FROM runs r \
              JOIN (SELECT player, MIN(millis) AS best, COUNT(*) AS runs FROM runs \
                    WHERE level_hash = $1 GROUP BY player) b \
@@ -243,6 +245,7 @@ impl RecordStore {
                     coins: get("coins")?,
                     finished_at_ms: row.try_get("finished_at")?,
                     runs: get("runs")?,
+                    replay: row.try_get("replay_id")?,
                 })
             })()
             .map_err(self.query_err())?;
@@ -364,7 +367,7 @@ async fn insert(tx: &mut Transaction<'_, Any>, run: &FinishedRun) -> Result<bool
     let inserted = sqlx::query(
         "INSERT INTO runs (run_key, level_hash, level_name, player, ticks, tick_rate, millis, \
                            deaths, coins, place, finished_at, replay_id) \
-         VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, NULL) \
+         VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12) \
          ON CONFLICT (run_key) DO NOTHING",
     )
     .bind(run.key.clone())
@@ -378,6 +381,7 @@ async fn insert(tx: &mut Transaction<'_, Any>, run: &FinishedRun) -> Result<bool
     .bind(i64::from(run.coins))
     .bind(i64::from(run.place))
     .bind(run.finished_at_ms)
+    .bind(run.replay_id.clone())
     .execute(&mut **tx)
     .await?
     .rows_affected();
@@ -400,6 +404,7 @@ mod tests {
             coins: 2,
             place: 1,
             finished_at_ms: 1_700_000_000_000,
+            replay_id: Some(format!("replay-of-{key}")),
         }
     }
 
@@ -442,6 +447,9 @@ mod tests {
             (top[1].player.as_str(), top[1].millis, top[1].runs),
             ("ann", 10_000, 2)
         );
+        // Each best with its own run's replay.
+        assert_eq!(top[0].replay.as_deref(), Some("replay-of-b1"));
+        assert_eq!(top[1].replay.as_deref(), Some("replay-of-a1"));
         assert_eq!(store.top(&"aa".repeat(32), 1).await.unwrap().len(), 1);
         let levels = store.levels().await.unwrap();
         assert_eq!(levels.len(), 1);

@@ -136,6 +136,25 @@ fn router(state: Arc<WebState>) -> Router {
         .route("/web.json", get(web_json_route))
         .route("/level", get(level))
         .route(
+            "/levels/:hex",
+            get(|s: State<Arc<WebState>>, Path(hex): Path<String>, request: Request| async move {
+                if hex.eq_ignore_ascii_case(&s.level_hex) {
+                    level(s, request).await
+                } else {
+                    text(
+                        StatusCode::NOT_FOUND,
+                        format!("this server does not play level {hex} (GET /level is its level)\n"),
+                    )
+                }
+            }),
+        )
+        .route(
+            "/replays/:id",
+            get(|State(s): State<Arc<WebState>>, Path(id): Path<String>, request: Request| async move {
+                replay(&s, &id, request).await
+            }),
+        )
+        .route(
             "/records",
             get(|State(s): State<Arc<WebState>>, request: Request| async move {
                 let html = records_pages::wants_html(&request);
@@ -290,6 +309,55 @@ async fn level(State(state): State<Arc<WebState>>, request: Request) -> Response
         &etag,
         state.level.clone(),
     )
+}
+
+/// `GET /replays/ID`: a replay file, paced and limited like the level.
+async fn replay(state: &WebState, id: &str, request: Request) -> Response {
+    let Some(dir) = &state.shared.replays_dir else {
+        return text(
+            StatusCode::NOT_FOUND,
+            "this server keeps no replays (--replays off)\n".into(),
+        );
+    };
+    if !crate::replays::is_replay_id(id) {
+        return text(
+            StatusCode::BAD_REQUEST,
+            "a replay is named by 16 lower-case hex digits (the records page links them)\n".into(),
+        );
+    }
+    let path = crate::replays::ReplayDir::path_of(dir, id);
+    let max =
+        (ledge_shared::replay::MAX_REPLAY_BYTES + ledge_shared::replay::file::HEADER_LEN) as u64;
+    let bytes = match tokio::fs::metadata(&path).await {
+        Ok(meta) if meta.len() > max => Err(format!("replay {id} is over {max} bytes")),
+        Ok(_) => tokio::fs::read(&path).await.map_err(|e| e.to_string()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return text(
+                StatusCode::NOT_FOUND,
+                format!("no replay {id} here: never saved, or deleted past the server's cap\n"),
+            );
+        }
+        Err(e) => Err(e.to_string()),
+    };
+    match bytes {
+        Ok(bytes) => {
+            let etag = format!("\"{id}-{}\"", bytes.len());
+            download(
+                state,
+                &request,
+                "application/octet-stream",
+                &etag,
+                Bytes::from(bytes),
+            )
+        }
+        Err(e) => {
+            warn!("cannot serve replay {id}: {e}");
+            text(
+                StatusCode::INTERNAL_SERVER_ERROR,
+                "the replay cannot be read\n".into(),
+            )
+        }
+    }
 }
 
 /// What a refused browser is told.

@@ -164,7 +164,7 @@ fn page(levels: &[LevelSummary], tops: &[Vec<TopEntry>]) -> String {
             html,
             "<h2>{}</h2><p>{} runs by {} players; level <code>{}</code> \
              (<a href=\"/records/{}\">JSON</a>)</p><table><tr><th>#</th><th>player</th>\
-             <th>time</th><th>deaths</th><th>runs</th></tr>",
+             <th>time</th><th>deaths</th><th>runs</th><th>replay</th></tr>",
             escape(&level.name),
             level.runs,
             level.players,
@@ -174,12 +174,14 @@ fn page(levels: &[LevelSummary], tops: &[Vec<TopEntry>]) -> String {
         for e in top {
             let _ = write!(
                 html,
-                "<tr><td>{}</td><td>{}</td><td class=\"t\">{}</td><td>{}</td><td>{}</td></tr>",
+                "<tr><td>{}</td><td>{}</td><td class=\"t\">{}</td><td>{}</td><td>{}</td>\
+                 <td>{}</td></tr>",
                 e.place,
                 escape(&e.player),
                 clock(e.millis),
                 e.deaths,
-                e.runs
+                e.runs,
+                replay_link(e.replay.as_deref()),
             );
         }
         html.push_str("</table>");
@@ -191,8 +193,20 @@ fn page(levels: &[LevelSummary], tops: &[Vec<TopEntry>]) -> String {
             levels.len() - MAX_LEVELS_SHOWN
         );
     }
-    html.push_str("</body></html>");
+    html.push_str(
+        "<p>A replay plays in the game: <code>ledge-client --replay</code> and the replay \
+         link's address.</p></body></html>",
+    );
     html
+}
+
+/// The cell linking a run's replay (only ids that are replay ids: the
+/// records may hold anything).
+fn replay_link(id: Option<&str>) -> String {
+    match id.filter(|id| crate::replays::is_replay_id(id)) {
+        Some(id) => format!("<a href=\"/replays/{id}\">{id}</a>"),
+        None => String::new(),
+    }
 }
 
 #[cfg(test)]
@@ -223,9 +237,12 @@ mod tests {
             coins: 0,
             finished_at_ms: 0,
             runs: 2,
+            replay: Some("0123456789abcdef".into()),
         }];
         let html = page(&[level], &[top]);
         assert!(html.contains("&lt;b&gt;x&lt;/b&gt;") && html.contains("a&amp;b"));
         assert!(html.contains("0:09.000") && !html.contains("<b>x"));
+        assert!(html.contains("<a href=\"/replays/0123456789abcdef\">"));
+        assert_eq!(replay_link(Some("<script>")), "");
     }
 }

@@ -67,7 +67,7 @@ pub enum ReplayKind {
 }
 
 /// What a replay is of.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ReplayHeader {
     /// Match or run.
     pub kind: ReplayKind,
@@ -108,7 +108,7 @@ pub enum Event {
 }
 
 /// A match or a run, ready to play (see the module documentation).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Replay {
     /// What it is of.
     pub header: ReplayHeader,

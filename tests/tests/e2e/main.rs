@@ -27,6 +27,7 @@ mod records;
 mod records_kill;
 mod records_postgres;
 mod remote_players;
+mod replays;
 mod resume;
 mod robustness;
 mod rooms_by_name;
