@@ -35,6 +35,8 @@ pub const DEFAULT_TICK_RATE: u32 = 60;
 pub const DEFAULT_SNAPSHOT_RATE: u32 = 30;
 /// Default most players in one room.
 pub const DEFAULT_MAX_PLAYERS: usize = 16;
+/// Default most spectators per room.
+pub const DEFAULT_MAX_SPECTATORS: usize = 16;
 /// Default number of rooms.
 pub const DEFAULT_ROOMS: u32 = 1;
 /// Default most rooms at once, counting those players open by name (the
@@ -127,6 +129,9 @@ pub struct ServerConfig {
     pub snapshot_rate: u32,
     /// Most players in one room.
     pub max_players: usize,
+    /// Most spectators in one room (`ClientControl::Spectate`; they take
+    /// no player's place).
+    pub max_spectators: usize,
     /// Number of rooms open from the start and never closed (named
     /// `room-1`, `room-2`, ...).
     pub rooms: u32,
@@ -232,6 +237,7 @@ impl Default for ServerConfig {
             tick_rate: DEFAULT_TICK_RATE,
             snapshot_rate: DEFAULT_SNAPSHOT_RATE,
             max_players: DEFAULT_MAX_PLAYERS,
+            max_spectators: DEFAULT_MAX_SPECTATORS,
             rooms: DEFAULT_ROOMS,
             max_rooms: DEFAULT_MAX_ROOMS,
             max_connections: DEFAULT_MAX_CONNECTIONS,
@@ -450,6 +456,10 @@ pub struct Cli {
     /// Most players per room [default: 16].
     #[arg(long, value_name = "N")]
     pub max_players: Option<usize>,
+    /// Most spectators per room (they take no player's place) [default:
+    /// 16].
+    #[arg(long, value_name = "N")]
+    pub max_spectators: Option<usize>,
     /// Rooms open from the start (room-1, room-2, ...) [default: 1].
     #[arg(long, value_name = "N")]
     pub rooms: Option<u32>,
@@ -568,6 +578,7 @@ struct FileConfig {
     tick_rate: Option<u32>,
     snapshot_rate: Option<u32>,
     max_players: Option<usize>,
+    max_spectators: Option<usize>,
     rooms: Option<u32>,
     max_rooms: Option<u32>,
     max_connections: Option<usize>,
@@ -729,6 +740,7 @@ impl Cli {
         set(&mut c.tick_rate, file.tick_rate);
         set(&mut c.snapshot_rate, file.snapshot_rate);
         set(&mut c.max_players, file.max_players);
+        set(&mut c.max_spectators, file.max_spectators);
         set(&mut c.rooms, file.rooms);
         set(&mut c.max_rooms, file.max_rooms);
         set(&mut c.max_connections, file.max_connections);
@@ -773,6 +785,7 @@ impl Cli {
         set(&mut c.tick_rate, self.tick_rate);
         set(&mut c.snapshot_rate, self.snapshot_rate);
         set(&mut c.max_players, self.max_players);
+        set(&mut c.max_spectators, self.max_spectators);
         set(&mut c.rooms, self.rooms);
         set(&mut c.max_rooms, self.max_rooms);
         // Unless set, the cap follows a larger number of rooms.

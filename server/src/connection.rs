@@ -256,7 +256,8 @@ async fn session(
     if let Some(download) = client.download.take() {
         download.abort();
     }
-    membership.lost = matches!(ending, Ending::Lost(_));
+    // A spectator has nothing to keep: lost, it leaves.
+    membership.lost = matches!(ending, Ending::Lost(_)) && !first.is_spectate();
     say_goodbye(&ending, &client.control, writer).await;
     ending.into_result(&shared.metrics)
 }
@@ -328,12 +329,15 @@ async fn take_seat(
         control: control.clone(),
         bytes: shared.metrics.client(player_id.0),
     };
+    if hello.is_spectate() {
+        return join_new(shared, (wanted_room, true), name, &link, send).await;
+    }
     match resume(shared, hello.resume_token(), &link).await {
         Some(resumed) => {
             shared.metrics.sessions_resumed.inc();
             Ok(resumed)
         }
-        None => join_new(shared, wanted_room, name, &link, send).await,
+        None => join_new(shared, (wanted_room, false), name, &link, send).await,
     }
 }
 
@@ -354,17 +358,18 @@ async fn resume(
         .map(|joined| (parked.room, joined, token))
 }
 
-/// Joins as a new player (a new id and session token), or rejects the
-/// client and forgets the id's metric series.
+/// Joins as a new player or spectator (a new id and session token) the
+/// room wanted (`None`: any), or rejects the client and forgets the id's
+/// metric series.
 async fn join_new(
     shared: &Shared,
-    wanted: Option<&str>,
+    (wanted, spectate): (Option<&str>, bool),
     name: &str,
     link: impl Fn(PlayerId) -> ClientLink,
     send: &mut ControlSend,
 ) -> Result<Seat, End> {
     let player_id = PlayerId(shared.next_player.fetch_add(1, Ordering::Relaxed));
-    match join(shared, wanted, player_id, name, link(player_id)).await {
+    match join(shared, (wanted, spectate), player_id, name, link(player_id)).await {
         Ok((room, joined)) => Ok((room, joined, shared.sessions.new_token())),
         Err(reason) => {
             shared.metrics.forget_client(player_id.0);
@@ -426,16 +431,24 @@ async fn say_goodbye(ending: &Ending, control: &mpsc::Sender<Outbound>, writer: 
 /// with a free place.
 async fn join(
     shared: &Shared,
-    wanted: Option<&str>,
+    (wanted, spectate): (Option<&str>, bool),
     player_id: PlayerId,
     name: &str,
     link: ClientLink,
 ) -> Result<(RoomHandle, room_logic::Joined), RejectReason> {
-    for room in shared.rooms.for_join(wanted, Instant::now())? {
-        if wanted.is_none() && !room.has_room() {
+    let mut rooms = shared.rooms.for_join(wanted, Instant::now())?;
+    if spectate {
+        // A spectator watches the room with the most players.
+        rooms.reverse();
+    }
+    for room in rooms {
+        if wanted.is_none() && !spectate && !room.has_room() {
             continue;
         }
-        match room.join(player_id, name.to_owned(), link.clone()).await {
+        match room
+            .join(player_id, name.to_owned(), link.clone(), spectate)
+            .await
+        {
             Ok(joined) => return Ok((room, joined)),
             Err(JoinError::Rejected(RejectReason::RoomFull)) if wanted.is_none() => continue,
             Err(JoinError::Rejected(reason)) => return Err(reason),
@@ -717,6 +730,7 @@ impl Client<'_> {
                 ClientControl::Hello { .. }
                 | ClientControl::HelloRoom { .. }
                 | ClientControl::Resume { .. }
+                | ClientControl::Spectate { .. }
                 | ClientControl::ListRooms { .. } => {
                     return Err(Ending::malformed("second hello".into()));
                 }

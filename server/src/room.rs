@@ -78,6 +78,7 @@ enum Command {
         player_id: PlayerId,
         name: String,
         link: ClientLink,
+        spectate: bool,
         reply: oneshot::Sender<Result<Joined, RejectReason>>,
     },
     Leave {
@@ -126,13 +127,14 @@ impl RoomHandle {
         self.players() < self.max_players
     }
 
-    /// Adds a player. Commands are unbounded but each connection sends one
+    /// Adds a player (a spectator with `spectate`). Commands are unbounded but each connection sends one
     /// join, one leave and rate-limited chat, so the queue stays small.
     pub async fn join(
         &self,
         player_id: PlayerId,
         name: String,
         link: ClientLink,
+        spectate: bool,
     ) -> Result<Joined, JoinError> {
         let (reply, answer) = oneshot::channel();
         self.commands
@@ -140,6 +142,7 @@ impl RoomHandle {
                 player_id,
                 name,
                 link,
+                spectate,
                 reply,
             })
             .map_err(|_| JoinError::Closed)?;
@@ -418,9 +421,14 @@ impl Room {
                 player_id,
                 name,
                 link,
+                spectate,
                 reply,
             } => {
-                let answer = self.logic.join(player_id, name);
+                let answer = if spectate {
+                    self.logic.spectate(player_id, name)
+                } else {
+                    self.logic.join(player_id, name)
+                };
                 if answer.is_ok() {
                     self.peers.insert(player_id, Peer::new(link));
                     self.sync_players();

@@ -95,6 +95,8 @@ pub struct RoomConfig {
     /// Where replays go ([`crate::replays`]); the room records its
     /// matches only when they are on.
     pub replays: ReplaysHandle,
+    /// Most spectators at once (they take no player's place).
+    pub max_spectators: usize,
 }
 
 /// The room's progress, published after every tick.
@@ -260,6 +262,8 @@ struct Member {
     last_snapshot: Option<u64>,
     /// A connection holds it (false: lost, kept for a resume).
     attached: bool,
+    /// Watching, with no body in the game.
+    spectator: bool,
 }
 
 impl Member {
@@ -352,7 +356,12 @@ impl RoomLogic {
 
     /// Players in the room (attached or kept for a resume).
     pub fn players(&self) -> usize {
-        self.members.len()
+        self.members.values().filter(|m| !m.spectator).count()
+    }
+
+    /// Spectators in the room.
+    pub fn spectators(&self) -> usize {
+        self.members.len() - self.players()
     }
 
     /// The room's progress now.
@@ -360,7 +369,7 @@ impl RoomLogic {
         RoomStatus {
             tick: self.game.tick(),
             state_hash: self.game.state_hash(),
-            players: self.members.len(),
+            players: self.players(),
         }
     }
 
@@ -373,19 +382,10 @@ impl RoomLogic {
     /// the others. Refused when the room is full, the name is taken (by
     /// [`name_key`]) or the game refuses the player.
     pub fn join(&mut self, player_id: PlayerId, name: String) -> Result<Joined, RejectReason> {
-        if self.members.len() >= self.config.max_players {
+        if self.players() >= self.config.max_players {
             return Err(RejectReason::RoomFull);
         }
-        let key = name_key(&name);
-        if let Some(taken) = self.members.values().find(|m| name_key(&m.name) == key) {
-            return Err(RejectReason::Other {
-                reason: format!(
-                    "the name \"{name}\" is taken in this room (by \"{}\"; names must differ by \
-                     more than case or look-alike letters): choose another with --name",
-                    taken.name
-                ),
-            });
-        }
+        self.check_name_free(&name)?;
         if let Some(r) = &mut self.recording {
             r.before_join(&self.game, names(&self.members));
         }
@@ -401,9 +401,51 @@ impl RoomLogic {
         if let Some(r) = &mut self.recording {
             r.joined(player_id, &name);
         }
+        info!(room = %self.config.name, %player_id, %name, tick = self.game.tick(), "player joined");
+        let joined = self.add_member(player_id, name, false);
+        self.announce_join(player_id);
+        Ok(joined)
+    }
+
+    /// Adds a spectator named `name`: no body in the game, no player's
+    /// place (the room's spectator cap instead), in no roster; it is sent
+    /// the roster and the snapshots like a player.
+    pub fn spectate(&mut self, id: PlayerId, name: String) -> Result<Joined, RejectReason> {
+        let max = self.config.max_spectators;
+        if self.spectators() >= max {
+            return Err(RejectReason::Other {
+                reason: format!(
+                    "this room's {max} spectator places are taken: try another room, or later"
+                ),
+            });
+        }
+        self.check_name_free(&name)?;
+        info!(room = %self.config.name, spectator = %id, %name, "spectator joined");
+        let joined = self.add_member(id, name, true);
+        self.send_roster(id);
+        Ok(joined)
+    }
+
+    /// Refuses a name another member's looks like ([`name_key`]).
+    fn check_name_free(&self, name: &str) -> Result<(), RejectReason> {
+        let key = name_key(name);
+        match self.members.values().find(|m| name_key(&m.name) == key) {
+            Some(taken) => Err(RejectReason::Other {
+                reason: format!(
+                    "the name \"{name}\" is taken in this room (by \"{}\"; names must differ by \
+                     more than case or look-alike letters): choose another with --name",
+                    taken.name
+                ),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// A new member (a player already in the game, or a spectator) and
+    /// what its connection needs.
+    fn add_member(&mut self, id: PlayerId, name: String, spectator: bool) -> Joined {
         let tick = self.game.tick();
         let inbox = Arc::new(Mutex::new(PlayerInbox::new(self.config.input_window, tick)));
-        info!(room = %self.config.name, %player_id, %name, tick, "player joined");
         let member = Member {
             name,
             inbox: inbox.clone(),
@@ -416,14 +458,14 @@ impl RoomLogic {
             packets_seen: 0,
             packets_at_snapshot: 0,
             last_snapshot: None,
+            spectator,
         };
-        self.members.insert(player_id, member);
-        self.announce_join(player_id);
-        Ok(Joined {
-            welcome: self.welcome(player_id, tick),
+        self.members.insert(id, member);
+        Joined {
+            welcome: self.welcome(id, tick),
             inbox,
             generation: 0,
-        })
+        }
     }
 
     /// Removes a player, if connection `generation` still holds it (no-op
@@ -499,7 +541,16 @@ impl RoomLogic {
     }
 
     /// Relays a chat line to everyone in the room.
+    /// A spectator's line goes nowhere: it is told so (players know each
+    /// other's names from the roster, which spectators are not in).
     pub fn chat(&mut self, from: PlayerId, text: String) {
+        if self.members.get(&from).is_some_and(|m| m.spectator) {
+            let notice = NoticeKind::Info {
+                text: "spectators cannot chat: join as a player to talk".into(),
+            };
+            self.send_control(from, &ServerControl::Notice { kind: notice });
+            return;
+        }
         self.broadcast(&ServerControl::Chat { from, text });
     }
 
@@ -612,7 +663,9 @@ impl RoomLogic {
                 None => {}
             }
             drop(inbox);
-            self.inputs.push((id, m.buttons));
+            if !m.spectator {
+                self.inputs.push((id, m.buttons));
+            }
         }
     }
 
@@ -644,13 +697,21 @@ impl RoomLogic {
     }
 
     fn remove(&mut self, player_id: PlayerId) {
-        if let Some(member) = self.members.remove(&player_id) {
+        let Some(member) = self.members.remove(&player_id) else {
+            return;
+        };
+        if member.spectator {
+            info!(room = %self.config.name, spectator = %player_id, name = %member.name, "spectator left");
+            self.actions.push(Action::Left(player_id));
+            return;
+        }
+        {
             let removed = self.game.remove_player(player_id);
             if let (true, Some(r)) = (removed, &self.config.record) {
                 r.leave(player_id);
             }
             if let (true, Some(r)) = (removed, &mut self.recording) {
-                let empty = self.members.is_empty();
+                let empty = self.members.values().all(|m| m.spectator);
                 if let Some(done) = r.left(&self.game, player_id, empty) {
                     self.actions.push(Action::SaveReplay(Box::new(done)));
                 }
@@ -666,7 +727,7 @@ impl RoomLogic {
     /// hold a seat. Each gets a `Notice{Kick}` and a close saying why.
     fn remove_idle(&mut self, tick: u64) {
         let mut limit = self.config.idle_kick;
-        if self.members.len() >= self.config.max_players {
+        if self.players() >= self.config.max_players {
             limit /= 2;
         }
         let limit = (limit.as_secs_f64() * f64::from(self.config.tick_rate)) as u64;
@@ -783,6 +844,7 @@ impl RoomLogic {
         let players = self
             .members
             .iter()
+            .filter(|(_, m)| !m.spectator)
             .take(MAX_ROSTER)
             .map(roster_entry)
             .collect();
@@ -816,7 +878,10 @@ impl RoomLogic {
 /// Whether a snapshot is a delta or a full one.
 /// The players in the room, by id and name.
 fn names(members: &BTreeMap<PlayerId, Member>) -> impl Iterator<Item = (PlayerId, &str)> {
-    members.iter().map(|(&id, m)| (id, m.name.as_str()))
+    members
+        .iter()
+        .filter(|(_, m)| !m.spectator)
+        .map(|(&id, m)| (id, m.name.as_str()))
 }
 
 /// What every replay of the room says it is of.
@@ -881,6 +946,7 @@ mod tests {
             instance: "test".into(),
             records: RecordsHandle::default(),
             replays: Default::default(),
+            max_spectators: 2,
         }
     }
 
@@ -1428,5 +1494,53 @@ mod tests {
         // Stopping an empty room saves nothing more.
         room.stop();
         assert!(actions(&mut room).is_empty());
+    }
+
+    #[test]
+    fn spectators_watch_without_a_body_or_a_place() {
+        // One player's place, two spectators'.
+        let (mut room, _) = room(1);
+        let (ann, sam, sue, tom) = (PlayerId(1), PlayerId(2), PlayerId(3), PlayerId(4));
+        join(&mut room, ann, "ann");
+        let spectator = room.spectate(sam, "sam".into()).unwrap();
+        // Told who plays; nobody is told of it.
+        let told = actions(&mut room);
+        assert_eq!(told, [control(sam, &roster(&[(ann, "ann")]))]);
+        assert_eq!((room.players(), room.spectators()), (1, 1));
+        assert_eq!(room.status().players, 1);
+        assert_eq!(room.game().players().count(), 1, "no body in the game");
+        // Its place is not a player's, and the player's is not its.
+        assert!(matches!(
+            room.join(tom, "tom".into()),
+            Err(RejectReason::RoomFull)
+        ));
+        room.spectate(sue, "sue".into()).unwrap();
+        actions(&mut room);
+        let Err(RejectReason::Other { reason }) = room.spectate(tom, "tom".into()) else {
+            panic!("a third spectator");
+        };
+        assert!(reason.contains("2 spectator places"), "{reason}");
+        assert!(room.spectate(tom, "Ann".into()).is_err(), "a player's name");
+        // It gets snapshots; its buttons move nothing.
+        let t0 = Instant::now();
+        send(&spectator, room.game().tick(), &[RIGHT; 30], None);
+        let before = room.game().state_hash();
+        let sent = snapshots(&ticks(&mut room, 10, Some(1200), t0));
+        assert!(sent.iter().any(|s| s.0 == sam), "{sent:?}");
+        assert_eq!(
+            room.game().player(ann).unwrap().vel.x,
+            0,
+            "ann holds nothing"
+        );
+        assert_ne!(room.game().state_hash(), before, "time passes");
+        // It cannot chat, and is told why.
+        room.chat(sam, "hi".into());
+        let answer = actions(&mut room);
+        assert_eq!(answer.len(), 1);
+        assert!(matches!(&answer[0], Action::Control { to, .. } if *to == sam));
+        // It leaves quietly.
+        room.leave(sam, 0);
+        assert_eq!(actions(&mut room), [Action::Left(sam)]);
+        assert_eq!(room.spectators(), 1);
     }
 }

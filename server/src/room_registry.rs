@@ -238,6 +238,7 @@ mod tests {
             instance: "test".into(),
             records: Default::default(),
             replays: Default::default(),
+            max_spectators: 2,
         };
         let (metrics, _registry) = Metrics::new();
         Rooms::new(game, template, max_rooms, metrics)

@@ -690,6 +690,7 @@ fn open_rooms(
         tick_rate: config.tick_rate,
         snapshot_interval: config.snapshot_interval(),
         max_players: config.max_players,
+        max_spectators: config.max_spectators,
         max_catch_up: config.max_catch_up,
         input_window: config.tick_rate.max(32) as usize,
         input_redundancy: DEFAULT_INPUT_REDUNDANCY,

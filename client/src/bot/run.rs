@@ -216,6 +216,7 @@ pub async fn connect_and_run(
         player_name: options.name.clone(),
         room: options.room.clone(),
         resume: None,
+        spectate: false,
     };
     match connect_trusted(server, trust, &join).await {
         Ok((session, _)) => run_bot(session, brain, options).await,

@@ -57,6 +57,7 @@ pub async fn run_thin_with(
         player_name: options.name.clone(),
         room: options.room.clone(),
         resume: None,
+        spectate: false,
     };
     let mut session = match connect_trusted(server, trust, &join).await {
         Ok((session, _)) => session,

@@ -266,6 +266,7 @@ async fn run(
         player_name: request.player_name.clone(),
         room: options.room.clone(),
         resume: None,
+        spectate: false,
     };
     // Set once joined: then a lost connection is resumed.
     let mut lost: Option<(Instant, u32)> = None;

@@ -17,6 +17,7 @@ fn list_rooms_shows_a_room_opened_by_name() {
         player_name: "ana".into(),
         room: Some("friends".into()),
         resume: None,
+        spectate: false,
     };
     let ana = server
         .block_on(connect_with(

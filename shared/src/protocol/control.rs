@@ -474,6 +474,21 @@ pub enum ClientControl {
         /// The token of the session to resume.
         token: SessionToken,
     },
+    /// Instead of a hello, as the first message: joins a room with no
+    /// body, to watch. A spectator gets the `Welcome` (its id is in no
+    /// snapshot), the snapshots and the roster like a player, sends input
+    /// datagrams only for their acknowledgements (their buttons move
+    /// nothing), takes no player's place (rooms have a cap of their own)
+    /// and is in no roster. Added in protocol version 10.
+    Spectate {
+        /// The client's [`PROTOCOL_VERSION`], checked by the server.
+        version: u32,
+        /// Display name, checked by [`check_name`].
+        name: String,
+        /// The room to watch (`None`: the one with the most players),
+        /// checked like a room name.
+        room: Option<String>,
+    },
 }
 
 impl ClientControl {
@@ -493,8 +508,18 @@ impl ClientControl {
                 room,
                 ..
             } => Some((*version, name, room.as_deref())),
+            ClientControl::Spectate {
+                version,
+                name,
+                room,
+            } => Some((*version, name, room.as_deref())),
             _ => None,
         }
+    }
+
+    /// Whether this first message asks to watch ([`ClientControl::Spectate`]).
+    pub fn is_spectate(&self) -> bool {
+        matches!(self, ClientControl::Spectate { .. })
     }
 
     /// The session token of a `Resume`.
@@ -530,7 +555,8 @@ impl Message for ClientControl {
                 check_name(name)?;
                 check_text("room name", room, 1, MAX_ID_LEN)
             }
-            ClientControl::Resume { name, room, .. } => {
+            ClientControl::Resume { name, room, .. }
+            | ClientControl::Spectate { name, room, .. } => {
                 check_name(name)?;
                 room.as_deref()
                     .map_or(Ok(()), |r| check_text("room name", r, 1, MAX_ID_LEN))

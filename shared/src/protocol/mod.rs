@@ -72,7 +72,8 @@ pub use snapshot::{
 /// change nothing for a client that sent nothing).
 /// 9: records: `ServerControl::RunRecorded` (where a finished run stands,
 /// sent once it is stored) and `ServerControl::RunNotRecorded`.
-pub const PROTOCOL_VERSION: u32 = 9;
+/// 10: spectators: `ClientControl::Spectate`.
+pub const PROTOCOL_VERSION: u32 = 10;
 
 /// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
 /// an unrelated QUIC peer. It names the application, not the version:

@@ -65,6 +65,7 @@ async fn join(server: &TestServer, name: &str, room: Option<&str>) -> Session {
         player_name: name.into(),
         room: room.map(str::to_owned),
         resume: None,
+        spectate: false,
     };
     connect_with(server.addr, "localhost", server.fingerprint, &options)
         .await
@@ -130,6 +131,7 @@ async fn ready_after_listening_then_counters_list_and_label_follow_two_rooms() {
             player_name: "dave".into(),
             room: Some("more".into()),
             resume: None,
+            spectate: false,
         },
     )
     .await;

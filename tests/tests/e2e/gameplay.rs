@@ -174,6 +174,7 @@ async fn players_fill_the_least_full_room_or_the_named_one() {
             player_name: name.to_owned(),
             room: room.map(str::to_owned),
             resume: None,
+            spectate: false,
         };
         async move { connect_with(addr, "localhost", fingerprint, &options).await }
     };

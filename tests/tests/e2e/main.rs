@@ -33,6 +33,7 @@ mod robustness;
 mod rooms_by_name;
 mod roster;
 mod seats;
+mod spectators;
 mod stall;
 mod trust;
 mod web_hostile;

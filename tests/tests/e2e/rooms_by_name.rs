@@ -17,6 +17,7 @@ async fn join_room(server: &TestServer, name: &str, room: &str) -> Result<Sessio
         player_name: name.into(),
         room: Some(room.into()),
         resume: None,
+        spectate: false,
     };
     connect_with(server.addr, "localhost", server.fingerprint, &options).await
 }

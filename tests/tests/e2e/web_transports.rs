@@ -144,6 +144,7 @@ async fn bot(server: &TestServer, name: &str, room: &str) -> Session {
         player_name: name.into(),
         room: Some(room.into()),
         resume: None,
+        spectate: false,
     };
     connect_with(server.addr, "localhost", server.fingerprint, &options)
         .await

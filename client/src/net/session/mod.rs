@@ -52,6 +52,9 @@ pub struct JoinOptions {
     /// Resume the session this token names (a lost connection's player:
     /// same id, position, coins); an unknown or expired one joins as new.
     pub resume: Option<SessionToken>,
+    /// Watch rather than play ([`ClientControl::Spectate`]): no body, no
+    /// player's place; `room` is the room to watch.
+    pub spectate: bool,
 }
 
 impl JoinOptions {
@@ -61,11 +64,19 @@ impl JoinOptions {
             player_name: player_name.to_owned(),
             room: None,
             resume: None,
+            spectate: false,
         }
     }
 
     /// The hello these options send.
     pub fn hello(&self) -> ClientControl {
+        if self.spectate {
+            return ClientControl::Spectate {
+                version: PROTOCOL_VERSION,
+                name: self.player_name.clone(),
+                room: self.room.clone(),
+            };
+        }
         if let Some(token) = self.resume {
             return ClientControl::Resume {
                 version: PROTOCOL_VERSION,
