@@ -20,6 +20,7 @@
 //!   thread ([`net::background`]), a networked game for a GUI
 //!   ([`net::online`], [`OnlineGame`]), and the server's level
 //!   ([`net::levels`], [`net::download`], [`net::bundle`]);
+//! * [`ghost`]: a run to race against, played from its replay;
 //! * [`netstats`]: RTT, jitter, loss, rates;
 //! * [`bot`]: headless bots (idle, random walker, route runner,
 //!   misbehaving);
@@ -43,6 +44,7 @@
 pub mod bot;
 pub mod error;
 pub mod game;
+pub mod ghost;
 pub mod net;
 pub mod netstats;
 pub mod rng;

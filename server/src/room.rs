@@ -33,6 +33,7 @@ use crate::link::{DatagramError, Link, Wire};
 use crate::metrics::{
     Channel, ClientBytes, DropReason, Metrics, RoomLabel, SnapshotKind, SnapshotLabel,
 };
+use crate::replays::ghosts;
 use crate::room_logic::{Action, Joined, RoomConfig, RoomLogic, RoomStatus};
 
 /// Something for a client's control-stream writer.
@@ -425,11 +426,14 @@ impl Room {
                 reply,
             } => {
                 let answer = if spectate {
-                    self.logic.spectate(player_id, name)
+                    self.logic.spectate(player_id, name.clone())
                 } else {
-                    self.logic.join(player_id, name)
+                    self.logic.join(player_id, name.clone())
                 };
                 if answer.is_ok() {
+                    if !spectate {
+                        self.send_ghosts(&link.control, name);
+                    }
                     self.peers.insert(player_id, Peer::new(link));
                     self.sync_players();
                 }
@@ -567,6 +571,28 @@ impl Room {
                 }
             }
         }
+    }
+
+    /// Sends a new player the runs to race against (the record, its own
+    /// best), read off the room's thread, when records and replays are on.
+    fn send_ghosts(&self, control: &mpsc::Sender<Outbound>, name: String) {
+        let config = self.logic.config();
+        let (Some(store), Some(dir)) = (config.records.store(), config.replays.dir()) else {
+            return;
+        };
+        let (store, dir, level) = (store.clone(), dir.to_owned(), config.level.hex());
+        let control = control.clone();
+        tokio::spawn(async move {
+            for ghost in ghosts::find(&store, &dir, &level, &name).await {
+                let mut frame = Vec::new();
+                match write_frame(&ServerControl::Ghost(ghost), &mut frame) {
+                    Ok(()) => {
+                        let _ = control.try_send(Outbound::Frame(frame));
+                    }
+                    Err(e) => debug!("a ghost not sent: {e}"),
+                }
+            }
+        });
     }
 
     /// Publishes the number of players (for the handle and the metrics).

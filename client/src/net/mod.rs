@@ -51,7 +51,7 @@ use std::time::Duration;
 
 use ledge_levels::LevelBundle;
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::{NoticeKind, PlayerId, Standing, Welcome};
+use ledge_shared::protocol::{GhostRun, NoticeKind, PlayerId, Standing, Welcome};
 
 use crate::net::download::Fetched;
 use crate::net::session::{SessionEvent, SnapshotUpdate};
@@ -119,6 +119,8 @@ pub enum NetEvent {
     /// Our finished run is in the server's records (`Ok`: where it stands),
     /// or why not (`Err`).
     RunRecorded(Result<Standing, String>),
+    /// A run to race against, as its replay ([`crate::ghost::Ghost`]).
+    Ghost(Box<GhostRun>),
     /// Connecting failed; the thread has ended.
     Failed(String),
     /// Connecting failed because the server's certificate is not the one
@@ -149,6 +151,7 @@ impl NetEvent {
             SessionEvent::PlayerJoined { id, name } => NetEvent::PlayerJoined { id, name },
             SessionEvent::PlayerLeft { id, .. } => NetEvent::PlayerLeft { id },
             SessionEvent::RunRecorded(r) => NetEvent::RunRecorded(r),
+            SessionEvent::Ghost(g) => NetEvent::Ghost(Box::new(g)),
         })
     }
 }
@@ -206,7 +209,8 @@ impl NetStatus {
                 | NetEvent::Notice(_)
                 | NetEvent::PlayerJoined { .. }
                 | NetEvent::PlayerLeft { .. }
-                | NetEvent::RunRecorded(_),
+                | NetEvent::RunRecorded(_)
+                | NetEvent::Ghost(_),
             ) => status,
             (_, NetEvent::Failed(reason) | NetEvent::Untrusted(reason)) => {
                 NetStatus::Failed(reason)

@@ -35,9 +35,10 @@ use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
 #[cfg(not(target_arch = "wasm32"))]
 use ledge_shared::protocol::Fingerprint;
-use ledge_shared::protocol::{NoticeKind, PlayerId, Standing, StateSnapshot};
+use ledge_shared::protocol::{GhostRun, NoticeKind, PlayerId, Standing, StateSnapshot};
 
 use crate::game::ClientGame;
+use crate::ghost::Ghost;
 #[cfg(not(target_arch = "wasm32"))]
 use crate::net::background::{ConnectRequest, NetOptions, NetThread};
 #[cfg(not(target_arch = "wasm32"))]
@@ -126,6 +127,10 @@ pub struct OnlineGame<
     /// How many standings (or refusals) the server sent: tells a new one
     /// from the last when both say the same.
     standings: u64,
+    /// The runs to race against, played from their replays.
+    ghosts: Vec<Ghost>,
+    /// Why the last ghost the server sent could not be played, if so.
+    ghost_error: Option<String>,
     /// Snapshots arrived since the last [`OnlineGame::take_arrivals`].
     arrivals: u32,
     /// When the last snapshot (or the welcome) arrived.
@@ -205,6 +210,8 @@ impl<N: Network> OnlineGame<N> {
             latest: None,
             standing: None,
             standings: 0,
+            ghosts: Vec::new(),
+            ghost_error: None,
             arrivals: 0,
             last_news: None,
             fresh: false,
@@ -329,6 +336,7 @@ impl<N: Network> OnlineGame<N> {
                 self.standing = Some(r.clone());
                 self.standings += 1;
             }
+            NetEvent::Ghost(run) => self.add_ghost(run),
             NetEvent::Untrusted(reason) => self.untrusted = Some(reason.clone()),
             NetEvent::Failed(_)
             | NetEvent::Disconnected(_)
@@ -384,6 +392,37 @@ impl<N: Network> OnlineGame<N> {
     /// The game, once welcomed.
     pub fn game(&self) -> Option<&ClientGame> {
         self.game.as_ref()
+    }
+
+    /// The runs to race against (the level's record, our best), as the
+    /// server sent them.
+    pub fn ghosts(&self) -> &[Ghost] {
+        &self.ghosts
+    }
+
+    /// Why the last ghost could not be played, if so.
+    pub fn ghost_error(&self) -> Option<&str> {
+        self.ghost_error.as_deref()
+    }
+
+    /// Plays a ghost's replay into its track (a run of a few seconds plays
+    /// in milliseconds); replaces the ghost of the same kind.
+    fn add_ghost(&mut self, run: &GhostRun) {
+        let Some(level) = self.level() else {
+            self.ghost_error = Some("a ghost came before the level".into());
+            return;
+        };
+        match Ghost::from_run(level, run) {
+            Ok(ghost) => {
+                self.ghosts.retain(|g| g.record != ghost.record);
+                self.ghosts.push(ghost);
+                self.ghosts.sort_by_key(|g| !g.record);
+            }
+            Err(e) => {
+                tracing::warn!("ghost of {} not shown: {e}", run.player);
+                self.ghost_error = Some(e.to_string());
+            }
+        }
     }
 
     /// The level, once welcomed (draw its tilemap).

@@ -279,6 +279,30 @@ impl RecordStore {
             .map_err(self.query_err())
     }
 
+    /// `player`'s best run on the level: its time (milliseconds) and its
+    /// replay's id, if it has one.
+    pub async fn best_of(
+        &self,
+        level_hash: &str,
+        player: &str,
+    ) -> Result<Option<(u64, Option<String>)>, RecordsError> {
+        let row = sqlx::query(
+            "SELECT millis, replay_id FROM runs WHERE level_hash = $1 AND player = $2 \
+             ORDER BY millis ASC, finished_at ASC LIMIT 1",
+        )
+        .bind(level_hash)
+        .bind(player)
+        .fetch_optional(&self.pool)
+        .await
+        .map_err(self.query_err())?;
+        let Some(row) = row else {
+            return Ok(None);
+        };
+        let millis: i64 = row.try_get("millis").map_err(self.query_err())?;
+        let replay: Option<String> = row.try_get("replay_id").map_err(self.query_err())?;
+        Ok(Some((millis.max(0) as u64, replay)))
+    }
+
     /// Runs stored under `key` (0 or 1: for the tests).
     pub async fn count_key(&self, key: &str) -> Result<u64, RecordsError> {
         let row = sqlx::query("SELECT COUNT(*) AS n FROM runs WHERE run_key = $1")
@@ -450,6 +474,12 @@ mod tests {
         // Each best with its own run's replay.
         assert_eq!(top[0].replay.as_deref(), Some("replay-of-b1"));
         assert_eq!(top[1].replay.as_deref(), Some("replay-of-a1"));
+        let level = "aa".repeat(32);
+        assert_eq!(
+            store.best_of(&level, "ann").await.unwrap(),
+            Some((10_000, Some("replay-of-a1".into())))
+        );
+        assert_eq!(store.best_of(&level, "zed").await.unwrap(), None);
         assert_eq!(store.top(&"aa".repeat(32), 1).await.unwrap().len(), 1);
         let levels = store.levels().await.unwrap();
         assert_eq!(levels.len(), 1);

@@ -10,6 +10,7 @@
 //! The web port serves them at `/replays/ID`.
 
 pub mod dir;
+pub mod ghosts;
 pub mod recording;
 pub mod writer;
 

@@ -773,7 +773,30 @@ pub enum ServerControl {
         /// Why, for the results card.
         reason: String,
     },
+    /// A run to race against, as its replay file
+    /// (`ledge_shared::replay::decode`): the level's record, or the
+    /// receiver's own best. Sent after the roster when the server has one.
+    /// Added in protocol version 10.
+    Ghost(GhostRun),
 }
+
+/// A ghost: who ran it, in what time, and the run's replay.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct GhostRun {
+    /// The level's record (`false`: the receiver's own best).
+    pub record: bool,
+    /// Who ran it (checked as a player name).
+    pub player: String,
+    /// Its time, milliseconds.
+    pub millis: u64,
+    /// The run's replay file, at most [`MAX_GHOST_REPLAY`] bytes.
+    #[serde(with = "super::codec::bytes")]
+    pub replay: Vec<u8>,
+}
+
+/// Most bytes of a ghost's replay in a [`ServerControl::Ghost`] (a run
+/// replay of a few minutes among a few players; a larger one is not sent).
+pub const MAX_GHOST_REPLAY: usize = MAX_FRAME - 1024;
 
 impl ServerControl {
     /// The message's name, for errors and logs (never its contents, which
@@ -792,6 +815,7 @@ impl ServerControl {
             ServerControl::Rooms { .. } => "Rooms",
             ServerControl::RunRecorded(_) => "RunRecorded",
             ServerControl::RunNotRecorded { .. } => "RunNotRecorded",
+            ServerControl::Ghost(_) => "Ghost",
         }
     }
 }
@@ -835,6 +859,17 @@ impl Message for ServerControl {
             ServerControl::RunRecorded(standing) => check_standing(standing),
             ServerControl::RunNotRecorded { reason } => {
                 check_text("not recorded reason", reason, 0, MAX_REASON_LEN)
+            }
+            ServerControl::Ghost(ghost) => {
+                check_name(&ghost.player)?;
+                if ghost.replay.len() > MAX_GHOST_REPLAY {
+                    return Err(ProtocolError::too_large(
+                        "ghost replay",
+                        ghost.replay.len(),
+                        MAX_GHOST_REPLAY,
+                    ));
+                }
+                Ok(())
             }
         }
     }

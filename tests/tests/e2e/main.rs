@@ -14,6 +14,7 @@ mod churn;
 mod conditioned;
 mod deploy_manifests;
 mod gameplay;
+mod ghosts;
 mod handshake;
 mod impaired;
 mod level_download;

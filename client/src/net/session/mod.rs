@@ -22,7 +22,8 @@
 use std::time::Duration;
 
 use ledge_shared::protocol::{
-    ClientControl, NoticeKind, PlayerId, SessionToken, Standing, StateSnapshot, PROTOCOL_VERSION,
+    ClientControl, GhostRun, NoticeKind, PlayerId, SessionToken, Standing, StateSnapshot,
+    PROTOCOL_VERSION,
 };
 
 use crate::time::Instant;
@@ -165,6 +166,9 @@ pub enum SessionEvent {
     /// Our finished run is stored in the server's records: where it
     /// stands (`Ok`), or why it was not stored (`Err`).
     RunRecorded(Result<Standing, String>),
+    /// A run to race against (the level's record or our best), as its
+    /// replay ([`crate::ghost::Ghost::from_run`] plays it).
+    Ghost(GhostRun),
 }
 
 /// Counters of what the session received and sent.

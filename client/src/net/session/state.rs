@@ -439,6 +439,7 @@ impl SessionState {
             ServerControl::RunNotRecorded { reason } => {
                 self.push(SessionEvent::RunRecorded(Err(reason)));
             }
+            ServerControl::Ghost(ghost) => self.push(SessionEvent::Ghost(ghost)),
             ServerControl::Welcome(_)
             | ServerControl::Reject { .. }
             | ServerControl::Rooms { .. } => {
