@@ -92,10 +92,12 @@ impl Playback {
     /// Steps one tick; `false` at the end (nothing done).
     pub fn step(&mut self) -> Result<bool, ReplayError> {
         if self.cursor.steps_left == 0 {
+            // After a failure the cursor is still on the event that failed:
+            // this fails again, saying why.
+            self.between_steps()?;
             if self.at_end() {
                 return Ok(false);
             }
-            // `between_steps` stopped at a `Step`.
             let Event::Step(n) = self.replay.events[self.cursor.event] else {
                 unreachable!("between_steps stops at a step or the end");
             };

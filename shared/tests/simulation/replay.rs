@@ -188,7 +188,10 @@ fn a_replay_that_plays_differently_says_from_which_tick() {
             }
         }
     }
-    let err = playback(replay).play_to_end().unwrap_err();
+    let mut playing = playback(replay);
+    let err = playing.play_to_end().unwrap_err();
+    // Stepping on says the same again.
+    assert_eq!(playing.step().unwrap_err(), err);
     match err {
         ReplayError::Diverged { tick, ours, theirs } => {
             assert_eq!(tick, 180);
