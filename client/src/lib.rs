@@ -21,6 +21,9 @@
 //!   ([`net::online`], [`OnlineGame`]), and the server's level
 //!   ([`net::levels`], [`net::download`], [`net::bundle`]);
 //! * [`netstats`]: RTT, jitter, loss, rates;
+//! * [`replay`]: a replay as a front end shows it ([`replay::ReplayViewer`]:
+//!   speeds, pauses, seeking, whom the camera follows; its frames as
+//!   [`view::FrameView`]s);
 //! * [`bot`]: headless bots (idle, random walker, route runner,
 //!   misbehaving);
 //! * [`time`]: the clock type, native or the browser's;
@@ -45,6 +48,7 @@ pub mod error;
 pub mod game;
 pub mod net;
 pub mod netstats;
+pub mod replay;
 pub mod rng;
 pub mod time;
 pub mod view;
