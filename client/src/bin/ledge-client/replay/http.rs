@@ -1,5 +1,6 @@
 //! One plain HTTP GET to a ledge server's web port (ureq: no TLS, no
-//! compression, no redirects): the body read up to a bound and never
+//! compression, no redirects, no proxy: straight to the server, as the
+//! game's own connection goes): the body read up to a bound and never
 //! more, refused before reading when the server announces more; every
 //! failure in words, with what to do.
 
@@ -22,6 +23,7 @@ pub fn get(url: &str, max: u64, what: &str, not_found: &str) -> anyhow::Result<V
     let agent: ureq::Agent = ureq::Agent::config_builder()
         .http_status_as_error(false)
         .max_redirects(0)
+        .proxy(None)
         .timeout_connect(Some(CONNECT_TIMEOUT))
         .timeout_global(Some(REQUEST_TIMEOUT))
         .user_agent(concat!("ledge-client/", env!("CARGO_PKG_VERSION")))
