@@ -22,6 +22,9 @@
 //!   ([`net::levels`], [`net::download`], [`net::bundle`]);
 //! * [`ghost`]: a run to race against, played from its replay;
 //! * [`netstats`]: RTT, jitter, loss, rates;
+//! * [`replay`]: a replay as a front end shows it ([`replay::ReplayViewer`]:
+//!   speeds, pauses, seeking, whom the camera follows; its frames as
+//!   [`view::FrameView`]s);
 //! * [`bot`]: headless bots (idle, random walker, route runner,
 //!   misbehaving);
 //! * [`time`]: the clock type, native or the browser's;
@@ -47,6 +50,7 @@ pub mod game;
 pub mod ghost;
 pub mod net;
 pub mod netstats;
+pub mod replay;
 pub mod rng;
 pub mod time;
 pub mod view;

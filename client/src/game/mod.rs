@@ -441,7 +441,7 @@ impl ClientGame {
 /// The side a wall touches an airborne player on (for
 /// [`PlayerDraw::wall`]): `None` on the ground, or touching both sides or
 /// neither.
-fn wall_side(sides: Sides, grounded: bool) -> Option<Facing> {
+pub(crate) fn wall_side(sides: Sides, grounded: bool) -> Option<Facing> {
     if grounded {
         return None;
     }

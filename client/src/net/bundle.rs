@@ -80,7 +80,7 @@ impl LevelCache {
 
     /// The cached bundle's bytes if present, of the offered size and hash;
     /// a damaged one is deleted.
-    fn get(&self, offer: &LevelOffer) -> Option<Vec<u8>> {
+    pub fn get(&self, offer: &LevelOffer) -> Option<Vec<u8>> {
         let path = self.bundle_path(offer);
         let len = std::fs::metadata(&path).ok()?.len();
         if len == offer.size {
@@ -93,6 +93,30 @@ impl LevelCache {
         tracing::warn!("{} is damaged; downloading it again", path.display());
         let _ = std::fs::remove_file(&path);
         None
+    }
+
+    /// Keeps `bytes`, the bundle `offer` names (refused unless they are:
+    /// size and SHA-256), as its complete file: written beside it, then
+    /// renamed into place; the cache is then trimmed. Returns the file.
+    pub fn store(&self, offer: &LevelOffer, bytes: &[u8]) -> Result<PathBuf, ClientError> {
+        if bytes.len() as u64 != offer.size || sha256(bytes) != offer.sha256 {
+            return Err(ClientError::LevelHashMismatch {
+                expected: offer.hex(),
+            });
+        }
+        let fail = |e: std::io::Error| {
+            ClientError::LevelDownload(format!(
+                "cannot write the level cache {}: {e} (choose another folder with --level-cache)",
+                self.dir.display()
+            ))
+        };
+        std::fs::create_dir_all(&self.dir).map_err(fail)?;
+        let part = self.part_path(offer);
+        std::fs::write(&part, bytes).map_err(fail)?;
+        let done = self.bundle_path(offer);
+        std::fs::rename(&part, &done).map_err(fail)?;
+        self.trim(&done);
+        Ok(done)
     }
 
     /// What a cut download left (at most the offered size; more is

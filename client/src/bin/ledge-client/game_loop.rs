@@ -15,7 +15,7 @@ use crate::draw::anim::Animator;
 use crate::sound::audio::{Audio, AudioStatus, Effect};
 use crate::sound::cues::Cues;
 use ledge_client::time::Instant;
-use ledge_client::view::{px2, FrameView, NetStats};
+use ledge_client::view::{FrameView, NetStats};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::game::PlayerView;
 use ledge_shared::input::Buttons;
@@ -26,7 +26,7 @@ use crate::chat::{Chat, Key};
 use crate::draw::art::ArtView;
 use crate::draw::camera::{self, Camera};
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
-use crate::draw::{card, chat as chat_view, debug, fx, hud};
+use crate::draw::{card, chat as chat_view, fx, hud, scene};
 use crate::input::keys::{Bindings, Gamepads};
 use crate::input::script::Script;
 use crate::input::typing;
@@ -437,7 +437,7 @@ impl GameLoop {
 
     /// What to draw (players posed, entities), and the camera following us.
     fn compose(&mut self, dt: Duration) -> Scene {
-        let level_px = level_extent(self.setup.play.level(), &self.art);
+        let level_px = scene::level_extent(self.setup.play.level(), &self.art);
         let frame_view = self.setup.play.view().unwrap_or_default();
         let (local, remotes) = play::sprites(&frame_view, &mut self.animator, dt.as_secs_f32());
         let entities: Vec<EntitySprite> =
@@ -514,42 +514,27 @@ impl GameLoop {
 
     /// Draws the world: sky, art, tiles, entities, players, effects, debug overlay.
     fn draw_world(&self, scene: &Scene, now: f64) {
-        let level = self.setup.play.level();
-        let view = &scene.view;
-        let time = now as f32;
-        match self.art.background() {
-            Some(colour) => clear_background(colour),
-            None => render::draw_background(view, time),
-        }
-        self.art.draw(view);
-        render::draw_tilemap(&level.tilemap, view, self.art.covered());
-        // A level's own art draws its solids; ledge draws them otherwise.
-        let statics = self.art.is_empty();
-        if statics {
-            render::draw_polygon_blocks(level, view);
-        }
-        render::draw_entities(
-            &scene.entities,
-            view,
-            scene.me.as_ref().and_then(|m| m.checkpoint),
-            time,
-            statics,
-        );
-        render::draw_players(
-            view,
-            scene.local.as_ref().zip(self.local_label(scene)),
-            scene
+        let debug = self
+            .show_debug
+            .then(|| self.setup.play.game())
+            .flatten()
+            .map(|g| g.game().world());
+        scene::draw(scene::WorldFrame {
+            level: self.setup.play.level(),
+            art: &self.art,
+            view: &scene.view,
+            entities: &scene.entities,
+            checkpoint: scene.me.as_ref().and_then(|m| m.checkpoint),
+            local: scene.local.as_ref().zip(self.local_label(scene)),
+            remotes: scene
                 .remotes
                 .iter()
-                .zip(scene.labels.iter().map(String::as_str)),
-        );
-        self.effects.draw(view);
-        self.effects.draw_flash();
-        if self.show_debug {
-            if let Some(game) = self.setup.play.game() {
-                debug::draw(game.game().world(), view);
-            }
-        }
+                .zip(scene.labels.iter().map(String::as_str))
+                .collect(),
+            effects: &self.effects,
+            debug,
+            time: now as f32,
+        });
     }
 
     /// Our player's label: its name from the roster, else ours.
@@ -770,6 +755,7 @@ impl GameLoop {
                 recent: self.effects.recent(),
                 dead: scene.me.as_ref().is_some_and(|m| m.dead.is_some()),
             },
+            replay: None,
         };
         if let Err(e) = shot::save(path, &shot) {
             fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));
@@ -797,20 +783,5 @@ impl GameLoop {
         drop(play);
         #[cfg(not(target_arch = "wasm32"))]
         drop(server);
-    }
-}
-
-/// The world the camera stays inside: everything in the level (grid,
-/// entities, platform paths) and everything its art draws, world pixels.
-fn level_extent(level: &Level, art: &ArtView) -> Rect {
-    let things = level.bounds().map(|(lo, hi)| {
-        let (lo, hi) = (px2(lo), px2(hi));
-        Rect::new(lo.x, lo.y, hi.x - lo.x, hi.y - lo.y)
-    });
-    match (things, art.extent()) {
-        (Some(a), Some(e)) => a.combine_with(e),
-        (Some(a), None) => a,
-        (None, Some(e)) => e,
-        (None, None) => Rect::new(0.0, 0.0, 1.0, 1.0),
     }
 }

@@ -9,7 +9,9 @@
 //!   `$XDG_CONFIG_HOME/ledge/known_hosts`); a changed certificate is refused
 //!   with a message saying what to do, and exit code 3;
 //! * `--local`: starts the real server in-process on `127.0.0.1:0` and
-//!   joins it: one command, a playable game.
+//!   joins it: one command, a playable game;
+//! * `--replay FILE|URL`: plays a replay in the window ([`replay`]), or
+//!   checks it without one (`--check`).
 //!
 //! The simulation runs at a fixed 60 Hz (accumulator); frames are drawn
 //! interpolated between the last two ticks. `--script`, `--screenshot` and
@@ -30,7 +32,8 @@
 //!
 //! Modules, top to bottom (each uses only those below it): the entry
 //! points ([`native`] with [`local`], and `web` in the browser) prepare a
-//! [`game_loop::Setup`]; the [`game_loop`] runs the frames; [`play`] (the
+//! [`game_loop::Setup`]; the [`game_loop`] runs the frames (a replay's
+//! entry and window are [`replay`]'s, beside it); [`play`] (the
 //! game, offline or online) and [`shot`] (`--screenshot`) serve it, with
 //! three groups that do one thing each for it: [`draw`] (the camera, the
 //! world, the players' animation, effects, the HUD, the debug overlay),
@@ -57,6 +60,8 @@ mod outcome;
 #[cfg(target_arch = "wasm32")]
 mod page;
 mod play;
+#[cfg(not(target_arch = "wasm32"))]
+mod replay;
 mod shot;
 mod sound;
 #[cfg(target_arch = "wasm32")]

@@ -14,7 +14,7 @@ use crate::game_loop::{game, Setup};
 use crate::input::keys::{self, Bindings};
 use crate::input::script::Script;
 use crate::outcome::{tell, EXIT_CODE, EXIT_FAILED, EXIT_UNTRUSTED};
-use crate::{local, play};
+use crate::{local, play, replay};
 
 /// How long the window waits for the server's first answer before it
 /// opens (showing "connecting..."): enough for the TLS handshake, so a
@@ -23,13 +23,21 @@ const CONNECT_WAIT: Duration = Duration::from_secs(3);
 
 /// The exit codes, for `--help`.
 const EXIT_CODES: &str = "Exit codes:
-  0  the game ended normally (Esc, window closed, --exit-after-ticks reached)
+  0  the game ended normally (Esc, window closed, --exit-after-ticks reached);
+     --replay --check: the replay played to its end as recorded
   1  the session failed (server unreachable, refused us or dropped us), or the
-     game could not start (level or keys file, screenshot); the reason is
-     printed on stderr, prefixed \"ledge-client: \"
-  2  a command-line error, or not joined within --join-timeout
+     game could not start (level or keys file, screenshot); a replay does not
+     play (its level not found, it plays differently from the server); the
+     reason is printed on stderr, prefixed \"ledge-client: \"
+  2  a command-line error, or not joined within --join-timeout; the replay
+     cannot be read (missing, damaged, cut short, newer, not on the server)
   3  the server's certificate was refused (wrong --cert-hash, or not the one
-     remembered in the known-hosts file)";
+     remembered in the known-hosts file)
+
+Replays (--replay FILE|URL): Space pause, -/+ (or [/]) speed 0.25x to 4x,
+Left/Right 5 s back/forward, Home/End start/end, Tab next player (Shift+Tab
+the one before), F free camera (WASD moves it), F1 debug, F2 HUD, M sound,
+Esc quits.";
 
 /// ledge: a networked 2D platformer.
 ///
@@ -130,6 +138,28 @@ struct Cli {
     /// Start with sound muted (M toggles it).
     #[arg(long)]
     mute: bool,
+    /// Play a replay: a file saved from a server, or its address on the
+    /// server's web port, http://HOST:PORT/replays/ID. Its level is the
+    /// embedded one, in the level cache, --level FILE, or downloaded from
+    /// that server. Keys below.
+    #[arg(long, value_name = "FILE|URL",
+          conflicts_with_all = ["connect", "local", "script", "look_at"])]
+    replay: Option<String>,
+    /// With --replay: play it to its end as fast as possible, checking
+    /// every state hash against the server's, without a window; print one
+    /// line (or the reason it fails, exit code 1).
+    #[arg(long, requires = "replay")]
+    check: bool,
+    /// With --replay: open it at this game tick (the HUD's "tick").
+    #[arg(long, value_name = "TICK", requires = "replay")]
+    replay_seek: Option<u64>,
+    /// With --replay: follow the player of this name (a run's replay
+    /// follows its runner, a match's its first player).
+    #[arg(long, value_name = "NAME", requires = "replay")]
+    follow: Option<String>,
+    /// With --replay: start at this speed (0.25, 0.5, 1, 2 or 4).
+    #[arg(long, value_name = "X", requires = "replay")]
+    replay_speed: Option<f32>,
     /// Window size, WIDTHxHEIGHT.
     #[arg(long, value_name = "WxH", default_value = "960x540", value_parser = parse_size)]
     window: (i32, i32),
@@ -216,6 +246,12 @@ fn run() -> anyhow::Result<()> {
         Some(path) => Bindings::load(path).map_err(anyhow::Error::msg)?,
         None => Bindings::default(),
     };
+    if let Some(replay) = cli.replay.clone() {
+        return match replay::run(replay_args(cli, replay, bindings)) {
+            0 => Ok(()),
+            code => std::process::exit(code),
+        };
+    }
     let script = cli
         .script
         .as_deref()
@@ -309,6 +345,28 @@ fn run() -> anyhow::Result<()> {
     match EXIT_CODE.load(Ordering::Relaxed) {
         0 => Ok(()),
         code => std::process::exit(code),
+    }
+}
+
+/// The replay's options from the command line.
+fn replay_args(cli: Cli, replay: String, bindings: Bindings) -> replay::ReplayArgs {
+    replay::ReplayArgs {
+        replay,
+        check: cli.check,
+        seek: cli.replay_seek,
+        follow: cli.follow,
+        speed: cli.replay_speed,
+        level: cli.level,
+        level_settings: cli.level_settings,
+        level_cache: cli.level_cache,
+        bindings,
+        exit_after: cli.exit_after_ticks,
+        screenshot: cli.screenshot,
+        debug: cli.debug,
+        hud: !cli.no_hud,
+        volume: f32::from(cli.volume) / 100.0,
+        mute: cli.mute,
+        window: cli.window,
     }
 }
 

@@ -13,6 +13,10 @@ pub const EXIT_FAILED: i32 = 1;
 /// exit with 2 too).
 pub const EXIT_JOIN_TIMEOUT: i32 = 2;
 
+/// Exit code when `--replay`'s file cannot be read, or is not a replay
+/// ledge can read (missing, damaged, cut short, newer, not served).
+pub const EXIT_UNREADABLE: i32 = 2;
+
 /// Exit code when the server's certificate is refused.
 pub const EXIT_UNTRUSTED: i32 = 3;
 

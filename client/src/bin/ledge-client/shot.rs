@@ -60,6 +60,16 @@
 //!                                      // null unless the chat line is open
 //!     "muted": ["eve"]
 //!   },
+//!   "replay": {                        // null unless playing a replay (--replay)
+//!     "tick": 1530,                    // the game's tick shown
+//!     "start_tick": 0, "end_tick": 2400, "home": 0,  // its span; where it opened
+//!     "speed": 1.0, "paused": false, "at_end": false, "run": false,
+//!     "following": {"id": 2, "name": "bob"},  // null: nobody (free camera, empty game)
+//!     "free_camera": false,
+//!     "lines": {"clock": "replay 0:25.50 / 0:40.00   1x", "kind": "match   room-1 on Default",
+//!               "follow": "following bob (Tab: next)   tick 1530", "failure": null},
+//!     "end_banner": null               // ["end of replay", "Space or Home: ..."] when drawn
+//!   },                                 // ("player" above is the followed player)
 //!   "failure": {                       // null unless the session failed
 //!     "message": "cannot join ...",    // as printed on stderr
 //!     "font_size": 20.0,
@@ -107,6 +117,36 @@ pub struct Shot<'a> {
     pub chat: Option<ChatShot<'a>>,
     /// The visual effects on screen.
     pub fx: FxShot<'a>,
+    /// The replay shown, if it is one (`--replay`).
+    pub replay: Option<ReplayShot<'a>>,
+}
+
+/// A replay's frame.
+pub struct ReplayShot<'a> {
+    /// The game's tick shown.
+    pub tick: u64,
+    /// The game's tick where the replay starts.
+    pub start_tick: u64,
+    /// Where it ends.
+    pub end_tick: u64,
+    /// Where it opened (a run's start).
+    pub home: u64,
+    /// Its speed (1: as played).
+    pub speed: f32,
+    /// Paused by the viewer.
+    pub paused: bool,
+    /// At its end (or where it failed).
+    pub at_end: bool,
+    /// A run's replay (else a match's).
+    pub run: bool,
+    /// The followed player's id and name.
+    pub following: Option<(u32, &'a str)>,
+    /// The camera is free.
+    pub free_camera: bool,
+    /// The replay's HUD lines.
+    pub lines: &'a crate::draw::replay_hud::ReplayLines,
+    /// The end's notice (its paragraphs), when drawn.
+    pub end_banner: Option<&'a [&'a str]>,
 }
 
 /// The chat when the frame was taken.
@@ -271,6 +311,7 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
         fx.dead
     );
     describe_chat(&mut s, shot.chat.as_ref());
+    describe_replay(&mut s, shot.replay.as_ref());
     describe_failure(&mut s, shot.failure);
     s.push_str("}\n");
     s
@@ -455,6 +496,43 @@ fn describe_card_line(line: &crate::draw::card::Line) -> String {
     )
 }
 
+/// The replay's frame (`null` unless it is one).
+fn describe_replay(s: &mut String, replay: Option<&ReplayShot>) {
+    let Some(r) = replay else {
+        let _ = writeln!(s, "  \"replay\": null,");
+        return;
+    };
+    let following = r.following.map_or("null".to_owned(), |(id, name)| {
+        format!("{{\"id\": {id}, \"name\": {}}}", json_string(name))
+    });
+    let l = r.lines;
+    let failure = l.failure.as_deref().map_or("null".to_owned(), json_string);
+    let end = r.end_banner.map_or("null".to_owned(), |paragraphs| {
+        let texts: Vec<String> = paragraphs.iter().map(|p| json_string(p)).collect();
+        format!("[{}]", texts.join(", "))
+    });
+    let _ = writeln!(s, "  \"replay\": {{");
+    let _ = writeln!(s, "    \"tick\": {},", r.tick);
+    let _ = writeln!(s, "    \"start_tick\": {},", r.start_tick);
+    let _ = writeln!(s, "    \"end_tick\": {},", r.end_tick);
+    let _ = writeln!(s, "    \"home\": {},", r.home);
+    let _ = writeln!(s, "    \"speed\": {},", r.speed);
+    let _ = writeln!(s, "    \"paused\": {},", r.paused);
+    let _ = writeln!(s, "    \"at_end\": {},", r.at_end);
+    let _ = writeln!(s, "    \"run\": {},", r.run);
+    let _ = writeln!(s, "    \"following\": {following},");
+    let _ = writeln!(s, "    \"free_camera\": {},", r.free_camera);
+    let _ = writeln!(
+        s,
+        "    \"lines\": {{\"clock\": {}, \"kind\": {}, \"follow\": {}, \"failure\": {failure}}},",
+        json_string(&l.clock),
+        json_string(&l.kind),
+        json_string(&l.follow)
+    );
+    let _ = writeln!(s, "    \"end_banner\": {end}");
+    let _ = writeln!(s, "  }},");
+}
+
 /// The session's failure and its panel (`null` unless it failed).
 fn describe_failure(s: &mut String, failure: Option<(&str, &BannerLayout)>) {
     match failure {
@@ -531,6 +609,7 @@ mod tests {
                 recent: &[],
                 dead: false,
             },
+            replay: None,
         };
         let json = describe(&shot, Path::new("c.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect(&json);
@@ -609,6 +688,7 @@ mod tests {
                 recent: &[crate::sound::audio::Effect::Hurt],
                 dead: true,
             },
+            replay: None,
         };
         let json = describe(&shot, Path::new("/tmp/a.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect("JSON");
@@ -680,6 +760,7 @@ mod tests {
                 recent: &[],
                 dead: false,
             },
+            replay: None,
         };
         let json: serde_json::Value =
             serde_json::from_str(&describe(&shot, Path::new("f.png"), 480, 270)).expect("JSON");
@@ -771,6 +852,7 @@ mod tests {
                 recent: &[],
                 dead: false,
             },
+            replay: None,
         };
         let json = describe(&shot(hud(Some(&card))), Path::new("c.png"), 960, 540);
         let json: serde_json::Value = serde_json::from_str(&json).expect("JSON");

@@ -175,6 +175,17 @@ pub fn run_time(ticks: u32, rate: u32) -> String {
     format!("{}:{:02}.{:02}", cs / 6000, cs / 100 % 60, cs % 100)
 }
 
+/// A run as the HUD's second line says it: `coins 2/13   deaths 1   0:06.86`.
+pub fn run_line(run: &RunInfo) -> String {
+    format!(
+        "coins {}/{}   deaths {}   {}",
+        run.coins,
+        run.coins_total,
+        run.deaths,
+        run_time(run.run_ticks, run.tick_rate)
+    )
+}
+
 /// `1st`, `2nd`, `3rd`, `4th`, ... `11th`, `21st`.
 pub fn ordinal(n: u32) -> String {
     let suffix = match (n % 10, n % 100) {
@@ -204,9 +215,9 @@ pub fn crisp_text(text: &str, x: f32, y: f32, size: f32, color: Color) {
     }
 }
 
-/// A panel of `lines` with its top-left corner at `(x, y)`; returns its
-/// height.
-fn panel(lines: &[(String, Color, f32)], x: f32, y: f32) -> f32 {
+/// A panel of `lines` (text, colour, font size) with its top-left corner
+/// at `(x, y)`; returns its height.
+pub fn panel(lines: &[(String, Color, f32)], x: f32, y: f32) -> f32 {
     let width = lines
         .iter()
         .map(|(l, _, size)| measure_text(l, None, *size as u16, 1.0).width)
@@ -227,17 +238,7 @@ fn panel(lines: &[(String, Color, f32)], x: f32, y: f32) -> f32 {
 pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
     let mut lines: Vec<(String, Color, f32)> = vec![(info.name.to_owned(), WHITE, 22.0)];
     if let Some(run) = &info.run {
-        lines.push((
-            format!(
-                "coins {}/{}   deaths {}   {}",
-                run.coins,
-                run.coins_total,
-                run.deaths,
-                run_time(run.run_ticks, run.tick_rate)
-            ),
-            GOLD,
-            FONT,
-        ));
+        lines.push((run_line(run), GOLD, FONT));
     }
     lines.push((format!("restart: {}", info.restart_key), DIM, 14.0));
     let mut y = 8.0 + panel(&lines, 8.0, 8.0) + 6.0;
@@ -318,28 +319,33 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
             "arrows/WASD move   space/Z jump   down+jump drop   {} restart   T chat   M sound   F3 net   F2 HUD{quit}",
             info.restart_key
         );
-        let dims = measure_text(&help, None, 16, 1.0);
-        let (x, y) = (screen_width() - dims.width - 14.0, screen_height() - 10.0);
-        let a = info.hint_alpha.clamp(0.0, 1.0);
-        draw_rectangle(
-            x - 6.0,
-            y - 15.0,
-            dims.width + 12.0,
-            20.0,
-            Color {
-                a: PANEL.a * a,
-                ..PANEL
-            },
-        );
-        crisp_text(&help, x, y, 16.0, Color { a, ..DIM });
+        hint(&help, info.hint_alpha);
     }
+}
+
+/// The keys' hint, bottom right, at opacity `alpha` (0..=1).
+pub fn hint(help: &str, alpha: f32) {
+    let dims = measure_text(help, None, 16, 1.0);
+    let (x, y) = (screen_width() - dims.width - 14.0, screen_height() - 10.0);
+    let a = alpha.clamp(0.0, 1.0);
+    draw_rectangle(
+        x - 6.0,
+        y - 15.0,
+        dims.width + 12.0,
+        20.0,
+        Color {
+            a: PANEL.a * a,
+            ..PANEL
+        },
+    );
+    crisp_text(help, x, y, 16.0, Color { a, ..DIM });
 }
 
 /// Rows of the results table drawn at most (the rest: "... and N more").
 pub const TABLE_ROWS: usize = 10;
 
 /// The room's results, top right: place, name, time, deaths; ours in gold.
-fn results_table(rows: &[ResultRow], rate: u32, top: f32) {
+pub fn results_table(rows: &[ResultRow], rate: u32, top: f32) {
     let mut lines: Vec<(String, Color, f32)> = vec![("finished".to_owned(), DIM, 14.0)];
     for r in rows.iter().take(TABLE_ROWS) {
         lines.push((
@@ -466,6 +472,21 @@ fn draw_banner(layout: &BannerLayout, panel: Color) {
 pub fn banner(text: &str) {
     let screen = vec2(screen_width(), screen_height());
     draw_banner(&BannerLayout::new(&[text], screen, measure), PANEL);
+}
+
+/// Between the bottom of the window and a notice's panel, pixels: room
+/// for the keys' hint.
+const NOTICE_BOTTOM: f32 = 40.0;
+
+/// A notice of `paragraphs` (the first white, the others dim) on a panel
+/// centred near the bottom of the window, above the keys' hint (the
+/// middle is where the camera's player is); returns its layout.
+pub fn notice(paragraphs: &[&str]) -> BannerLayout {
+    let screen = vec2(screen_width(), screen_height());
+    let mut layout = BannerLayout::new(paragraphs, screen, measure);
+    layout.panel.y = (screen.y - NOTICE_BOTTOM - layout.panel.h).max(BANNER_EDGE);
+    draw_banner(&layout, PANEL);
+    layout
 }
 
 /// The end of a failed session: the scene shaded, and `message` (what

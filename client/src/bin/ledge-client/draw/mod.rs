@@ -3,7 +3,8 @@
 //! in [`art`]), how the players move between ticks ([`anim`]), particles,
 //! shake and flashes ([`fx`]), the heads-up display ([`hud`]), the results
 //! card once our run is finished ([`card`]), the chat ([`chat`]) and the
-//! debug overlay ([`debug`]).
+//! debug overlay ([`debug`]); the world's layers in their order
+//! ([`scene`]), and a replay's HUD ([`replay_hud`]).
 //!
 //! Grouped so that the front end's layout says what it does; this module
 //! only declares them.
@@ -17,3 +18,5 @@ pub mod debug;
 pub mod fx;
 pub mod hud;
 pub mod render;
+pub mod replay_hud;
+pub mod scene;
