@@ -12,6 +12,8 @@ use ledge_server::{Server, ServerConfig, ShutdownHandle};
 /// A real server on loopback, in-process, on its own runtime, for one test.
 pub struct TestServer {
     pub addr: SocketAddr,
+    /// The web port, when configured (`ServerConfig::web`).
+    pub web_addr: Option<SocketAddr>,
     pub fingerprint: Fingerprint,
     shutdown: ShutdownHandle,
     runtime: tokio::runtime::Runtime,
@@ -43,10 +45,11 @@ impl TestServer {
             ..ServerConfig::default()
         };
         configure(&mut config);
-        let (addr, fingerprint, shutdown, task) = runtime.block_on(async {
+        let (addr, web_addr, fingerprint, shutdown, task) = runtime.block_on(async {
             let server = Server::bind(config).expect("server binds");
             (
                 server.local_addr(),
+                server.web_addr(),
                 server.fingerprint(),
                 server.shutdown_handle(),
                 tokio::spawn(server.run()),
@@ -54,6 +57,7 @@ impl TestServer {
         });
         TestServer {
             addr,
+            web_addr,
             fingerprint,
             shutdown,
             runtime,
