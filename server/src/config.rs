@@ -188,6 +188,9 @@ pub struct ServerConfig {
     /// Where finished runs are stored (`--records`); `None` (the
     /// default): [`crate::records::DEFAULT_FILE`] in `cert_dir`.
     pub records: Option<RecordsTarget>,
+    /// How often records that could not be opened at start are tried
+    /// again (set programmatically; 30 s).
+    pub records_retry: Duration,
     /// Where replays are saved (`--replays`); `None` (the default):
     /// [`crate::replays::DEFAULT_DIR`] in `cert_dir`.
     pub replays: Option<ReplaysTarget>,
@@ -255,6 +258,7 @@ impl Default for ServerConfig {
             agones: None,
             web: None,
             records: None,
+            records_retry: Duration::from_secs(30),
             replays: None,
             replays_cap: crate::replays::DEFAULT_CAP_MIB << 20,
         }

@@ -580,7 +580,7 @@ impl Room {
         let (Some(store), Some(dir)) = (config.records.store(), config.replays.dir()) else {
             return;
         };
-        let (store, dir, level) = (store.clone(), dir.to_owned(), config.level.hex());
+        let (dir, level) = (dir.to_owned(), config.level.hex());
         let control = control.clone();
         tokio::spawn(async move {
             for ghost in ghosts::find(&store, &dir, &level, &name).await {

@@ -27,7 +27,7 @@ use crate::metrics::{self, Metrics};
 use crate::quic_cert::{CertError, Identity};
 use crate::record::Recorder;
 use crate::records::writer::WriterMetrics;
-use crate::records::{RecordStore, RecordsHandle};
+use crate::records::{RecordStore, RecordsHandle, RecordsTarget};
 use crate::replays::{ReplayDir, ReplaysHandle, ReplaysTarget};
 use crate::room_logic::RoomConfig;
 use crate::room_registry::Rooms;
@@ -506,8 +506,8 @@ impl Server {
             ..
         } = self;
         let mut stop = shutdown.subscribe();
-        let (records, records_task) = open_records(&config, &metrics).await;
-        let (replays, replays_task) = open_replays(&config, &metrics, records.store().cloned());
+        let (records, records_task) = open_records(&config, &metrics, stop.clone()).await;
+        let (replays, replays_task) = open_replays(&config, &metrics, records.clone());
         let replays_dir = replays.dir().map(Path::to_owned);
         let rooms = open_rooms(
             &config,
@@ -610,20 +610,24 @@ fn instance_id() -> String {
 pub const RECORDS_GRACE: Duration = Duration::from_secs(10);
 
 /// Opens the records (`--records`) and starts their writer; if they cannot
-/// be opened, says so and plays on without them.
+/// be opened, says so, plays on without them and tries again every
+/// `records_retry` until they open or `stop`. The task to await at
+/// shutdown: the writer's, or the one trying again (which ends with the
+/// writer it started).
 async fn open_records(
     config: &ServerConfig,
     metrics: &Metrics,
+    stop: watch::Receiver<bool>,
 ) -> (RecordsHandle, Option<tokio::task::JoinHandle<()>>) {
     let target = config.records_target();
+    let writer = WriterMetrics {
+        stored: metrics.records_stored.clone(),
+        failed: metrics.records_failed.clone(),
+        write_seconds: Some(metrics.records_write_seconds.clone()),
+    };
     match RecordStore::open(&target).await {
         Ok(Some(store)) => {
             info!(records = %store.target(), "storing finished runs");
-            let writer = WriterMetrics {
-                stored: metrics.records_stored.clone(),
-                failed: metrics.records_failed.clone(),
-                write_seconds: Some(metrics.records_write_seconds.clone()),
-            };
             let (handle, task) = RecordsHandle::spawn(store, writer);
             (handle, Some(task))
         }
@@ -632,11 +636,42 @@ async fn open_records(
             (RecordsHandle::off("this server keeps no records"), None)
         }
         Err(e) => {
-            error!("records are off: {e}");
-            (
-                RecordsHandle::off("the server's records database could not be opened"),
-                None,
-            )
+            let every = config.records_retry;
+            error!("records are off: {e}; trying again every {every:?}");
+            let handle = RecordsHandle::off("the server's records database could not be opened")
+                .with_metrics(writer);
+            let task = tokio::spawn(reopen_records(handle.clone(), target, every, stop));
+            (handle, Some(task))
+        }
+    }
+}
+
+/// Tries to open the records every `every` until they open (then every
+/// clone of `handle` stores, and this waits for the writer to end) or the
+/// server stops.
+async fn reopen_records(
+    handle: RecordsHandle,
+    target: RecordsTarget,
+    every: Duration,
+    mut stop: watch::Receiver<bool>,
+) {
+    loop {
+        tokio::select! {
+            () = tokio::time::sleep(every) => {}
+            _ = stop.wait_for(|stopped| *stopped) => return,
+        }
+        match RecordStore::open(&target).await {
+            Ok(Some(store)) => {
+                info!(records = %store.target(), "records are on again: storing finished runs");
+                let writer = handle.go_live(store);
+                drop(handle);
+                if let Some(writer) = writer {
+                    let _ = writer.await;
+                }
+                return;
+            }
+            Ok(None) => return,
+            Err(e) => warn!("records still off: {e}"),
         }
     }
 }
@@ -646,7 +681,7 @@ async fn open_records(
 fn open_replays(
     config: &ServerConfig,
     metrics: &Metrics,
-    records: Option<RecordStore>,
+    records: RecordsHandle,
 ) -> (ReplaysHandle, Option<tokio::task::JoinHandle<()>>) {
     let ReplaysTarget::Dir(dir) = config.replays_target() else {
         info!("replays are off (--replays off)");

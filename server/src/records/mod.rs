@@ -90,7 +90,7 @@ pub enum RecordsError {
     /// The database could not be opened or reached.
     #[error(
         "cannot open the records database {target}: {source}; fix it or pass --records with \
-         another file or URL (or --records off); the server plays on without records"
+         another file or URL (or --records off); the server plays on without records meanwhile"
     )]
     Open {
         /// The file or URL (without its password).

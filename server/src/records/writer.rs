@@ -3,6 +3,7 @@
 //! stores them in batches of one transaction each, retrying a failed batch
 //! a few times, and only then answers each run's player.
 
+use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 use ledge_shared::protocol::Standing;
@@ -48,20 +49,26 @@ pub struct WriterMetrics {
     pub write_seconds: Option<Histogram>,
 }
 
-/// Where rooms send finished runs (cheap to clone). Off: every run is
-/// answered "not recorded" with the reason.
+/// Where rooms send finished runs (cheap to clone; clones share one
+/// writer). Off: every run is answered "not recorded" with the reason,
+/// until [`RecordsHandle::go_live`] (a database reached later).
 #[derive(Clone)]
 pub struct RecordsHandle {
-    queue: Option<mpsc::Sender<Pending>>,
-    store: Option<RecordStore>,
-    off: String,
+    live: Arc<OnceLock<Live>>,
+    off: Arc<str>,
     metrics: WriterMetrics,
+}
+
+/// An open store and its writer's queue.
+struct Live {
+    queue: mpsc::Sender<Pending>,
+    store: RecordStore,
 }
 
 impl std::fmt::Debug for RecordsHandle {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("RecordsHandle")
-            .field("store", &self.store.as_ref().map(RecordStore::target))
+            .field("store", &self.live.get().map(|l| l.store.target()))
             .field("off", &self.off)
             .finish()
     }
@@ -74,12 +81,11 @@ impl Default for RecordsHandle {
 }
 
 impl RecordsHandle {
-    /// No records; runs are answered with `reason`.
+    /// No records (yet); runs are answered with `reason`.
     pub fn off(reason: &str) -> RecordsHandle {
         RecordsHandle {
-            queue: None,
-            store: None,
-            off: reason.to_owned(),
+            live: Arc::new(OnceLock::new()),
+            off: reason.into(),
             metrics: WriterMetrics::default(),
         }
     }
@@ -87,29 +93,45 @@ impl RecordsHandle {
     /// Starts the writer for `store`: the handle and the task, which ends
     /// once every handle is gone and the queue is stored.
     pub fn spawn(store: RecordStore, metrics: WriterMetrics) -> (RecordsHandle, JoinHandle<()>) {
-        let (tx, rx) = mpsc::channel(WRITE_QUEUE);
-        let task = tokio::spawn(write(store.clone(), rx, metrics.clone()));
         let handle = RecordsHandle {
-            queue: Some(tx),
-            store: Some(store),
-            off: String::new(),
             metrics,
+            ..RecordsHandle::off("")
         };
+        let task = handle.go_live(store).expect("a new handle is not live");
         (handle, task)
     }
 
+    /// Starts storing in `store` (a database reached after the server
+    /// started), with `metrics`: every clone of this handle stores from
+    /// now on. The writer task, or `None` if this handle was live already.
+    pub fn go_live(&self, store: RecordStore) -> Option<JoinHandle<()>> {
+        let (tx, rx) = mpsc::channel(WRITE_QUEUE);
+        let mut task = None;
+        self.live.get_or_init(|| {
+            task = Some(tokio::spawn(write(store.clone(), rx, self.metrics.clone())));
+            Live { queue: tx, store }
+        });
+        task
+    }
+
+    /// The same handle counting into `metrics`.
+    pub fn with_metrics(mut self, metrics: WriterMetrics) -> RecordsHandle {
+        self.metrics = metrics;
+        self
+    }
+
     /// The store, for reading (`None`: records are off).
-    pub fn store(&self) -> Option<&RecordStore> {
-        self.store.as_ref()
+    pub fn store(&self) -> Option<RecordStore> {
+        self.live.get().map(|l| l.store.clone())
     }
 
     /// Queues `run`; `reply` is called once it is stored or not.
     pub fn submit(&self, run: FinishedRun, reply: Reply) {
-        let Some(queue) = &self.queue else {
-            reply(Err(self.off.clone()));
+        let Some(live) = self.live.get() else {
+            reply(Err(self.off.to_string()));
             return;
         };
-        if let Err(e) = queue.try_send(Pending { run, reply }) {
+        if let Err(e) = live.queue.try_send(Pending { run, reply }) {
             self.metrics.failed.inc();
             let (reason, pending) = match e {
                 mpsc::error::TrySendError::Full(p) => ("too many runs waiting to be stored", p),

@@ -15,7 +15,7 @@ use tracing::{error, info, warn};
 
 use super::dir::ReplayDir;
 use super::recording::ToSave;
-use crate::records::RecordStore;
+use crate::records::{RecordStore, RecordsHandle};
 
 /// Replays waiting to be saved, at most; more are dropped (and counted).
 pub const SAVE_QUEUE: usize = 256;
@@ -74,7 +74,7 @@ impl ReplaysHandle {
     /// and the queue is saved.
     pub fn spawn(
         dir: ReplayDir,
-        records: Option<RecordStore>,
+        records: RecordsHandle,
         metrics: ReplayMetrics,
     ) -> (ReplaysHandle, JoinHandle<()>) {
         let (tx, rx) = mpsc::channel(SAVE_QUEUE);
@@ -106,7 +106,7 @@ impl ReplaysHandle {
 /// The writer task: saves what `rx` brings until every sender is gone.
 async fn write(
     dir: ReplayDir,
-    records: Option<RecordStore>,
+    records: RecordsHandle,
     mut rx: mpsc::Receiver<ToSave>,
     metrics: ReplayMetrics,
 ) {
@@ -136,7 +136,7 @@ async fn write(
         }
         let d = dir.as_mut().expect("just returned");
         if d.over_cap() {
-            let keep = kept(records.as_ref()).await;
+            let keep = kept(records.store().as_ref()).await;
             match d.prune(&keep) {
                 Ok(p) => {
                     metrics.pruned.inc_by(p.files);

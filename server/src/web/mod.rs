@@ -159,7 +159,7 @@ fn router(state: Arc<WebState>) -> Router {
             get(|State(s): State<Arc<WebState>>, request: Request| async move {
                 let html = records_pages::wants_html(&request);
                 drop(request);
-                records_pages::levels(s.shared.records.store(), html).await
+                records_pages::levels(s.shared.records.store().as_ref(), html).await
             }),
         )
         .route(
@@ -168,7 +168,7 @@ fn router(state: Arc<WebState>) -> Router {
                 |State(s): State<Arc<WebState>>, Path(level): Path<String>, request: Request| async move {
                     let query = request.uri().query().map(str::to_owned);
                     drop(request);
-                    records_pages::level(s.shared.records.store(), &level, query.as_deref()).await
+                    records_pages::level(s.shared.records.store().as_ref(), &level, query.as_deref()).await
                 },
             ),
         )

@@ -3,7 +3,8 @@
 //! share one store and one top ten; the database going away mid-match
 //! fails the runs finished meanwhile, not play, and records resume once it
 //! is back; an unreachable database leaves the server playing without
-//! records, saying so without the URL's password.
+//! records, saying so without the URL's password; a database down at start
+//! is found once it is up, with no restart.
 //!
 //! Without PostgreSQL installed the first two are skipped loudly (they fail
 //! under `CI=true`); the third needs none.
@@ -329,5 +330,39 @@ async fn a_server_whose_postgres_is_unreachable_plays_without_records() {
         "the password stays out of the log"
     );
     eprintln!("played without records {:?} after start", started.elapsed());
+    server.stop().await.unwrap();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn records_down_at_start_come_on_once_postgres_is_up() {
+    let logs = logs::capture();
+    let Some(mut pg) =
+        Postgres::start("records_postgres::records_down_at_start_come_on_once_postgres_is_up")
+    else {
+        return;
+    };
+    tokio::task::block_in_place(|| pg.stop());
+    let root = page();
+    let url = pg.url().to_owned();
+    let server = web_server(root.path(), move |c| {
+        c.records = Some(RecordsTarget::Url(url));
+        c.records_retry = Duration::from_secs(1);
+    })
+    .await;
+    // Down: play goes on, the run is not recorded.
+    let first = race(&server, &["una"]).await;
+    let told = first[0].standing.clone().expect("told about its run");
+    assert!(told.is_err(), "not recorded while the database is down");
+    // Up: the server finds it by itself and stores the next run.
+    tokio::task::block_in_place(|| pg.restart());
+    logs.wait_for(&["records are on again"], Duration::from_secs(20))
+        .await
+        .unwrap_or_else(|| panic!("records never came on:\n{}", logs.text()));
+    let second = race(&server, &["una"]).await;
+    let standing = second[0].standing.clone().unwrap().expect("recorded");
+    assert!(standing.new_personal_best, "her first stored run");
+    let (status, doc) = get(&server, &format!("/records/{}", server.level_offer.hex())).await;
+    assert_eq!(status, 200);
+    assert_eq!(listed(&doc).len(), 1);
     server.stop().await.unwrap();
 }
