@@ -8,6 +8,7 @@ mod common;
 mod art_screenshot;
 mod chat_screenshot;
 mod failure_screenshot;
+mod ghost_screenshot;
 mod replay_check;
 mod replay_files;
 mod replay_screenshot;

@@ -25,12 +25,14 @@ use macroquad::prelude::*;
 use crate::chat::{Chat, Key};
 use crate::draw::art::ArtView;
 use crate::draw::camera::{self, Camera};
+use crate::draw::ghost::{self, GhostSprite};
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
 use crate::draw::{card, chat as chat_view, fx, hud, scene};
 use crate::input::keys::{Bindings, Gamepads};
 use crate::input::script::Script;
 use crate::input::typing;
 use crate::outcome::{fail, EXIT_FAILED, EXIT_JOIN_TIMEOUT, EXIT_UNTRUSTED};
+use crate::splits::{Split, Splits};
 use crate::{play, shot};
 
 /// How long "sound off: why" stays on screen, seconds from the start.
@@ -142,6 +144,10 @@ struct GameLoop {
     show_debug: bool,
     show_hud: bool,
     show_net: bool,
+    /// The ghosts are drawn (their key toggles them).
+    show_ghosts: bool,
+    /// Our run's split times against the first ghost.
+    splits: Splits,
     /// Sound: never fails; without a device it is off and says why.
     audio: Audio,
     /// Why there is no sound, if so.
@@ -178,6 +184,8 @@ struct Scene {
     /// The remote players' labels, in the order of `remotes`.
     labels: Vec<String>,
     entities: Vec<EntitySprite>,
+    /// The ghosts drawn (none when hidden).
+    ghosts: Vec<GhostSprite>,
     me: Option<PlayerView>,
     view: camera::View,
 }
@@ -194,6 +202,8 @@ struct Hud {
     /// The chat as laid out: the lines received (with the HUD) and the
     /// line typed.
     chat: chat_view::ChatView,
+    /// The split against a ghost on screen, and its text.
+    split: Option<(Split, String)>,
 }
 
 impl GameLoop {
@@ -229,6 +239,8 @@ impl GameLoop {
             show_debug: setup.debug,
             show_hud: setup.hud,
             show_net: setup.net,
+            show_ghosts: true,
+            splits: Splits::default(),
             audio,
             sound_off,
             cues: Cues::default(),
@@ -263,6 +275,7 @@ impl GameLoop {
         let dt = self.frame_time();
         let before = self.played;
         self.simulate(now);
+        self.race_ghosts(now);
         self.script_chat(before, now);
         self.receive_chat(now);
         let cued = self.play_sounds();
@@ -365,6 +378,18 @@ impl GameLoop {
         if Bindings::pressed(&bindings.mute) {
             self.audio.toggle_mute();
         }
+        if Bindings::pressed(&bindings.ghosts) {
+            self.show_ghosts = !self.show_ghosts;
+        }
+    }
+
+    /// Compares our run with the first ghost's (the record, else our
+    /// best) at the checkpoints and the goal.
+    fn race_ghosts(&mut self, now: f64) {
+        if let Some(me) = self.setup.play.me() {
+            let ghost = self.setup.play.ghosts().first();
+            self.splits.observe(&me, ghost, now);
+        }
     }
 
     /// The time since the last frame (and this frame's start noted).
@@ -443,6 +468,15 @@ impl GameLoop {
         let entities: Vec<EntitySprite> =
             frame_view.entities.iter().map(EntitySprite::from).collect();
         let me = self.setup.play.me();
+        let ghosts = if self.show_ghosts {
+            ghost::place(
+                self.setup.play.ghosts(),
+                me.as_ref(),
+                self.setup.play.tick_rate(),
+            )
+        } else {
+            Vec::new()
+        };
         let focus = self.setup.look_at.unwrap_or_else(|| {
             local
                 .as_ref()
@@ -469,6 +503,7 @@ impl GameLoop {
             remotes,
             labels,
             entities,
+            ghosts,
             me,
             view,
         }
@@ -524,6 +559,7 @@ impl GameLoop {
             art: &self.art,
             view: &scene.view,
             entities: &scene.entities,
+            ghosts: &scene.ghosts,
             checkpoint: scene.me.as_ref().and_then(|m| m.checkpoint),
             local: scene.local.as_ref().zip(self.local_label(scene)),
             remotes: scene
@@ -586,6 +622,8 @@ impl GameLoop {
             vec2(screen_width(), screen_height()),
             |t| hud::measure(t, chat_view::SIZE),
         );
+        let rate = self.setup.play.tick_rate();
+        let split = self.splits.shown(now).map(|s| (s.clone(), s.text(rate)));
         Hud {
             failure,
             run,
@@ -593,6 +631,7 @@ impl GameLoop {
             results,
             card,
             chat,
+            split,
         }
     }
 
@@ -645,6 +684,7 @@ impl GameLoop {
                 muted: self.audio.is_muted(),
                 restart_key: &self.restart_key,
                 results: &hud.results,
+                split: hud.split.as_ref().map(|(s, t)| (t.as_str(), s.faster())),
             };
             hud::draw(&info, &self.graph, now);
             if let Some(card) = &hud.card {
@@ -756,6 +796,9 @@ impl GameLoop {
                 dead: scene.me.as_ref().is_some_and(|m| m.dead.is_some()),
             },
             replay: None,
+            ghosts: &scene.ghosts,
+            ghosts_shown: self.show_ghosts,
+            split: hud.split.as_ref().map(|(s, t)| (s, t.clone())),
         };
         if let Err(e) = shot::save(path, &shot) {
             fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));

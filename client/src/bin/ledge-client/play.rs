@@ -269,6 +269,12 @@ impl Play {
         (count, lines)
     }
 
+    /// The runs to race against the server sent (the level's record,
+    /// our best; none offline).
+    pub fn ghosts(&self) -> &[ledge_client::ghost::Ghost] {
+        self.connection().map_or(&[], OnlineGame::ghosts)
+    }
+
     /// The online game, if online.
     fn connection(&self) -> Option<&OnlineGame> {
         match &self.mode {

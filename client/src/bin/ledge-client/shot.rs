@@ -22,6 +22,14 @@
 //!   "remotes": [                       // other players drawn, with their labels
 //!     {"id": 2, "label": "bob", "drawn_screen": [60.0, 412.0], "size_px": [12.0, 16.0]}
 //!   ],
+//!   "ghosts": [                        // the ghosts drawn (none when hidden with G)
+//!     {"kind": "record", "player": "bob", "run_tick": 212,  // "record" or "best"
+//!      "pos_units": [52224, 106496], "pos_px": [204.0, 416.0], "screen": [400.0, 412.0]}
+//!   ],
+//!   "ghosts_shown": true,              // G: on
+//!   "split": {"text": "+0.42", "faster": false, "checkpoint": 17, "against": "bob",
+//!             "record": true},         // null unless a split is on screen
+//!                                      // (checkpoint null: the finish's)
 //!   "colors": {"sky": [r, g, b], "solid": [...], "grass": [...],
 //!              "local_player": [...], "one_way": [...]},
 //!   "hud": {                           // null when hidden (F2) or failed
@@ -89,8 +97,10 @@ use macroquad::texture::get_screen_data;
 
 use crate::draw::camera::View;
 use crate::draw::card::{millis_time, Card, Says};
+use crate::draw::ghost::GhostSprite;
 use crate::draw::hud::{BannerLayout, FAILURE_PANEL};
 use crate::draw::render::palette;
+use crate::splits::Split;
 
 /// What a screenshot records.
 pub struct Shot<'a> {
@@ -119,6 +129,12 @@ pub struct Shot<'a> {
     pub fx: FxShot<'a>,
     /// The replay shown, if it is one (`--replay`).
     pub replay: Option<ReplayShot<'a>>,
+    /// The ghosts drawn.
+    pub ghosts: &'a [GhostSprite],
+    /// Ghosts are on (their key).
+    pub ghosts_shown: bool,
+    /// The split on screen and its text, if any.
+    pub split: Option<(&'a Split, String)>,
 }
 
 /// A replay's frame.
@@ -285,6 +301,7 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
     } else {
         let _ = writeln!(s, "  \"remotes\": [\n{}\n  ],", remotes.join(",\n"));
     }
+    describe_ghosts(&mut s, shot);
     let _ = writeln!(
         s,
         "  \"colors\": {{\"sky\": {}, \"solid\": {}, \"grass\": {}, \"local_player\": {}, \"one_way\": {}}},",
@@ -315,6 +332,49 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
     describe_failure(&mut s, shot.failure);
     s.push_str("}\n");
     s
+}
+
+/// The ghosts drawn and the split shown.
+fn describe_ghosts(s: &mut String, shot: &Shot) {
+    let v = shot.view;
+    let ghosts: Vec<String> = shot
+        .ghosts
+        .iter()
+        .map(|g| {
+            format!(
+                "    {{\"kind\": \"{}\", \"player\": {}, \"run_tick\": {}, \"pos_units\": [{}, {}], \"pos_px\": {}, \"screen\": {}}}",
+                if g.record { "record" } else { "best" },
+                json_string(&g.player),
+                g.run_tick,
+                g.units.x,
+                g.units.y,
+                pair(g.sprite.pos),
+                pair(v.to_screen(g.sprite.pos))
+            )
+        })
+        .collect();
+    if ghosts.is_empty() {
+        let _ = writeln!(s, "  \"ghosts\": [],");
+    } else {
+        let _ = writeln!(s, "  \"ghosts\": [\n{}\n  ],", ghosts.join(",\n"));
+    }
+    let _ = writeln!(s, "  \"ghosts_shown\": {},", shot.ghosts_shown);
+    match &shot.split {
+        Some((split, text)) => {
+            let _ = writeln!(
+                s,
+                "  \"split\": {{\"text\": {}, \"faster\": {}, \"checkpoint\": {}, \"against\": {}, \"record\": {}}},",
+                json_string(text),
+                split.faster(),
+                split.checkpoint.map_or("null".to_owned(), |c| c.to_string()),
+                json_string(&split.against),
+                split.record
+            );
+        }
+        None => {
+            let _ = writeln!(s, "  \"split\": null,");
+        }
+    }
 }
 
 /// Our player, as the server last said and as drawn (`null` before the
@@ -610,6 +670,9 @@ mod tests {
                 dead: false,
             },
             replay: None,
+            ghosts: &[],
+            ghosts_shown: true,
+            split: None,
         };
         let json = describe(&shot, Path::new("c.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect(&json);
@@ -689,6 +752,9 @@ mod tests {
                 dead: true,
             },
             replay: None,
+            ghosts: &[],
+            ghosts_shown: true,
+            split: None,
         };
         let json = describe(&shot, Path::new("/tmp/a.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect("JSON");
@@ -761,6 +827,9 @@ mod tests {
                 dead: false,
             },
             replay: None,
+            ghosts: &[],
+            ghosts_shown: true,
+            split: None,
         };
         let json: serde_json::Value =
             serde_json::from_str(&describe(&shot, Path::new("f.png"), 480, 270)).expect("JSON");
@@ -853,6 +922,9 @@ mod tests {
                 dead: false,
             },
             replay: None,
+            ghosts: &[],
+            ghosts_shown: true,
+            split: None,
         };
         let json = describe(&shot(hud(Some(&card))), Path::new("c.png"), 960, 540);
         let json: serde_json::Value = serde_json::from_str(&json).expect("JSON");

@@ -414,6 +414,7 @@ impl ReplayLoop {
                 .collect(),
             effects: &self.effects,
             debug: self.show_debug.then(|| viewer.game().world()),
+            ghosts: &[],
             time: now as f32,
         });
     }
@@ -556,6 +557,9 @@ impl ReplayLoop {
                 dead: scene.me.as_ref().is_some_and(|m| m.dead.is_some()),
             },
             replay: Some(replay),
+            ghosts: &[],
+            ghosts_shown: false,
+            split: None,
         };
         if let Err(e) = shot::save(path, &shot) {
             fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));
