@@ -162,14 +162,14 @@ mod tests {
         assert_eq!(ghost_tick(&g, Some(&me(false, 0, false))), 0);
         assert_eq!(ghost_tick(&g, Some(&me(true, 42, false))), 42);
         assert_eq!(ghost_tick(&g, Some(&me(true, 90, true))), 120);
-        let placed = place(&[g.clone()], Some(&me(true, 42, false)), 60);
+        let placed = place(std::slice::from_ref(&g), Some(&me(true, 42, false)), 60);
         assert_eq!(placed.len(), 1);
         assert_eq!(placed[0].units, g.track[42]);
         assert_eq!(placed[0].sprite.pos, px2(g.track[42]));
         assert_eq!(placed[0].sprite.facing, Facing::Right);
         assert_eq!(placed[0].label, "record: bob 0:02.05");
         // Past its finish (our run slower): at its goal, crowned.
-        let late = place(&[g.clone()], Some(&me(true, 500, false)), 60);
+        let late = place(std::slice::from_ref(&g), Some(&me(true, 500, false)), 60);
         assert_eq!(late[0].units, g.track[120]);
         assert!(late[0].sprite.won);
         let best = Ghost { record: false, ..g };
