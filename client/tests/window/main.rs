@@ -16,4 +16,5 @@ mod replay_url;
 mod rooms_cli;
 mod run_screenshots;
 mod screenshot;
+mod spectate_screenshot;
 mod trust_cli;

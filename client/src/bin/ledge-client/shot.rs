@@ -30,6 +30,18 @@
 //!   "split": {"text": "+0.42", "faster": false, "checkpoint": 17, "against": "bob",
 //!             "record": true},         // null unless a split is on screen
 //!                                      // (checkpoint null: the finish's)
+//!   "spectate": {                      // null unless --spectate
+//!     "room": "room-1", "line": "spectating room-1 - following bob (Tab: next)",
+//!     "free_camera": false,
+//!     "following": {                   // null: nobody (free camera, empty room)
+//!       "id": 2, "name": "bob",
+//!       "drawn_px": [204.0, 416.0],    // its centre as drawn (interpolated)
+//!       "drawn_screen": [400.0, 412.0],
+//!       "render_tick": 1520.4,         // the game tick the others are drawn at
+//!       "server_tick": 1526,           // the newest snapshot's tick
+//!       "server_pos_units": [52224, 106496], "server_pos_px": [204.0, 416.0]
+//!     }                                // (its centre in that snapshot)
+//!   },
 //!   "colors": {"sky": [r, g, b], "solid": [...], "grass": [...],
 //!              "local_player": [...], "one_way": [...]},
 //!   "hud": {                           // null when hidden (F2) or failed
@@ -135,6 +147,25 @@ pub struct Shot<'a> {
     pub ghosts_shown: bool,
     /// The split on screen and its text, if any.
     pub split: Option<(&'a Split, String)>,
+    /// What a spectator watched (`--spectate`).
+    pub spectate: Option<SpectateShot<'a>>,
+}
+
+/// A spectator's frame.
+pub struct SpectateShot<'a> {
+    /// The room watched.
+    pub room: &'a str,
+    /// The HUD's line.
+    pub line: &'a str,
+    /// The camera is free.
+    pub free_camera: bool,
+    /// The followed player: id, name, centre as drawn (world px).
+    pub following: Option<(u32, &'a str, Vec2)>,
+    /// The game tick the other players are drawn at.
+    pub render_tick: f64,
+    /// The followed player in the newest snapshot: its tick and centre
+    /// (units).
+    pub server: Option<(u64, IVec2)>,
 }
 
 /// A replay's frame.
@@ -302,6 +333,7 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
         let _ = writeln!(s, "  \"remotes\": [\n{}\n  ],", remotes.join(",\n"));
     }
     describe_ghosts(&mut s, shot);
+    describe_spectate(&mut s, shot);
     let _ = writeln!(
         s,
         "  \"colors\": {{\"sky\": {}, \"solid\": {}, \"grass\": {}, \"local_player\": {}, \"one_way\": {}}},",
@@ -332,6 +364,42 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
     describe_failure(&mut s, shot.failure);
     s.push_str("}\n");
     s
+}
+
+/// What a spectator watched (`null` unless spectating).
+fn describe_spectate(s: &mut String, shot: &Shot) {
+    let Some(w) = &shot.spectate else {
+        let _ = writeln!(s, "  \"spectate\": null,");
+        return;
+    };
+    let following = match w.following {
+        Some((id, name, pos)) => {
+            let server = match w.server {
+                Some((tick, units)) => format!(
+                    "\"server_tick\": {tick}, \"server_pos_units\": [{}, {}], \"server_pos_px\": {}",
+                    units.x,
+                    units.y,
+                    pair(Vec2::new(units.x as f32, units.y as f32) / 256.0)
+                ),
+                None => "\"server_tick\": null, \"server_pos_units\": null, \"server_pos_px\": null".to_owned(),
+            };
+            format!(
+                "{{\"id\": {id}, \"name\": {}, \"drawn_px\": {}, \"drawn_screen\": {}, \"render_tick\": {:.3}, {server}}}",
+                json_string(name),
+                pair(pos),
+                pair(shot.view.to_screen(pos)),
+                w.render_tick
+            )
+        }
+        None => "null".to_owned(),
+    };
+    let _ = writeln!(
+        s,
+        "  \"spectate\": {{\"room\": {}, \"line\": {}, \"free_camera\": {}, \"following\": {following}}},",
+        json_string(w.room),
+        json_string(w.line),
+        w.free_camera
+    );
 }
 
 /// The ghosts drawn and the split shown.
@@ -673,6 +741,7 @@ mod tests {
             ghosts: &[],
             ghosts_shown: true,
             split: None,
+            spectate: None,
         };
         let json = describe(&shot, Path::new("c.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect(&json);
@@ -755,6 +824,7 @@ mod tests {
             ghosts: &[],
             ghosts_shown: true,
             split: None,
+            spectate: None,
         };
         let json = describe(&shot, Path::new("/tmp/a.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect("JSON");
@@ -830,6 +900,7 @@ mod tests {
             ghosts: &[],
             ghosts_shown: true,
             split: None,
+            spectate: None,
         };
         let json: serde_json::Value =
             serde_json::from_str(&describe(&shot, Path::new("f.png"), 480, 270)).expect("JSON");
@@ -925,6 +996,7 @@ mod tests {
             ghosts: &[],
             ghosts_shown: true,
             split: None,
+            spectate: None,
         };
         let json = describe(&shot(hud(Some(&card))), Path::new("c.png"), 960, 540);
         let json: serde_json::Value = serde_json::from_str(&json).expect("JSON");

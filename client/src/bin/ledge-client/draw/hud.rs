@@ -131,6 +131,9 @@ pub struct HudInfo<'a> {
     /// The split against a ghost on screen: its text (`+0.42`) and
     /// whether we were faster (green) or not (red).
     pub split: Option<(&'a str, bool)>,
+    /// Spectating: the line saying whom we watch (in place of our name;
+    /// the run shown is theirs).
+    pub spectate: Option<&'a str>,
 }
 
 /// A split we were faster in.
@@ -244,11 +247,18 @@ pub fn panel(lines: &[(String, Color, f32)], x: f32, y: f32) -> f32 {
 /// panel and graph when `show_net`; the room's results table; the
 /// controls hint; sound notices.
 pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
-    let mut lines: Vec<(String, Color, f32)> = vec![(info.name.to_owned(), WHITE, 22.0)];
+    let mut lines: Vec<(String, Color, f32)> = match info.spectate {
+        Some(line) => vec![(line.to_owned(), WHITE, FONT)],
+        None => vec![(info.name.to_owned(), WHITE, 22.0)],
+    };
     if let Some(run) = &info.run {
         lines.push((run_line(run), GOLD, FONT));
     }
-    lines.push((format!("restart: {}", info.restart_key), DIM, 14.0));
+    let keys = match info.spectate {
+        Some(_) => "Tab/Shift+Tab: next player   F: free camera (WASD)".to_owned(),
+        None => format!("restart: {}", info.restart_key),
+    };
+    lines.push((keys, DIM, 14.0));
     let mut y = 8.0 + panel(&lines, 8.0, 8.0) + 6.0;
     if let Some((text, faster)) = info.split {
         let colour = if faster { FASTER } else { SLOWER };
