@@ -21,6 +21,8 @@
 //!   ([`net::online`], [`OnlineGame`]), and the server's level
 //!   ([`net::levels`], [`net::download`], [`net::bundle`]);
 //! * [`ghost`]: a run to race against, played from its replay;
+//! * [`follow`]: whom a watching camera follows, and cycling through the
+//!   players (replays and spectators);
 //! * [`netstats`]: RTT, jitter, loss, rates;
 //! * [`replay`]: a replay as a front end shows it ([`replay::ReplayViewer`]:
 //!   speeds, pauses, seeking, whom the camera follows; its frames as
@@ -46,6 +48,7 @@
 #[cfg(not(target_arch = "wasm32"))]
 pub mod bot;
 pub mod error;
+pub mod follow;
 pub mod game;
 pub mod ghost;
 pub mod net;

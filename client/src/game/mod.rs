@@ -77,6 +77,9 @@ pub struct ClientGame {
     /// Entity centres one tick before the newest (for blending).
     prev_entities: Vec<IVec2>,
     offline: bool,
+    /// Watching, not playing: no body of ours in the game, every player
+    /// interpolated, no buttons but none ([`ClientGame::set_spectating`]).
+    spectating: bool,
 }
 
 impl ClientGame {
@@ -116,6 +119,7 @@ impl ClientGame {
             prev_entities: Vec::new(),
             level,
             offline: false,
+            spectating: false,
         })
     }
 
@@ -139,6 +143,7 @@ impl ClientGame {
             prev_entities: Vec::new(),
             level,
             offline: true,
+            spectating: false,
         })
     }
 
@@ -196,6 +201,23 @@ impl ClientGame {
         self.welcome.as_ref()
     }
 
+    /// Watch rather than play (a session joined with
+    /// [`crate::net::session::JoinOptions::spectate`]): the welcome's id
+    /// is nobody's in the game, so there is no player of ours to predict
+    /// or draw ([`FrameView::local`] is `None`), every player in the
+    /// snapshots is drawn interpolated as a remote one, and the buttons
+    /// given to [`ClientGame::update`] and [`ClientGame::step`] are
+    /// replaced by none (the inputs still sent only acknowledge
+    /// snapshots).
+    pub fn set_spectating(&mut self, spectating: bool) {
+        self.spectating = spectating;
+    }
+
+    /// Whether we watch rather than play ([`ClientGame::set_spectating`]).
+    pub fn spectating(&self) -> bool {
+        self.spectating
+    }
+
     /// Whether this is a local game without a server.
     pub fn is_offline(&self) -> bool {
         self.offline
@@ -251,6 +273,11 @@ impl ClientGame {
     /// Runs one local tick with our `buttons`; returns the tick they are
     /// for (send them to the server with it).
     pub fn step(&mut self, buttons: Buttons) -> u64 {
+        let buttons = if self.spectating {
+            Buttons::NONE
+        } else {
+            buttons
+        };
         self.prev_entities.clear();
         let positions = self.predictor.game().entities().map(|e| e.pos);
         self.prev_entities.extend(positions);
@@ -271,7 +298,11 @@ impl ClientGame {
     ) -> u64 {
         let due = u64::from(self.advance(now)).min(max_ticks);
         for i in 0..due {
-            let b = buttons(i);
+            let b = if self.spectating {
+                Buttons::NONE
+            } else {
+                buttons(i)
+            };
             let tick = self.step(b);
             if due - i <= u64::from(MAX_SENDS_PER_UPDATE) && !self.offline {
                 send(tick, b);
@@ -333,7 +364,8 @@ impl ClientGame {
         let rate = self.clock.rate() as f32;
         let game = self.predictor.game();
         let size = px2(self.player_half * 2);
-        let local = game.player(self.me).map(|p| {
+        let me = game.player(self.me).filter(|_| !self.spectating);
+        let local = me.map(|p| {
             let cur = px2(p.pos);
             let prev = self.predictor.prev_pos().map_or(cur, px2);
             let prev = if (cur - prev).abs().max_element() > 64.0 {
@@ -467,6 +499,84 @@ mod tests {
         assert_eq!(wall_side(both, false), None);
         assert_eq!(wall_side(Sides::BOTTOM, false), None);
         assert_eq!(wall_side(Sides::NONE, false), None);
+    }
+
+    /// A spectator's game: the welcome's id is in no snapshot; every
+    /// player is drawn interpolated, nothing is predicted for us, and the
+    /// inputs sent (only acknowledgements) hold no buttons.
+    #[test]
+    fn a_spectator_interpolates_every_player_and_sends_no_buttons() {
+        use crate::net::session::SnapshotUpdate;
+        use ledge_shared::protocol::NetTiming;
+        let level = ledge_levels::default_level();
+        let mut server = Game::from_level(&level).unwrap();
+        for id in [1, 2] {
+            server.add_player(PlayerId(id)).unwrap();
+        }
+        let welcome = Welcome {
+            player_id: PlayerId(9),
+            room: "room-1".into(),
+            level_id: "default".into(),
+            level_hash: level.content_hash(),
+            level: Default::default(),
+            session_token: Default::default(),
+            server_tick: 0,
+            timing: NetTiming {
+                tick_rate: 60,
+                snapshot_interval: 2,
+                input_redundancy: 16,
+            },
+            sim_config: vec![],
+        };
+        let start = Instant::now();
+        let mut game = ClientGame::new(&welcome, level, Duration::from_millis(20), start).unwrap();
+        game.set_spectating(true);
+        assert!(game.spectating());
+        let mut sent = Vec::new();
+        let mut previous = None;
+        for tick in 1..=240u64 {
+            let now = start + Duration::from_secs_f64(tick as f64 / 60.0);
+            server.step(&[
+                (PlayerId(1), Buttons(Buttons::RIGHT)),
+                (PlayerId(2), Buttons(Buttons::LEFT)),
+            ]);
+            if tick % 2 == 0 {
+                let update = SnapshotUpdate {
+                    state: server.snapshot(),
+                    baseline_tick: None,
+                    previous_tick: previous,
+                    last_input_tick: None,
+                    input_timing: 0,
+                    via_stream: false,
+                    wire_bytes: 100,
+                    received: now,
+                };
+                previous = Some(update.state.tick);
+                game.on_snapshot(&update);
+            }
+            game.update(
+                now,
+                u64::MAX,
+                |_| Buttons(Buttons::RIGHT | Buttons::JUMP),
+                |_, b| sent.push(b),
+            );
+        }
+        assert!(!sent.is_empty(), "inputs still go out (acknowledgements)");
+        assert!(sent.iter().all(|&b| b == Buttons::NONE), "{sent:?}");
+        let view = game.view();
+        assert!(view.local.is_none(), "no player of ours");
+        let ids: Vec<u32> = view.remotes.iter().map(|p| p.id.0).collect();
+        assert_eq!(ids, [1, 2], "every player, as a remote one");
+        assert!(game.game().player(PlayerId(9)).is_none());
+        let stats = game.predictor().stats();
+        assert_eq!((stats.mispredictions, stats.corrections), (0, 0));
+        // Interpolated a little behind the server (player 1 runs right).
+        let server_x = px2(server.player(PlayerId(1)).unwrap().pos).x;
+        let drawn_x = view.remotes[0].pos.x;
+        assert!(
+            drawn_x <= server_x && drawn_x > server_x - 60.0,
+            "{drawn_x} {server_x}"
+        );
     }
 
     #[test]

@@ -78,6 +78,8 @@ pub struct NetOptions {
     pub download_level: bool,
     /// Where downloaded levels are cached (`None`: in memory only).
     pub level_cache: Option<PathBuf>,
+    /// Join to watch ([`JoinOptions::spectate`]): no body in the game.
+    pub spectate: bool,
 }
 
 /// What the front end asks the network thread to do.
@@ -266,7 +268,7 @@ async fn run(
         player_name: request.player_name.clone(),
         room: options.room.clone(),
         resume: None,
-        spectate: false,
+        spectate: options.spectate,
     };
     // Set once joined: then a lost connection is resumed.
     let mut lost: Option<(Instant, u32)> = None;

@@ -77,6 +77,9 @@ pub struct OnlineRequest {
     /// Where downloaded levels are cached (`None`: in memory only;
     /// [`crate::net::bundle::LevelCache::default_dir`] is the usual place).
     pub level_cache: Option<PathBuf>,
+    /// Watch rather than play ([`crate::net::session::JoinOptions::spectate`]):
+    /// the game has no player of ours ([`ClientGame::set_spectating`]).
+    pub spectate: bool,
 }
 
 #[cfg(not(target_arch = "wasm32"))]
@@ -90,6 +93,7 @@ impl OnlineRequest {
             room: None,
             level: None,
             level_cache: LevelCache::default_dir(),
+            spectate: false,
         }
     }
 }
@@ -138,6 +142,8 @@ pub struct OnlineGame<
     /// The game was just created: the ticks due at its first update are
     /// nobody's play (e.g. a window was opening after a wait).
     fresh: bool,
+    /// We watch rather than play ([`OnlineGame::spectating`]).
+    spectate: bool,
 }
 
 #[cfg(not(target_arch = "wasm32"))]
@@ -159,10 +165,12 @@ impl OnlineGame<NetThread> {
                 trust: Some(request.trust.clone()),
                 download_level: request.level.is_none(),
                 level_cache: request.level_cache.clone(),
+                spectate: request.spectate,
             },
         )?;
         let mut game = OnlineGame::with_network(net, &request.server, &request.player_name);
         game.level_file = request.level;
+        game.spectate = request.spectate;
         Ok(game)
     }
 
@@ -215,6 +223,7 @@ impl<N: Network> OnlineGame<N> {
             arrivals: 0,
             last_news: None,
             fresh: false,
+            spectate: false,
         }
     }
 
@@ -289,6 +298,7 @@ impl<N: Network> OnlineGame<N> {
                 match made {
                     Ok(mut game) => {
                         game.set_name(&self.name);
+                        game.set_spectating(self.spectate);
                         game.set_player_names(&self.net.players());
                         self.game = Some(game);
                         self.fresh = true;
@@ -343,6 +353,22 @@ impl<N: Network> OnlineGame<N> {
             | NetEvent::Reconnecting { .. }
             | NetEvent::LevelProgress { .. }
             | NetEvent::Level(..) => {}
+        }
+    }
+
+    /// Whether we watch rather than play: joined as a spectator, no
+    /// player of ours in the game (every player is drawn as a remote one).
+    pub fn spectating(&self) -> bool {
+        self.spectate
+    }
+
+    /// Watch rather than play, for a game made with
+    /// [`OnlineGame::with_network`] on a network that joined as a
+    /// spectator; before the welcome.
+    pub fn set_spectating(&mut self, spectate: bool) {
+        self.spectate = spectate;
+        if let Some(game) = &mut self.game {
+            game.set_spectating(spectate);
         }
     }
 

@@ -23,6 +23,7 @@ use ledge_shared::level::Level;
 use ledge_shared::protocol::PlayerId;
 use ledge_shared::replay::{Playback, Replay, ReplayError, ReplayKind};
 
+pub use crate::follow::Follow;
 use crate::replay::view::{frame_view, Before};
 use crate::view::FrameView;
 
@@ -35,15 +36,6 @@ const NORMAL_SPEED: usize = 2;
 /// At most this many ticks are due at once (a frame that took seconds
 /// does not stall the next one stepping them all).
 pub const MAX_DUE_TICKS: f64 = 240.0;
-
-/// Whom the camera follows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Follow {
-    /// This player (while in the game; else the first player who is).
-    Player(PlayerId),
-    /// Nobody: the front end moves the camera itself.
-    Free,
-}
 
 /// A replay being watched (see the module documentation).
 #[derive(Debug)]
@@ -294,30 +286,13 @@ impl ReplayViewer {
     /// the first player in the game; `None` with a free camera or an empty
     /// game.
     pub fn followed(&self) -> Option<PlayerId> {
-        let Follow::Player(id) = self.follow else {
-            return None;
-        };
-        let game = self.game();
-        if game.player(id).is_some() {
-            Some(id)
-        } else {
-            game.players().next().map(|(id, _)| id)
-        }
+        self.follow.resolve(&self.players())
     }
 
     /// Follows the next player in the game by id (`forward`), or the one
     /// before, wrapping around; from a free camera the first (or last).
     pub fn follow_next(&mut self, forward: bool) {
-        let players = self.players();
-        let next = match self.followed() {
-            Some(now) if forward => players.iter().find(|&&p| p > now).or(players.first()),
-            Some(now) => players.iter().rev().find(|&&p| p < now).or(players.last()),
-            None if forward => players.first(),
-            None => players.last(),
-        };
-        if let Some(&id) = next {
-            self.follow = Follow::Player(id);
-        }
+        self.follow = self.follow.next(&self.players(), forward);
     }
 
     /// The players in the game now, ascending by id.

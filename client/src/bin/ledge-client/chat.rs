@@ -158,6 +158,12 @@ impl Chat {
         None
     }
 
+    /// A line of the chat's own saying `text` (e.g. why the chat cannot
+    /// be opened).
+    pub fn tell(&mut self, text: &str, now: f64) {
+        self.note(text.to_owned(), now);
+    }
+
     /// Says that sending the line just closed failed, and why: a line of
     /// the chat's own.
     pub fn not_sent(&mut self, why: &str, now: f64) {

@@ -25,13 +25,17 @@ use macroquad::prelude::*;
 use crate::chat::{Chat, Key};
 use crate::draw::art::ArtView;
 use crate::draw::camera::{self, Camera};
+use crate::draw::ghost::{self, GhostSprite};
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
 use crate::draw::{card, chat as chat_view, fx, hud, scene};
 use crate::input::keys::{Bindings, Gamepads};
 use crate::input::script::Script;
 use crate::input::typing;
 use crate::outcome::{fail, EXIT_FAILED, EXIT_JOIN_TIMEOUT, EXIT_UNTRUSTED};
+use crate::spectate::{self, Spectate};
+use crate::splits::{Split, Splits};
 use crate::{play, shot};
+use ledge_shared::protocol::PlayerId;
 
 /// How long "sound off: why" stays on screen, seconds from the start.
 const SOUND_NOTICE_SECONDS: f64 = 6.0;
@@ -85,6 +89,10 @@ pub struct Setup {
     pub volume: f32,
     pub mute: bool,
     pub look_at: Option<Vec2>,
+    /// Watch rather than play (`--spectate`).
+    pub spectate: bool,
+    /// Spectating, follow the player of this name (`--follow`).
+    pub follow: Option<String>,
     /// The level's art (textures are made when the window exists).
     pub level_art: ledge_levels::art::LevelArt,
     /// Kept alive for the whole game; dropped after the network thread.
@@ -142,6 +150,12 @@ struct GameLoop {
     show_debug: bool,
     show_hud: bool,
     show_net: bool,
+    /// The ghosts are drawn (their key toggles them).
+    show_ghosts: bool,
+    /// Our run's split times against the first ghost.
+    splits: Splits,
+    /// Spectating: whom the camera follows.
+    spectate: Option<Spectate>,
     /// Sound: never fails; without a device it is off and says why.
     audio: Audio,
     /// Why there is no sound, if so.
@@ -178,6 +192,10 @@ struct Scene {
     /// The remote players' labels, in the order of `remotes`.
     labels: Vec<String>,
     entities: Vec<EntitySprite>,
+    /// Spectating: the player followed (drawn as `local`).
+    followed: Option<PlayerId>,
+    /// The ghosts drawn (none when hidden).
+    ghosts: Vec<GhostSprite>,
     me: Option<PlayerView>,
     view: camera::View,
 }
@@ -194,6 +212,10 @@ struct Hud {
     /// The chat as laid out: the lines received (with the HUD) and the
     /// line typed.
     chat: chat_view::ChatView,
+    /// The split against a ghost on screen, and its text.
+    split: Option<(Split, String)>,
+    /// Spectating: the line saying whom we watch.
+    spectate: Option<String>,
 }
 
 impl GameLoop {
@@ -229,6 +251,9 @@ impl GameLoop {
             show_debug: setup.debug,
             show_hud: setup.hud,
             show_net: setup.net,
+            show_ghosts: true,
+            splits: Splits::default(),
+            spectate: setup.spectate.then(|| Spectate::new(setup.follow.clone())),
             audio,
             sound_off,
             cues: Cues::default(),
@@ -263,6 +288,7 @@ impl GameLoop {
         let dt = self.frame_time();
         let before = self.played;
         self.simulate(now);
+        self.race_ghosts(now);
         self.script_chat(before, now);
         self.receive_chat(now);
         let cued = self.play_sounds();
@@ -291,7 +317,12 @@ impl GameLoop {
     fn type_chat(&mut self, now: f64) {
         if !self.chat.is_open() {
             if Bindings::pressed(&self.setup.bindings.chat) {
-                self.chat.open();
+                if self.spectate.is_some() {
+                    // The server would answer so: said at once.
+                    self.chat.tell(spectate::NO_CHAT, now);
+                } else {
+                    self.chat.open();
+                }
             }
             typing::forget();
             return;
@@ -364,6 +395,18 @@ impl GameLoop {
         }
         if Bindings::pressed(&bindings.mute) {
             self.audio.toggle_mute();
+        }
+        if Bindings::pressed(&bindings.ghosts) {
+            self.show_ghosts = !self.show_ghosts;
+        }
+    }
+
+    /// Compares our run with the first ghost's (the record, else our
+    /// best) at the checkpoints and the goal.
+    fn race_ghosts(&mut self, now: f64) {
+        if let Some(me) = self.setup.play.me() {
+            let ghost = self.setup.play.ghosts().first();
+            self.splits.observe(&me, ghost, now);
         }
     }
 
@@ -438,17 +481,30 @@ impl GameLoop {
     /// What to draw (players posed, entities), and the camera following us.
     fn compose(&mut self, dt: Duration) -> Scene {
         let level_px = scene::level_extent(self.setup.play.level(), &self.art);
-        let frame_view = self.setup.play.view().unwrap_or_default();
+        let (frame_view, followed) = self.watched_view(dt);
         let (local, remotes) = play::sprites(&frame_view, &mut self.animator, dt.as_secs_f32());
         let entities: Vec<EntitySprite> =
             frame_view.entities.iter().map(EntitySprite::from).collect();
-        let me = self.setup.play.me();
-        let focus = self.setup.look_at.unwrap_or_else(|| {
-            local
-                .as_ref()
-                .or(remotes.first())
-                .map_or(level_px.center(), |p| p.pos)
-        });
+        let me = match (&self.spectate, followed) {
+            (Some(_), Some(id)) => self.setup.play.game().and_then(|g| g.game().player(id)),
+            (Some(_), None) => None,
+            (None, _) => self.setup.play.me(),
+        };
+        let ghosts = if self.show_ghosts {
+            ghost::place(
+                self.setup.play.ghosts(),
+                me.as_ref(),
+                self.setup.play.tick_rate(),
+            )
+        } else {
+            Vec::new()
+        };
+        let shown = local.as_ref().or(remotes.first()).map(|p| p.pos);
+        let focus = match (self.setup.look_at, &mut self.spectate) {
+            (Some(at), _) => at,
+            (None, Some(watch)) => watch.focus(local.as_ref().map(|p| p.pos), level_px),
+            (None, None) => shown.unwrap_or_else(|| level_px.center()),
+        };
         let screen = vec2(screen_width(), screen_height());
         let view = self
             .camera
@@ -469,9 +525,26 @@ impl GameLoop {
             remotes,
             labels,
             entities,
+            followed,
+            ghosts,
             me,
             view,
         }
+    }
+
+    /// What to draw, and spectating whom the camera follows (its keys
+    /// read first): that player is drawn as the featured one.
+    fn watched_view(&mut self, dt: Duration) -> (FrameView, Option<PlayerId>) {
+        let view = self.setup.play.view().unwrap_or_default();
+        let Some(watch) = &mut self.spectate else {
+            return (view, None);
+        };
+        let players = self.setup.play.players();
+        if let Some(g) = self.setup.play.game() {
+            watch.keys(&players, g.player_names(), dt.as_secs_f32());
+        }
+        let followed = watch.followed(&players);
+        (spectate::feature(view, followed), followed)
     }
 
     /// Moves the effects on (ours from the cues, the others' from what is drawn); shakes the view.
@@ -524,6 +597,7 @@ impl GameLoop {
             art: &self.art,
             view: &scene.view,
             entities: &scene.entities,
+            ghosts: &scene.ghosts,
             checkpoint: scene.me.as_ref().and_then(|m| m.checkpoint),
             local: scene.local.as_ref().zip(self.local_label(scene)),
             remotes: scene
@@ -564,8 +638,10 @@ impl GameLoop {
             .unwrap_or(&self.setup.name)
             .to_owned();
         let results = self.room_results(&name);
-        // Once finished: the card, with the records online.
-        let card = run.filter(|r| r.place.is_some()).map(|run| {
+        // Once finished: the card, with the records online (not a
+        // spectator's: it is nobody's run of ours).
+        let mine = run.filter(|_| self.spectate.is_none());
+        let card = mine.filter(|r| r.place.is_some()).map(|run| {
             card::Card::new(
                 &run,
                 &self.restart_key,
@@ -586,6 +662,13 @@ impl GameLoop {
             vec2(screen_width(), screen_height()),
             |t| hud::measure(t, chat_view::SIZE),
         );
+        let rate = self.setup.play.tick_rate();
+        let split = self.splits.shown(now).map(|s| (s.clone(), s.text(rate)));
+        let spectate = self.spectate.as_ref().map(|_| {
+            let room = self.setup.play.room().unwrap_or("the room");
+            let following = scene.followed.map(|_| name.as_str());
+            spectate::line(room, following)
+        });
         Hud {
             failure,
             run,
@@ -593,6 +676,8 @@ impl GameLoop {
             results,
             card,
             chat,
+            split,
+            spectate,
         }
     }
 
@@ -640,11 +725,17 @@ impl GameLoop {
                 name: &hud.name,
                 run: hud.run,
                 show_net: self.show_net,
-                hint_alpha: hint_alpha(self.first_move, now),
+                hint_alpha: if self.spectate.is_some() {
+                    0.0
+                } else {
+                    hint_alpha(self.first_move, now)
+                },
                 sound_notice: self.sound_notice(now),
                 muted: self.audio.is_muted(),
                 restart_key: &self.restart_key,
                 results: &hud.results,
+                split: hud.split.as_ref().map(|(s, t)| (t.as_str(), s.faster())),
+                spectate: hud.spectate.as_deref(),
             };
             hud::draw(&info, &self.graph, now);
             if let Some(card) = &hud.card {
@@ -756,10 +847,37 @@ impl GameLoop {
                 dead: scene.me.as_ref().is_some_and(|m| m.dead.is_some()),
             },
             replay: None,
+            ghosts: &scene.ghosts,
+            ghosts_shown: self.show_ghosts,
+            split: hud.split.as_ref().map(|(s, t)| (s, t.clone())),
+            spectate: self.spectate_shot(scene, hud),
         };
         if let Err(e) = shot::save(path, &shot) {
             fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));
         }
+    }
+
+    /// What a spectator's screenshot says it watched.
+    fn spectate_shot<'a>(
+        &'a self,
+        scene: &'a Scene,
+        hud: &'a Hud,
+    ) -> Option<shot::SpectateShot<'a>> {
+        let watch = self.spectate.as_ref()?;
+        let following = scene
+            .followed
+            .zip(scene.local.as_ref())
+            .map(|(id, p)| (id.0, hud.name.as_str(), p.pos));
+        Some(shot::SpectateShot {
+            room: self.setup.play.room().unwrap_or(""),
+            line: hud.spectate.as_deref().unwrap_or(""),
+            free_camera: watch.follow() == ledge_client::follow::Follow::Free,
+            following,
+            render_tick: scene.frame_view.remote_tick,
+            server: scene
+                .followed
+                .and_then(|id| self.setup.play.server_player(id)),
+        })
     }
 
     /// Waits out the rest of the frame's time natively (no vsync under Xvfb or some drivers: do not spin; a browser calls us once per display frame).

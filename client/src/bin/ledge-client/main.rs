@@ -41,7 +41,8 @@
 //! (keys, gamepads, scripts, typing); at the bottom the page's glue (`page`, in the
 //! browser), the gamepads' state ([`input::pad`]), the chat's state
 //! ([`chat`]: the line typed, the lines received, who is muted) and how a
-//! run ends ([`outcome`]). The presentation here (animation, sound, cues) is the
+//! run ends ([`outcome`]), with the split times against a ghost ([`splits`])
+//! and a spectator's camera ([`spectate`]). The presentation here (animation, sound, cues) is the
 //! window's alone: the headless library leaves it out.
 
 // The browser build leaves out the command line, files and the network
@@ -64,6 +65,8 @@ mod play;
 mod replay;
 mod shot;
 mod sound;
+mod spectate;
+mod splits;
 #[cfg(target_arch = "wasm32")]
 mod web;
 

@@ -44,7 +44,9 @@ Esc quits.";
 /// Keys (rebind with --keys FILE; --print-keys shows the defaults): arrows
 /// or WASD move, space, Z or K jump, down + jump drops through one-way
 /// ledges, R restarts the run, M mutes, F1 debug overlay, F2 HUD on/off,
-/// F3 network panel, Esc quits. Gamepads need the `gamepad` build feature.
+/// F3 network panel, G ghosts, T or Enter chat, Esc quits. Gamepads need
+/// the `gamepad` build feature. Spectating (--spectate): Tab / Shift+Tab
+/// the next player, F free camera (WASD moves it).
 #[derive(Debug, Parser)]
 #[command(version, after_help = EXIT_CODES)]
 struct Cli {
@@ -84,6 +86,11 @@ struct Cli {
     /// and its room cap allows); default: the server picks.
     #[arg(long, value_name = "NAME", requires = "connect")]
     room: Option<String>,
+    /// Watch the room rather than play: no body, the camera follows a
+    /// player (Tab / Shift+Tab the next, F a free camera moved with WASD;
+    /// --follow NAME picks whom first); takes no player's place.
+    #[arg(long, requires = "connect")]
+    spectate: bool,
     /// Print the server's rooms (name, level, players, capacity) and exit.
     #[arg(long, requires = "connect")]
     list_rooms: bool,
@@ -153,9 +160,10 @@ struct Cli {
     /// With --replay: open it at this game tick (the HUD's "tick").
     #[arg(long, value_name = "TICK", requires = "replay")]
     replay_seek: Option<u64>,
-    /// With --replay: follow the player of this name (a run's replay
-    /// follows its runner, a match's its first player).
-    #[arg(long, value_name = "NAME", requires = "replay")]
+    /// With --replay or --spectate: follow the player of this name (a
+    /// run's replay follows its runner, a match's and a spectator its
+    /// first player).
+    #[arg(long, value_name = "NAME")]
     follow: Option<String>,
     /// With --replay: start at this speed (0.25, 0.5, 1, 2 or 4).
     #[arg(long, value_name = "X", requires = "replay")]
@@ -242,6 +250,15 @@ fn run() -> anyhow::Result<()> {
         .log_internal_errors(false)
         .init();
 
+    if cli.follow.is_some() && cli.replay.is_none() && !cli.spectate {
+        use clap::CommandFactory;
+        Cli::command()
+            .error(
+                clap::error::ErrorKind::MissingRequiredArgument,
+                "--follow NAME needs --replay FILE|URL or --spectate",
+            )
+            .exit();
+    }
     let bindings = match &cli.keys {
         Some(path) => Bindings::load(path).map_err(anyhow::Error::msg)?,
         None => Bindings::default(),
@@ -291,6 +308,7 @@ fn run() -> anyhow::Result<()> {
             OnlineRequest {
                 level: cli.level.clone(),
                 room: cli.room.clone(),
+                spectate: cli.spectate,
                 level_cache: cli.level_cache.clone().or(default.level_cache.clone()),
                 ..default
             }
@@ -328,6 +346,8 @@ fn run() -> anyhow::Result<()> {
         volume: f32::from(cli.volume) / 100.0,
         mute: cli.mute,
         look_at: cli.look_at.map(|(x, y)| vec2(x, y)),
+        spectate: cli.spectate,
+        follow: cli.follow.clone(),
         level_art,
         server,
     };

@@ -269,6 +269,42 @@ impl Play {
         (count, lines)
     }
 
+    /// The runs to race against the server sent (the level's record,
+    /// our best; none offline).
+    pub fn ghosts(&self) -> &[ledge_client::ghost::Ghost] {
+        self.connection().map_or(&[], OnlineGame::ghosts)
+    }
+
+    /// Whether we watch rather than play (`--spectate`).
+    pub fn spectating(&self) -> bool {
+        self.connection().is_some_and(OnlineGame::spectating)
+    }
+
+    /// The room's name, once welcomed.
+    pub fn room(&self) -> Option<&str> {
+        Some(self.game()?.welcome()?.room.as_str())
+    }
+
+    /// The players in the game (ascending ids), ours left out.
+    pub fn players(&self) -> Vec<ledge_shared::protocol::PlayerId> {
+        let mut ids: Vec<_> = self.game().map_or_else(Vec::new, |g| {
+            g.game()
+                .players()
+                .map(|(id, _)| id)
+                .filter(|&id| id != g.me())
+                .collect()
+        });
+        ids.sort_unstable();
+        ids
+    }
+
+    /// Player `id` in the newest authoritative state: `(tick, centre in
+    /// units)` (online).
+    pub fn server_player(&self, id: ledge_shared::protocol::PlayerId) -> Option<(u64, IVec2)> {
+        let s = self.connection()?.server_state()?;
+        Some((s.tick, s.get(id.0)?.pos))
+    }
+
     /// The online game, if online.
     fn connection(&self) -> Option<&OnlineGame> {
         match &self.mode {
@@ -387,6 +423,12 @@ impl Play {
                     "reconnecting... (nothing from {} for {:.0} s)",
                     self.server,
                     silent.as_secs_f32()
+                ),
+                None if self.spectating() => format!(
+                    "spectating: {} on {}{}",
+                    welcome.room,
+                    welcome.level_id,
+                    self.via()
                 ),
                 None => format!(
                     "online: {} on {}, you are player {}{}",

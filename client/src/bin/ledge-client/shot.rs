@@ -22,6 +22,26 @@
 //!   "remotes": [                       // other players drawn, with their labels
 //!     {"id": 2, "label": "bob", "drawn_screen": [60.0, 412.0], "size_px": [12.0, 16.0]}
 //!   ],
+//!   "ghosts": [                        // the ghosts drawn (none when hidden with G)
+//!     {"kind": "record", "player": "bob", "run_tick": 212,  // "record" or "best"
+//!      "pos_units": [52224, 106496], "pos_px": [204.0, 416.0], "screen": [400.0, 412.0]}
+//!   ],
+//!   "ghosts_shown": true,              // G: on
+//!   "split": {"text": "+0.42", "faster": false, "checkpoint": 17, "against": "bob",
+//!             "record": true},         // null unless a split is on screen
+//!                                      // (checkpoint null: the finish's)
+//!   "spectate": {                      // null unless --spectate
+//!     "room": "room-1", "line": "spectating room-1 - following bob (Tab: next)",
+//!     "free_camera": false,
+//!     "following": {                   // null: nobody (free camera, empty room)
+//!       "id": 2, "name": "bob",
+//!       "drawn_px": [204.0, 416.0],    // its centre as drawn (interpolated)
+//!       "drawn_screen": [400.0, 412.0],
+//!       "render_tick": 1520.4,         // the game tick the others are drawn at
+//!       "server_tick": 1526,           // the newest snapshot's tick
+//!       "server_pos_units": [52224, 106496], "server_pos_px": [204.0, 416.0]
+//!     }                                // (its centre in that snapshot)
+//!   },
 //!   "colors": {"sky": [r, g, b], "solid": [...], "grass": [...],
 //!              "local_player": [...], "one_way": [...]},
 //!   "hud": {                           // null when hidden (F2) or failed
@@ -89,8 +109,10 @@ use macroquad::texture::get_screen_data;
 
 use crate::draw::camera::View;
 use crate::draw::card::{millis_time, Card, Says};
+use crate::draw::ghost::GhostSprite;
 use crate::draw::hud::{BannerLayout, FAILURE_PANEL};
 use crate::draw::render::palette;
+use crate::splits::Split;
 
 /// What a screenshot records.
 pub struct Shot<'a> {
@@ -119,6 +141,31 @@ pub struct Shot<'a> {
     pub fx: FxShot<'a>,
     /// The replay shown, if it is one (`--replay`).
     pub replay: Option<ReplayShot<'a>>,
+    /// The ghosts drawn.
+    pub ghosts: &'a [GhostSprite],
+    /// Ghosts are on (their key).
+    pub ghosts_shown: bool,
+    /// The split on screen and its text, if any.
+    pub split: Option<(&'a Split, String)>,
+    /// What a spectator watched (`--spectate`).
+    pub spectate: Option<SpectateShot<'a>>,
+}
+
+/// A spectator's frame.
+pub struct SpectateShot<'a> {
+    /// The room watched.
+    pub room: &'a str,
+    /// The HUD's line.
+    pub line: &'a str,
+    /// The camera is free.
+    pub free_camera: bool,
+    /// The followed player: id, name, centre as drawn (world px).
+    pub following: Option<(u32, &'a str, Vec2)>,
+    /// The game tick the other players are drawn at.
+    pub render_tick: f64,
+    /// The followed player in the newest snapshot: its tick and centre
+    /// (units).
+    pub server: Option<(u64, IVec2)>,
 }
 
 /// A replay's frame.
@@ -285,6 +332,8 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
     } else {
         let _ = writeln!(s, "  \"remotes\": [\n{}\n  ],", remotes.join(",\n"));
     }
+    describe_ghosts(&mut s, shot);
+    describe_spectate(&mut s, shot);
     let _ = writeln!(
         s,
         "  \"colors\": {{\"sky\": {}, \"solid\": {}, \"grass\": {}, \"local_player\": {}, \"one_way\": {}}},",
@@ -315,6 +364,85 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
     describe_failure(&mut s, shot.failure);
     s.push_str("}\n");
     s
+}
+
+/// What a spectator watched (`null` unless spectating).
+fn describe_spectate(s: &mut String, shot: &Shot) {
+    let Some(w) = &shot.spectate else {
+        let _ = writeln!(s, "  \"spectate\": null,");
+        return;
+    };
+    let following = match w.following {
+        Some((id, name, pos)) => {
+            let server = match w.server {
+                Some((tick, units)) => format!(
+                    "\"server_tick\": {tick}, \"server_pos_units\": [{}, {}], \"server_pos_px\": {}",
+                    units.x,
+                    units.y,
+                    pair(Vec2::new(units.x as f32, units.y as f32) / 256.0)
+                ),
+                None => "\"server_tick\": null, \"server_pos_units\": null, \"server_pos_px\": null".to_owned(),
+            };
+            format!(
+                "{{\"id\": {id}, \"name\": {}, \"drawn_px\": {}, \"drawn_screen\": {}, \"render_tick\": {:.3}, {server}}}",
+                json_string(name),
+                pair(pos),
+                pair(shot.view.to_screen(pos)),
+                w.render_tick
+            )
+        }
+        None => "null".to_owned(),
+    };
+    let _ = writeln!(
+        s,
+        "  \"spectate\": {{\"room\": {}, \"line\": {}, \"free_camera\": {}, \"following\": {following}}},",
+        json_string(w.room),
+        json_string(w.line),
+        w.free_camera
+    );
+}
+
+/// The ghosts drawn and the split shown.
+fn describe_ghosts(s: &mut String, shot: &Shot) {
+    let v = shot.view;
+    let ghosts: Vec<String> = shot
+        .ghosts
+        .iter()
+        .map(|g| {
+            format!(
+                "    {{\"kind\": \"{}\", \"player\": {}, \"run_tick\": {}, \"pos_units\": [{}, {}], \"pos_px\": {}, \"screen\": {}}}",
+                if g.record { "record" } else { "best" },
+                json_string(&g.player),
+                g.run_tick,
+                g.units.x,
+                g.units.y,
+                pair(g.sprite.pos),
+                pair(v.to_screen(g.sprite.pos))
+            )
+        })
+        .collect();
+    if ghosts.is_empty() {
+        let _ = writeln!(s, "  \"ghosts\": [],");
+    } else {
+        let _ = writeln!(s, "  \"ghosts\": [\n{}\n  ],", ghosts.join(",\n"));
+    }
+    let _ = writeln!(s, "  \"ghosts_shown\": {},", shot.ghosts_shown);
+    match &shot.split {
+        Some((split, text)) => {
+            let _ = writeln!(
+                s,
+                "  \"split\": {{\"text\": {}, \"faster\": {}, \"checkpoint\": {}, \"against\": {}, \"record\": {}}},",
+                json_string(text),
+                split.faster(),
+                split.checkpoint.map_or("null".to_owned(), |c| c.to_string()),
+                json_string(&split.against),
+                split.record
+            );
+        }
+        None => {
+            let _ = writeln!(s, "  \"split\": null,");
+        }
+    }
 }
 
 /// Our player, as the server last said and as drawn (`null` before the
@@ -610,6 +738,10 @@ mod tests {
                 dead: false,
             },
             replay: None,
+            ghosts: &[],
+            ghosts_shown: true,
+            split: None,
+            spectate: None,
         };
         let json = describe(&shot, Path::new("c.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect(&json);
@@ -689,6 +821,10 @@ mod tests {
                 dead: true,
             },
             replay: None,
+            ghosts: &[],
+            ghosts_shown: true,
+            split: None,
+            spectate: None,
         };
         let json = describe(&shot, Path::new("/tmp/a.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect("JSON");
@@ -761,6 +897,10 @@ mod tests {
                 dead: false,
             },
             replay: None,
+            ghosts: &[],
+            ghosts_shown: true,
+            split: None,
+            spectate: None,
         };
         let json: serde_json::Value =
             serde_json::from_str(&describe(&shot, Path::new("f.png"), 480, 270)).expect("JSON");
@@ -853,6 +993,10 @@ mod tests {
                 dead: false,
             },
             replay: None,
+            ghosts: &[],
+            ghosts_shown: true,
+            split: None,
+            spectate: None,
         };
         let json = describe(&shot(hud(Some(&card))), Path::new("c.png"), 960, 540);
         let json: serde_json::Value = serde_json::from_str(&json).expect("JSON");

@@ -75,6 +75,8 @@ pub fn main() {
         volume: 0.8,
         mute: false,
         look_at: None,
+        spectate: false,
+        follow: None,
         level_art: Default::default(),
     };
     let conf = macroquad::window::Conf {

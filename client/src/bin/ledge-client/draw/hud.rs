@@ -128,7 +128,18 @@ pub struct HudInfo<'a> {
     /// The room's results: everyone in the game who finished, first place
     /// first (drawn when someone besides us is in it).
     pub results: &'a [ResultRow],
+    /// The split against a ghost on screen: its text (`+0.42`) and
+    /// whether we were faster (green) or not (red).
+    pub split: Option<(&'a str, bool)>,
+    /// Spectating: the line saying whom we watch (in place of our name;
+    /// the run shown is theirs).
+    pub spectate: Option<&'a str>,
 }
+
+/// A split we were faster in.
+pub const FASTER: Color = Color::new(0.35, 0.95, 0.45, 1.0);
+/// A split we were slower in.
+pub const SLOWER: Color = Color::new(1.0, 0.35, 0.3, 1.0);
 
 /// One line of the room's results table.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -236,12 +247,23 @@ pub fn panel(lines: &[(String, Color, f32)], x: f32, y: f32) -> f32 {
 /// panel and graph when `show_net`; the room's results table; the
 /// controls hint; sound notices.
 pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
-    let mut lines: Vec<(String, Color, f32)> = vec![(info.name.to_owned(), WHITE, 22.0)];
+    let mut lines: Vec<(String, Color, f32)> = match info.spectate {
+        Some(line) => vec![(line.to_owned(), WHITE, FONT)],
+        None => vec![(info.name.to_owned(), WHITE, 22.0)],
+    };
     if let Some(run) = &info.run {
         lines.push((run_line(run), GOLD, FONT));
     }
-    lines.push((format!("restart: {}", info.restart_key), DIM, 14.0));
+    let keys = match info.spectate {
+        Some(_) => "Tab/Shift+Tab: next player   F: free camera (WASD)".to_owned(),
+        None => format!("restart: {}", info.restart_key),
+    };
+    lines.push((keys, DIM, 14.0));
     let mut y = 8.0 + panel(&lines, 8.0, 8.0) + 6.0;
+    if let Some((text, faster)) = info.split {
+        let colour = if faster { FASTER } else { SLOWER };
+        y += panel(&[(text.to_owned(), colour, 28.0)], 8.0, y) + 6.0;
+    }
     if info.muted {
         y += panel(&[("muted (M)".to_owned(), DIM, 14.0)], 8.0, y) + 6.0;
     }

@@ -1,7 +1,7 @@
 //! What the window draws, each frame, from the game's views: where it looks
 //! ([`camera`]), the world and the players ([`render`], the level's own art
 //! in [`art`]), how the players move between ticks ([`anim`]), particles,
-//! shake and flashes ([`fx`]), the heads-up display ([`hud`]), the results
+//! shake and flashes ([`fx`]), the ghosts to race ([`ghost`]), the heads-up display ([`hud`]), the results
 //! card once our run is finished ([`card`]), the chat ([`chat`]) and the
 //! debug overlay ([`debug`]); the world's layers in their order
 //! ([`scene`]), and a replay's HUD ([`replay_hud`]).
@@ -16,6 +16,7 @@ pub mod card;
 pub mod chat;
 pub mod debug;
 pub mod fx;
+pub mod ghost;
 pub mod hud;
 pub mod render;
 pub mod replay_hud;

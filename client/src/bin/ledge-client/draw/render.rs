@@ -95,6 +95,10 @@ pub mod palette {
     pub const EYE: Color = rgb(255, 255, 255);
     /// The local player.
     pub const LOCAL_PLAYER: Color = rgb(255, 132, 24);
+    /// The level record's ghost (drawn translucent).
+    pub const GHOST_RECORD: Color = rgb(255, 255, 255);
+    /// Our own best run's ghost (drawn translucent).
+    pub const GHOST_BEST: Color = rgb(60, 200, 255);
     /// Other players, by id: each far from the others, from
     /// [`LOCAL_PLAYER`] and from the sky, ground and grass (a test checks
     /// the distances).
@@ -599,18 +603,18 @@ fn walker(view: &View, a: Rect, alive: bool, facing: Facing, time: f32) {
         body.h - 2.0,
         palette::WALKER,
     );
-    eyes(view, body, facing);
+    eyes(view, body, facing, 1.0);
 }
 
 /// Two eyes in the upper part of `body`, looking towards `facing`.
-fn eyes(view: &View, body: Rect, facing: Facing) {
+fn eyes(view: &View, body: Rect, facing: Facing, alpha: f32) {
     let cx = body.center().x + facing.sign() * body.w * 0.15;
     let y = body.y + body.h * 0.22;
     for dx in [-0.2, 0.2] {
         let x = cx + dx * body.w - 1.25;
-        rect(view, x, y, 2.5, 3.5, palette::EYE);
+        rect(view, x, y, 2.5, 3.5, fade(palette::EYE, alpha));
         let px = x + if facing == Facing::Left { 0.0 } else { 1.25 };
-        rect(view, px, y + 1.0, 1.25, 2.0, palette::INK);
+        rect(view, px, y + 1.0, 1.25, 2.0, fade(palette::INK, alpha));
     }
 }
 
@@ -723,10 +727,10 @@ pub fn draw_players<'a>(
     let remotes: Vec<_> = remotes.into_iter().filter(|(p, _)| !hidden(p)).collect();
     let local = local.filter(|(p, _)| !hidden(p));
     for (p, _) in &remotes {
-        draw_body(p, view, player_color(p.id, false));
+        draw_body(p, view, player_color(p.id, false), 1.0);
     }
     if let Some((p, _)) = local {
-        draw_body(p, view, player_color(p.id, true));
+        draw_body(p, view, player_color(p.id, true), 1.0);
     }
     let labelled: Vec<(&PlayerSprite, &str, Vec2, TextDimensions)> = local
         .into_iter()
@@ -776,15 +780,39 @@ fn label_place(p: &PlayerSprite, view: &View, dims: &TextDimensions) -> Vec2 {
     )
 }
 
-/// Draws a player's body in its pose (nothing while it is dead). The
+/// Draws a ghost: `p`'s body in `color` at opacity `alpha` (the same
+/// drawing as a player's), and its `label` above it, as faint.
+pub fn draw_ghost(p: &PlayerSprite, view: &View, color: Color, alpha: f32, label: &str) {
+    draw_body(p, view, color, alpha);
+    if label.is_empty() {
+        return;
+    }
+    let size = LABEL_SIZE - 2.0;
+    let dims = measure_text(label, None, size as u16, 1.0);
+    let at = label_place(p, view, &dims);
+    draw_text(label, at.x, at.y, size, fade(WHITE, (alpha * 2.0).min(1.0)));
+}
+
+/// `c` at opacity `alpha` (times its own).
+fn fade(c: Color, alpha: f32) -> Color {
+    Color {
+        a: c.a * alpha,
+        ..c
+    }
+}
+
+/// Draws a player's body in its pose (nothing while it is dead), at
+/// opacity `alpha` (1: a player; less: a ghost). The
 /// drawing stands on the bottom centre of its box: the body is scaled by
 /// the pose from there and sheared by its lean, the legs follow the action
 /// (a run cycle, tucked when rising, spread when falling, bent on landing,
 /// one against the wall when sliding down it).
-fn draw_body(p: &PlayerSprite, view: &View, color: Color) {
+fn draw_body(p: &PlayerSprite, view: &View, color: Color, alpha: f32) {
     if hidden(p) {
         return;
     }
+    let color = fade(color, alpha);
+    let ink = fade(palette::INK, alpha);
     let pose = &p.pose;
     let tl = p.top_left();
     let a = Rect::new(tl.x, tl.y, p.size.x, p.size.y);
@@ -842,7 +870,7 @@ fn draw_body(p: &PlayerSprite, view: &View, color: Color) {
         let bottom = (foot.y - up).max(top + 1.0);
         rect(view, x, top, 3.0, bottom - 1.0 - top, color);
         let toe = if dir > 0.0 { 0.0 } else { -1.0 };
-        rect(view, x + toe, bottom - 1.0, 4.0, 1.0, palette::INK);
+        rect(view, x + toe, bottom - 1.0, 4.0, 1.0, ink);
     }
     // The body: an outline, then the colour inside it.
     quad(
@@ -853,7 +881,7 @@ fn draw_body(p: &PlayerSprite, view: &View, color: Color) {
             at(bw / 2.0, bh),
             at(-bw / 2.0, bh),
         ],
-        palette::INK,
+        ink,
     );
     let (iw, ih) = (bw / 2.0 - 1.0, bh - 1.0);
     quad(
@@ -866,10 +894,11 @@ fn draw_body(p: &PlayerSprite, view: &View, color: Color) {
         view,
         Rect::new(head.x - bw / 2.0 - pose.lean * 0.3 * bh, head.y, bw, bh),
         pose.facing,
+        alpha,
     );
     // Arms: thrown up when jumping, flailing when falling, swinging
     // against the legs when running, one on the wall when sliding.
-    let arm = shade(color, 0.6);
+    let arm = fade(shade(color, 0.6), alpha);
     let shoulder = |k: f32| at(k * (bw / 2.0 - 0.5), bh * 0.45);
     let arms: Vec<(f32, Vec2)> = match pose.action {
         Action::Run => vec![
@@ -896,7 +925,7 @@ fn draw_body(p: &PlayerSprite, view: &View, color: Color) {
                 vec2(c + dx - 2.0, head.y - 1.0),
                 vec2(c + dx, head.y - 5.0),
                 vec2(c + dx + 2.0, head.y - 1.0),
-                palette::GOAL,
+                fade(palette::GOAL, alpha),
             );
         }
     }

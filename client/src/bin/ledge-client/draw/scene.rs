@@ -1,6 +1,6 @@
 //! The world as a frame shows it, back to front: the sky (or the level
 //! art's background colour), the level's art, its tiles and polygon
-//! blocks, the entities, the players with their name labels, the effects
+//! blocks, the entities, the ghosts, the players with their name labels, the effects
 //! and, when asked, the debug overlay. The game loop and the replay window
 //! draw with it alike.
 
@@ -12,6 +12,7 @@ use crate::draw::art::ArtView;
 use crate::draw::camera::View;
 use crate::draw::debug;
 use crate::draw::fx::Fx;
+use crate::draw::ghost::{self, GhostSprite};
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
 
 /// What one frame draws of the world.
@@ -27,6 +28,8 @@ pub struct WorldFrame<'a> {
     /// The checkpoint our (or the followed) player respawns at: drawn
     /// raised.
     pub checkpoint: Option<u32>,
+    /// The ghosts to race (drawn under the players).
+    pub ghosts: &'a [GhostSprite],
     /// Our (or the followed) player and its label, drawn over the others.
     pub local: Option<(&'a PlayerSprite, &'a str)>,
     /// The other players and their labels, ascending by id.
@@ -56,6 +59,7 @@ pub fn draw(frame: WorldFrame) {
         render::draw_polygon_blocks(level, view);
     }
     render::draw_entities(frame.entities, view, frame.checkpoint, frame.time, statics);
+    ghost::draw(frame.ghosts, view);
     render::draw_players(view, frame.local, frame.remotes);
     frame.effects.draw(view);
     frame.effects.draw_flash();

@@ -29,6 +29,8 @@ debug = ["F1"]
 hud = ["F2"]
 # Network panel and graph on/off.
 net = ["F3"]
+# Ghosts (the level's record, your best) on/off.
+ghosts = ["G"]
 # Opens the chat line (then Enter sends it, Escape closes it).
 chat = ["T", "Enter"]
 quit = ["Escape"]
@@ -48,6 +50,7 @@ struct KeyFile {
     debug: Option<Vec<String>>,
     hud: Option<Vec<String>>,
     net: Option<Vec<String>>,
+    ghosts: Option<Vec<String>>,
     chat: Option<Vec<String>>,
     quit: Option<Vec<String>>,
 }
@@ -65,6 +68,8 @@ pub struct Bindings {
     pub hud: Vec<KeyCode>,
     /// Toggles the network panel and graph.
     pub net: Vec<KeyCode>,
+    /// Toggles the ghosts.
+    pub ghosts: Vec<KeyCode>,
     /// Opens the chat line.
     pub chat: Vec<KeyCode>,
     /// Quits.
@@ -86,6 +91,7 @@ impl Default for Bindings {
             debug: Vec::new(),
             hud: Vec::new(),
             net: Vec::new(),
+            ghosts: Vec::new(),
             chat: Vec::new(),
             quit: Vec::new(),
         };
@@ -128,6 +134,7 @@ impl Bindings {
         keys(file.debug, &mut self.debug)?;
         keys(file.hud, &mut self.hud)?;
         keys(file.net, &mut self.net)?;
+        keys(file.ghosts, &mut self.ghosts)?;
         keys(file.chat, &mut self.chat)?;
         keys(file.quit, &mut self.quit)?;
         Ok(self)
@@ -379,6 +386,7 @@ mod tests {
         assert_eq!(b.hud, [KeyCode::F2]);
         assert_eq!(b.net, [KeyCode::F3]);
         assert_eq!(b.mute, [KeyCode::M]);
+        assert_eq!(b.ghosts, [KeyCode::G]);
         assert_eq!(b.chat, [KeyCode::T, KeyCode::Enter]);
         assert_eq!(b.buttons[5], (Buttons::RESTART, vec![KeyCode::R]));
         assert_eq!(b.quit, [KeyCode::Escape]);
@@ -402,7 +410,9 @@ mod tests {
             ]
         );
         let mut all: Vec<KeyCode> = b.buttons.iter().flat_map(|(_, k)| k.clone()).collect();
-        for keys in [&b.mute, &b.debug, &b.hud, &b.net, &b.chat, &b.quit] {
+        for keys in [
+            &b.mute, &b.debug, &b.hud, &b.net, &b.ghosts, &b.chat, &b.quit,
+        ] {
             all.extend(keys.iter().copied());
         }
         let n = all.len();

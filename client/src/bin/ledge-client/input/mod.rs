@@ -1,4 +1,5 @@
-//! What presses the game's buttons: the keyboard and gamepads through
+//! What presses the game's buttons, and a watching camera's keys
+//! ([`follow`]): the keyboard and gamepads through
 //! rebindable bindings ([`keys`]), one gamepad's state whatever reports it
 //! ([`pad`]), scripted input for tests and demos ([`script`]), and the
 //! keys typed into the chat line ([`typing`]).
@@ -6,6 +7,7 @@
 //! Grouped so that the front end's layout says what it does; this module
 //! only declares them.
 
+pub mod follow;
 pub mod keys;
 pub mod pad;
 pub mod script;

@@ -29,6 +29,7 @@ use crate::draw::hud::{self, BannerLayout, ResultRow, RunInfo};
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
 use crate::draw::replay_hud::{self, ReplayHud, ReplayLines};
 use crate::draw::{fx, scene};
+use crate::input::follow::FollowCamera;
 use crate::input::keys::Bindings;
 use crate::outcome::{fail, EXIT_FAILED};
 use crate::play;
@@ -39,9 +40,6 @@ use crate::sound::cues::Cues;
 
 /// Left and Right seek this many seconds.
 pub const SKIP_SECONDS: f64 = 5.0;
-
-/// A free camera moves this many world pixels a second (WASD).
-pub const PAN_PX_PER_SECOND: f32 = 480.0;
 
 /// Frames drawn before `--exit-after-ticks` ends the replay (and
 /// `--screenshot` takes the last): a new window's first frames may not be
@@ -107,11 +105,8 @@ struct ReplayLoop {
     /// Ticks played (not sought): `--exit-after-ticks`' count.
     played: u64,
     frames: u32,
-    /// Where the camera looked last frame, world px (a free camera starts
-    /// there).
-    focus: Vec2,
-    /// A free camera's centre.
-    free: Vec2,
+    /// Tab, F and WASD: whom the camera follows, or where it is free.
+    follow_camera: FollowCamera,
     /// The failure, once told.
     failed: Option<String>,
 }
@@ -162,8 +157,7 @@ impl ReplayLoop {
             show_hud: watch.hud,
             played: 0,
             frames: 0,
-            focus: Vec2::ZERO,
-            free: Vec2::ZERO,
+            follow_camera: FollowCamera::default(),
             failed: None,
             watch,
         }
@@ -213,7 +207,6 @@ impl ReplayLoop {
     /// player followed starts the sound cues and effects afresh.
     fn keys(&mut self, dt: f32) {
         let any = |keys: &[KeyCode]| keys.iter().any(|&k| is_key_pressed(k));
-        let shift = is_key_down(KeyCode::LeftShift) || is_key_down(KeyCode::RightShift);
         let v = &mut self.watch.viewer;
         let before = (v.tick(), v.followed());
         let mut result = Ok(());
@@ -238,24 +231,8 @@ impl ReplayLoop {
         if is_key_pressed(KeyCode::End) {
             result = result.and_then(|()| v.seek_end());
         }
-        if is_key_pressed(KeyCode::Tab) {
-            v.follow_next(!shift);
-        }
-        if is_key_pressed(KeyCode::F) {
-            if v.follow() == Follow::Free {
-                v.follow_next(true);
-            } else {
-                v.set_follow(Follow::Free);
-                self.free = self.focus;
-            }
-        }
-        if v.follow() == Follow::Free {
-            let axis = |minus: KeyCode, plus: KeyCode| {
-                f32::from(u8::from(is_key_down(plus))) - f32::from(u8::from(is_key_down(minus)))
-            };
-            let dir = vec2(axis(KeyCode::A, KeyCode::D), axis(KeyCode::W, KeyCode::S));
-            self.free += dir * PAN_PX_PER_SECOND * dt;
-        }
+        let players = v.players();
+        v.set_follow(self.follow_camera.keys(v.follow(), &players, dt));
         let after = (v.tick(), v.followed());
         if let Err(e) = result {
             self.failure(&e);
@@ -323,19 +300,10 @@ impl ReplayLoop {
         let (local, remotes) = play::sprites(&frame_view, &mut self.animator, pace);
         let entities = frame_view.entities.iter().map(EntitySprite::from).collect();
         let me = viewer.followed().and_then(|id| viewer.game().player(id));
-        let focus = match viewer.follow() {
-            Follow::Free => {
-                self.free = self
-                    .free
-                    .clamp(level_px.point(), level_px.point() + level_px.size());
-                self.free
-            }
-            Follow::Player(_) => local
-                .as_ref()
-                .or(remotes.first())
-                .map_or(level_px.center(), |p| p.pos),
-        };
-        self.focus = focus;
+        let followed = local.as_ref().or(remotes.first()).map(|p| p.pos);
+        let focus = self
+            .follow_camera
+            .focus(viewer.follow(), followed, level_px);
         let screen = vec2(screen_width(), screen_height());
         let view = self.camera.update(focus, level_px, screen, dt);
         let labels = remotes
@@ -414,6 +382,7 @@ impl ReplayLoop {
                 .collect(),
             effects: &self.effects,
             debug: self.show_debug.then(|| viewer.game().world()),
+            ghosts: &[],
             time: now as f32,
         });
     }
@@ -556,6 +525,10 @@ impl ReplayLoop {
                 dead: scene.me.as_ref().is_some_and(|m| m.dead.is_some()),
             },
             replay: Some(replay),
+            ghosts: &[],
+            ghosts_shown: false,
+            split: None,
+            spectate: None,
         };
         if let Err(e) = shot::save(path, &shot) {
             fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));
