@@ -34,7 +34,7 @@ use ledge_shared::protocol::{
     NoticeKind, Outgoing, PlayerId, RejectReason, RosterEntry, ServerControl, SessionToken,
     Snapshot, Welcome, MAX_ROSTER,
 };
-use ledge_shared::replay::{ReplayHeader, ReplayKind, MAX_LEVEL_NAME_LEN};
+use ledge_shared::replay::{ReplayHeader, MAX_LEVEL_NAME_LEN};
 use prometheus_client::metrics::counter::Counter;
 use tracing::{error, info, warn};
 
@@ -886,18 +886,16 @@ fn names(members: &BTreeMap<PlayerId, Member>) -> impl Iterator<Item = (PlayerId
 
 /// What every replay of the room says it is of.
 fn replay_header(game: &Game, config: &RoomConfig) -> ReplayHeader {
-    ReplayHeader {
-        kind: ReplayKind::Match,
-        room: config.name.clone(),
-        level_id: config.level_id.clone(),
-        level_name: clip_text(game.level_name(), MAX_LEVEL_NAME_LEN),
-        level: config.level,
-        config: *game.config(),
-        tick_rate: config.tick_rate.min(u32::from(u16::MAX)) as u16,
-        hash_interval: config.tick_rate.max(1),
-        recorded_at_ms: 0,
-        names: Vec::new(),
-    }
+    ReplayHeader::for_match(
+        &config.name,
+        (
+            &config.level_id,
+            &clip_text(game.level_name(), MAX_LEVEL_NAME_LEN),
+            config.level,
+        ),
+        *game.config(),
+        config.tick_rate.min(u32::from(u16::MAX)) as u16,
+    )
 }
 
 fn snapshot_kind(snapshot: &Snapshot) -> SnapshotKind {

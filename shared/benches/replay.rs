@@ -19,7 +19,7 @@ use ledge_levels::default_level;
 use ledge_shared::game::{Game, GameConfig};
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{LevelOffer, PlayerId};
-use ledge_shared::replay::{self, Playback, ReplayHeader, ReplayKind, ReplayRecorder};
+use ledge_shared::replay::{self, Playback, ReplayHeader, ReplayRecorder};
 
 /// Ticks per round (one minute at 60 Hz).
 const TICKS: u64 = 3600;
@@ -27,18 +27,12 @@ const TICKS: u64 = 3600;
 const ROUNDS: usize = 5;
 
 fn header() -> ReplayHeader {
-    ReplayHeader {
-        kind: ReplayKind::Match,
-        room: "bench".into(),
-        level_id: "default".into(),
-        level_name: "Default".into(),
-        level: LevelOffer::default(),
-        config: GameConfig::default(),
-        tick_rate: 60,
-        hash_interval: 60,
-        recorded_at_ms: 0,
-        names: Vec::new(),
-    }
+    ReplayHeader::for_match(
+        "bench",
+        ("default", "Default", LevelOffer::default()),
+        GameConfig::default(),
+        60,
+    )
 }
 
 fn buttons(id: u32, tick: u64) -> Buttons {

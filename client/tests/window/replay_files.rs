@@ -14,7 +14,7 @@ use ledge_shared::game::{Game, GameConfig};
 use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
 use ledge_shared::protocol::{LevelOffer, PlayerId};
-use ledge_shared::replay::{self, Playback, Replay, ReplayHeader, ReplayKind, ReplayRecorder};
+use ledge_shared::replay::{self, Playback, Replay, ReplayHeader, ReplayRecorder};
 
 /// The players, by id from 1: ada and bob from the start, cy from tick
 /// 400, dee from tick 800; bob leaves at tick 1800.
@@ -30,16 +30,13 @@ pub struct Recording {
 /// player drilling from an offset of its own.
 pub fn record(level: &Level, offer: LevelOffer, ticks: u64) -> Recording {
     let header = ReplayHeader {
-        kind: ReplayKind::Match,
-        room: "room-1".into(),
-        level_id: level.name.clone(),
-        level_name: level.name.clone(),
-        level: offer,
-        config: GameConfig::default(),
-        tick_rate: 60,
-        hash_interval: 60,
         recorded_at_ms: 1_790_000_000_000,
-        names: Vec::new(),
+        ..ReplayHeader::for_match(
+            "room-1",
+            (&level.name, &level.name, offer),
+            GameConfig::default(),
+            60,
+        )
     };
     let mut game = Game::from_level(level).expect("the level plays");
     let mut recorder = ReplayRecorder::new(header, &game);

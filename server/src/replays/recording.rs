@@ -144,21 +144,15 @@ mod tests {
     use ledge_levels::default_level;
     use ledge_shared::game::GameConfig;
     use ledge_shared::protocol::LevelOffer;
-    use ledge_shared::replay::{Playback, ReplayKind};
+    use ledge_shared::replay::Playback;
 
     fn template() -> ReplayHeader {
-        ReplayHeader {
-            kind: ReplayKind::Match,
-            room: "room-1".into(),
-            level_id: "default".into(),
-            level_name: "Default".into(),
-            level: LevelOffer::default(),
-            config: GameConfig::default(),
-            tick_rate: 60,
-            hash_interval: 60,
-            recorded_at_ms: 0,
-            names: Vec::new(),
-        }
+        ReplayHeader::for_match(
+            "room-1",
+            ("default", "Default", LevelOffer::default()),
+            GameConfig::default(),
+            60,
+        )
     }
 
     #[test]

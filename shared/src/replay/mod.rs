@@ -92,6 +92,32 @@ pub struct ReplayHeader {
     pub names: Vec<(PlayerId, String)>,
 }
 
+impl ReplayHeader {
+    /// The header of a match in `room` on the level `level_id` (named
+    /// `level_name`, its bundle `level`) played with `config` at
+    /// `tick_rate`: a hash a second, no names yet (the recorder adds
+    /// them), no start time (the writer sets it).
+    pub fn for_match(
+        room: &str,
+        (level_id, level_name, level): (&str, &str, LevelOffer),
+        config: GameConfig,
+        tick_rate: u16,
+    ) -> ReplayHeader {
+        ReplayHeader {
+            kind: ReplayKind::Match,
+            room: room.to_owned(),
+            level_id: level_id.to_owned(),
+            level_name: level_name.to_owned(),
+            level,
+            config,
+            tick_rate,
+            hash_interval: u32::from(tick_rate.max(1)),
+            recorded_at_ms: 0,
+            names: Vec::new(),
+        }
+    }
+}
+
 /// One step of a replay's stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Event {

@@ -13,18 +13,12 @@ use ledge_shared::replay::{
 };
 
 fn header() -> ReplayHeader {
-    ReplayHeader {
-        kind: ReplayKind::Match,
-        room: "room-1".into(),
-        level_id: "default".into(),
-        level_name: "Default".into(),
-        level: LevelOffer::default(),
-        config: GameConfig::default(),
-        tick_rate: 60,
-        hash_interval: 60,
-        recorded_at_ms: 1_790_000_000_000,
-        names: Vec::new(),
-    }
+    ReplayHeader::for_match(
+        "room-1",
+        ("default", "Default", LevelOffer::default()),
+        GameConfig::default(),
+        60,
+    )
 }
 
 /// Each player's buttons at `tick`: a loop of runs and jumps, shifted per

@@ -9,18 +9,12 @@ use ledge_shared::protocol::LevelOffer;
 use ledge_shared::replay::{Event, ReplayHeader, ReplayRecorder};
 
 fn header() -> ReplayHeader {
-    ReplayHeader {
-        kind: ReplayKind::Match,
-        room: "room".into(),
-        level_id: "default".into(),
-        level_name: "Default".into(),
-        level: LevelOffer::default(),
-        config: GameConfig::default(),
-        tick_rate: 60,
-        hash_interval: 60,
-        recorded_at_ms: 0,
-        names: Vec::new(),
-    }
+    ReplayHeader::for_match(
+        "room",
+        ("default", "Default", LevelOffer::default()),
+        GameConfig::default(),
+        60,
+    )
 }
 
 /// A match of `ticks` ticks: players 1 and 2 from the start, 3 from tick
