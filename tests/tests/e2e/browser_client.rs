@@ -10,6 +10,9 @@
 //! the level (ground and grass in the level's colours), our player, and bob
 //! in his colour where the page says it drew him.
 //!
+//! A page opened with `?spectate&follow=bob` watches a native runner in a
+//! one-player room: it takes no place, draws bob only, and sees him run.
+//!
 //! Without `chromium` these tests print a loud SKIPPED notice and pass,
 //! except with `CI=true`, where they fail.
 
@@ -387,6 +390,80 @@ fn a_gamepad_moves_and_jumps_the_player_in_the_page() {
         "the stick walked us left: {before} -> {after}"
     );
     assert!(y0 > 0.0);
+    drop(browser);
+    runtime.block_on(server.stop()).unwrap();
+}
+
+#[test]
+fn a_browser_spectates_a_runner_without_a_body() {
+    if skip_without_chromium("browser_client spectate") {
+        return;
+    }
+    // One player's place, taken by a native runner bot; WebSocket only.
+    let (runtime, server) = web_server(|c| {
+        c.max_players = 1;
+        if let Some(web) = &mut c.web {
+            web.webtransport = None;
+        }
+    });
+    let web = server.web_addr.expect("the web port");
+    let (addr, fingerprint) = (server.addr.to_string(), server.fingerprint);
+    let bot = runtime.spawn(async move {
+        let mut runner = ledge_client::bot::Runner::new(ledge_levels::default_route());
+        let options = ledge_client::bot::BotOptions {
+            stop_when_done: true,
+            ..ledge_client::bot::BotOptions::new("bob", Duration::from_secs(40))
+        };
+        ledge_client::bot::connect_and_run(
+            &addr,
+            &ledge_client::net::trust::Trust::Pinned(fingerprint),
+            &mut runner as &mut dyn ledge_client::bot::Brain,
+            &options,
+        )
+        .await
+    });
+    let browser = Browser::launch().expect("launch chromium");
+    let mut page = browser.new_page().expect("a tab");
+    page.open(&format!("http://{web}/?spectate&follow=bob&name=sam"))
+        .expect("the page loads");
+    page.wait_until(
+        "window.ledgeState && ledgeState.joined && ledgeState.players.some(p => p.name == 'bob')",
+        Duration::from_secs(30),
+    )
+    .unwrap_or_else(|e| panic!("the spectator sees bob: {e}\n{}", page.console_text()));
+    let first = state(&mut page);
+    assert_eq!(first["spectating"], true, "{first}");
+    // No body of ours: the one player drawn is bob, followed (drawn as
+    // the one the camera is on), and nobody is called sam.
+    let drawn = first["players"].as_array().unwrap();
+    assert_eq!(drawn.len(), 1, "{first}");
+    assert_eq!(drawn[0]["name"], "bob", "{first}");
+    assert!(
+        first["status"].as_str().unwrap().starts_with("spectating"),
+        "{first}"
+    );
+    let bob_x = |s: &Value| {
+        s["players"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == "bob")
+            .map(|p| p["world"][0].as_f64().unwrap())
+    };
+    let x0 = bob_x(&first).unwrap();
+    // bob runs the route: the page draws him moving.
+    page.wait_until(
+        &format!(
+            "ledgeState.players.some(p => p.name == 'bob' && Math.abs(p.world[0] - {x0}) > 100)"
+        ),
+        Duration::from_secs(20),
+    )
+    .unwrap_or_else(|e| panic!("bob moves on the page: {e}: {}", state(&mut page)));
+    let report = runtime.block_on(bot).expect("the bot task");
+    assert!(
+        report.won,
+        "bob reached the goal beside a spectator: {report}"
+    );
     drop(browser);
     runtime.block_on(server.stop()).unwrap();
 }

@@ -780,10 +780,12 @@ impl GameLoop {
                         name: label.to_owned(),
                         local: ours,
                         screen: [top_left.x, top_left.y, size.x, size.y],
+                        world: [p.pos.x, p.pos.y],
                         rgb: render::palette::bytes(render::player_color(p.id, ours)),
                     }
                 })
                 .collect(),
+            spectating: self.setup.play.spectating(),
         });
     }
 

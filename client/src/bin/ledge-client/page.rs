@@ -247,6 +247,8 @@ pub struct Report<'a> {
     pub me: Option<glam::IVec2>,
     /// The players drawn (ours first, if drawn).
     pub players: Vec<DrawnPlayer>,
+    /// We watch rather than play (`?spectate`).
+    pub spectating: bool,
 }
 
 /// A player as drawn this frame: its box on the canvas and its colour.
@@ -259,6 +261,8 @@ pub struct DrawnPlayer {
     pub local: bool,
     /// Its box's top left corner and size, canvas pixels.
     pub screen: [f32; 4],
+    /// Its centre as drawn, world pixels.
+    pub world: [f32; 2],
     /// Its body colour, RGB 0..=255.
     pub rgb: [u8; 3],
 }
@@ -273,7 +277,7 @@ pub fn report(r: &Report<'_>) {
         .map(|p| {
             serde_json::json!({
                 "id": p.id, "name": p.name, "local": p.local,
-                "screen": p.screen, "rgb": p.rgb,
+                "screen": p.screen, "world": p.world, "rgb": p.rgb,
             })
         })
         .collect();
@@ -282,6 +286,7 @@ pub fn report(r: &Report<'_>) {
         "status": r.status,
         "failure": r.failure,
         "joined": r.joined,
+        "spectating": r.spectating,
         "me": r.me.map(|p| serde_json::json!({"x": px(p.x), "y": px(p.y)})),
         "players": players,
         // The level's flat colours, for tests of what the canvas shows.

@@ -280,6 +280,15 @@ impl Play {
         self.connection().is_some_and(OnlineGame::spectating)
     }
 
+    /// Watch rather than play (a browser page's `?spectate`; natively the
+    /// request says it); before the welcome.
+    #[cfg(target_arch = "wasm32")]
+    pub fn set_spectating(&mut self, spectate: bool) {
+        if let Mode::Online(online) = &mut self.mode {
+            online.set_spectating(spectate);
+        }
+    }
+
     /// The room's name, once welcomed.
     pub fn room(&self) -> Option<&str> {
         Some(self.game()?.welcome()?.room.as_str())

@@ -6,7 +6,8 @@
 //! The page joins the server that served it ([`WebNet`]: WebTransport,
 //! or a WebSocket where the browser has no WebTransport), in the room the
 //! address names (`?room=friends`); `?offline` plays the embedded level
-//! without a server.
+//! without a server; `?spectate` watches (`&follow=NAME`) rather than
+//! plays.
 //!
 //! On top, beside [`crate::native`]: it builds the game's [`Setup`] and
 //! runs the game loop; nothing calls into it but `main`.
@@ -40,19 +41,18 @@ fn name() -> String {
 pub fn main() {
     let name = name();
     let level = ledge_levels::default_level();
+    let spectate = param("spectate").is_some();
     let made = if param("offline").is_some() {
         play::Play::offline(level, &name)
     } else {
         let options = JoinOptions {
             room: param("room").filter(|r| !r.is_empty()),
+            spectate,
             ..JoinOptions::new(&name)
         };
-        Ok(play::Play::web(
-            WebNet::open(options),
-            &host(),
-            level,
-            &name,
-        ))
+        let mut play = play::Play::web(WebNet::open(options), &host(), level, &name);
+        play.set_spectating(spectate);
+        Ok(play)
     };
     let play = match made {
         Ok(play) => play,
@@ -75,8 +75,8 @@ pub fn main() {
         volume: 0.8,
         mute: false,
         look_at: None,
-        spectate: false,
-        follow: None,
+        spectate,
+        follow: param("follow").filter(|f| !f.is_empty()),
         level_art: Default::default(),
     };
     let conf = macroquad::window::Conf {
