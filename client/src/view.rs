@@ -134,6 +134,23 @@ pub struct EntityDraw {
 }
 
 impl EntityDraw {
+    /// Level entity `e` drawn with its centre at `pos` (pixels).
+    pub fn of(e: &ledge_shared::game::EntityView, pos: Vec2) -> EntityDraw {
+        EntityDraw {
+            id: e.id,
+            kind: e.ty,
+            pos,
+            size: px2(e.half * 2),
+            active: e.active,
+            one_way: e.one_way,
+            facing: if e.ty == EntityType::Walker {
+                Facing::from_left(e.facing_left)
+            } else {
+                Facing::Right
+            },
+        }
+    }
+
     /// Top-left corner of its box, pixels.
     pub fn top_left(&self) -> Vec2 {
         self.pos - self.size * 0.5
@@ -220,4 +237,19 @@ pub fn px(units: i32) -> f32 {
 /// A unit vector to pixels.
 pub fn px2(units: glam::IVec2) -> Vec2 {
     Vec2::new(px(units.x), px(units.y))
+}
+
+/// A move longer than this in one tick (pixels) is a teleport (a respawn,
+/// a restart): drawn where it ends, not blended.
+pub const TELEPORT_PX: f32 = 64.0;
+
+/// Where something drawn between two ticks is (pixels): `alpha` of the
+/// way from `before` to `now` (units), or at `now` when it has no
+/// `before` or teleported.
+pub fn blend(before: Option<glam::IVec2>, now: glam::IVec2, alpha: f32) -> Vec2 {
+    let cur = px2(now);
+    match before.map(px2) {
+        Some(prev) if (cur - prev).abs().max_element() <= TELEPORT_PX => prev.lerp(cur, alpha),
+        _ => cur,
+    }
 }

@@ -48,7 +48,7 @@ use crate::game::predict::{Predictor, Reconciled};
 use crate::net::levels::check_level;
 use crate::net::session::SnapshotUpdate;
 use crate::netstats::{StatsTracker, TransportSample};
-use crate::view::{px2, EntityDraw, EntityType, Facing, FrameView, NetStats, PlayerDraw};
+use crate::view::{blend, px2, EntityDraw, Facing, FrameView, NetStats, PlayerDraw};
 
 /// At most this many inputs are handed to `send` per [`ClientGame::update`]
 /// (after a long frame): each packet repeats the previous ticks anyway, and
@@ -365,29 +365,20 @@ impl ClientGame {
         let game = self.predictor.game();
         let size = px2(self.player_half * 2);
         let me = game.player(self.me).filter(|_| !self.spectating);
-        let local = me.map(|p| {
-            let cur = px2(p.pos);
-            let prev = self.predictor.prev_pos().map_or(cur, px2);
-            let prev = if (cur - prev).abs().max_element() > 64.0 {
-                cur
-            } else {
-                prev
-            };
-            PlayerDraw {
-                id: self.me,
-                name: self
-                    .name
-                    .clone()
-                    .or_else(|| self.names.get(&self.me).cloned()),
-                pos: prev.lerp(cur, alpha) + self.predictor.offset(),
-                size: px2(p.half * 2),
-                vel: px2(p.vel) * rate,
-                facing: Facing::from_left(p.facing_left),
-                grounded: p.grounded,
-                won: p.won,
-                dead: p.dead.is_some(),
-                wall: wall_side(p.sides, p.grounded),
-            }
+        let local = me.map(|p| PlayerDraw {
+            id: self.me,
+            name: self
+                .name
+                .clone()
+                .or_else(|| self.names.get(&self.me).cloned()),
+            pos: blend(self.predictor.prev_pos(), p.pos, alpha) + self.predictor.offset(),
+            size: px2(p.half * 2),
+            vel: px2(p.vel) * rate,
+            facing: Facing::from_left(p.facing_left),
+            grounded: p.grounded,
+            won: p.won,
+            dead: p.dead.is_some(),
+            wall: wall_side(p.sides, p.grounded),
         });
         let remotes = self
             .interp
@@ -412,26 +403,7 @@ impl ClientGame {
             .entities()
             .enumerate()
             .map(|(i, e)| {
-                let cur = px2(e.pos);
-                let prev = self.prev_entities.get(i).map_or(cur, |&p| px2(p));
-                let pos = if (cur - prev).abs().max_element() > 64.0 {
-                    cur
-                } else {
-                    prev.lerp(cur, alpha)
-                };
-                EntityDraw {
-                    id: e.id,
-                    kind: e.ty,
-                    pos,
-                    size: px2(e.half * 2),
-                    active: e.active,
-                    one_way: e.one_way,
-                    facing: if e.ty == EntityType::Walker {
-                        Facing::from_left(e.facing_left)
-                    } else {
-                        Facing::Right
-                    },
-                }
+                EntityDraw::of(&e, blend(self.prev_entities.get(i).copied(), e.pos, alpha))
             })
             .collect();
         FrameView {

@@ -6,15 +6,11 @@
 //! as the replay's header names them.
 
 use glam::IVec2;
-use ledge_shared::game::{EntityType, Game, PlayerView};
+use ledge_shared::game::{Game, PlayerView};
 use ledge_shared::protocol::PlayerId;
 
 use crate::game::wall_side;
-use crate::view::{px2, EntityDraw, Facing, FrameView, PlayerDraw, Vec2};
-
-/// A move longer than this in one tick (pixels) is a teleport (a respawn,
-/// a restart): drawn where it ends, not blended.
-pub const TELEPORT_PX: f32 = 64.0;
+use crate::view::{blend, px2, EntityDraw, Facing, FrameView, PlayerDraw, Vec2};
 
 /// Where the players and entities stood before the last tick (units): the
 /// start of the blend.
@@ -44,16 +40,6 @@ impl Before {
     fn player(&self, id: PlayerId) -> Option<IVec2> {
         let i = self.players.binary_search_by_key(&id, |p| p.0).ok()?;
         Some(self.players[i].1)
-    }
-}
-
-/// `now` blended from `before` by `alpha` (pixels); a teleport is not
-/// blended.
-fn blend(before: Option<IVec2>, now: IVec2, alpha: f32) -> Vec2 {
-    let cur = px2(now);
-    match before.map(px2) {
-        Some(prev) if (cur - prev).abs().max_element() <= TELEPORT_PX => prev.lerp(cur, alpha),
-        _ => cur,
     }
 }
 
@@ -97,19 +83,7 @@ pub fn frame_view(
     view.entities = game
         .entities()
         .enumerate()
-        .map(|(i, e)| EntityDraw {
-            id: e.id,
-            kind: e.ty,
-            pos: blend(before.entities.get(i).copied(), e.pos, alpha),
-            size: px2(e.half * 2),
-            active: e.active,
-            one_way: e.one_way,
-            facing: if e.ty == EntityType::Walker {
-                Facing::from_left(e.facing_left)
-            } else {
-                Facing::Right
-            },
-        })
+        .map(|(i, e)| EntityDraw::of(&e, blend(before.entities.get(i).copied(), e.pos, alpha)))
         .collect();
     view.tick = game.tick();
     view.alpha = alpha;
