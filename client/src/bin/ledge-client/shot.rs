@@ -689,6 +689,35 @@ fn describe_failure(s: &mut String, failure: Option<(&str, &BannerLayout)>) {
 mod tests {
     use super::*;
 
+    /// A shot of nothing (no player, HUD, chat, effects...) in `view`:
+    /// each test sets what it looks at.
+    fn blank(view: &View) -> Shot<'_> {
+        Shot {
+            tick: 0,
+            view,
+            level_px: Rect::new(0.0, 0.0, 1.0, 1.0),
+            tile_px: 16,
+            server: None,
+            drawn: None,
+            remotes: Vec::new(),
+            hud: None,
+            failure: None,
+            chat: None,
+            fx: FxShot {
+                particles: 0,
+                shake: 0.0,
+                flash: 0.0,
+                recent: &[],
+                dead: false,
+            },
+            replay: None,
+            ghosts: &[],
+            ghosts_shown: true,
+            split: None,
+            spectate: None,
+        }
+    }
+
     #[test]
     fn json_lists_the_chat_lines_drawn() {
         use crate::chat::Shown;
@@ -718,30 +747,12 @@ mod tests {
         );
         let shot = Shot {
             tick: 1,
-            view: &view,
             level_px: Rect::new(0.0, 0.0, 100.0, 100.0),
-            tile_px: 16,
-            server: None,
-            drawn: None,
-            remotes: Vec::new(),
-            hud: None,
-            failure: None,
             chat: Some(ChatShot {
                 view: &chat,
                 muted: vec!["eve"],
             }),
-            fx: FxShot {
-                particles: 0,
-                shake: 0.0,
-                flash: 0.0,
-                recent: &[],
-                dead: false,
-            },
-            replay: None,
-            ghosts: &[],
-            ghosts_shown: true,
-            split: None,
-            spectate: None,
+            ..blank(&view)
         };
         let json = describe(&shot, Path::new("c.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect(&json);
@@ -764,9 +775,7 @@ mod tests {
         };
         let shot = Shot {
             tick: 7,
-            view: &view,
             level_px: Rect::new(0.0, 0.0, 1600.0, 480.0),
-            tile_px: 16,
             server: Some((
                 5,
                 3,
@@ -811,8 +820,6 @@ mod tests {
                 ],
                 card: None,
             }),
-            failure: None,
-            chat: None,
             fx: FxShot {
                 particles: 12,
                 shake: 1.5,
@@ -820,11 +827,7 @@ mod tests {
                 recent: &[crate::sound::audio::Effect::Hurt],
                 dead: true,
             },
-            replay: None,
-            ghosts: &[],
-            ghosts_shown: true,
-            split: None,
-            spectate: None,
+            ..blank(&view)
         };
         let json = describe(&shot, Path::new("/tmp/a.png"), 960, 540);
         let parsed: serde_json::Value = serde_json::from_str(&json).expect("JSON");
@@ -879,28 +882,8 @@ mod tests {
             panel: Rect::new(40.0, 16.0, 400.0, 80.5),
         };
         let shot = Shot {
-            tick: 0,
-            view: &view,
-            level_px: Rect::new(0.0, 0.0, 1.0, 1.0),
-            tile_px: 16,
-            server: None,
-            drawn: None,
-            remotes: Vec::new(),
-            hud: None,
             failure: Some((message, &layout)),
-            chat: None,
-            fx: FxShot {
-                particles: 0,
-                shake: 0.0,
-                flash: 0.0,
-                recent: &[],
-                dead: false,
-            },
-            replay: None,
-            ghosts: &[],
-            ghosts_shown: true,
-            split: None,
-            spectate: None,
+            ..blank(&view)
         };
         let json: serde_json::Value =
             serde_json::from_str(&describe(&shot, Path::new("f.png"), 480, 270)).expect("JSON");
@@ -975,28 +958,8 @@ mod tests {
             card,
         };
         let shot = |hud| Shot {
-            tick: 0,
-            view: &view,
-            level_px: Rect::new(0.0, 0.0, 1.0, 1.0),
-            tile_px: 16,
-            server: None,
-            drawn: None,
-            remotes: Vec::new(),
             hud: Some(hud),
-            failure: None,
-            chat: None,
-            fx: FxShot {
-                particles: 0,
-                shake: 0.0,
-                flash: 0.0,
-                recent: &[],
-                dead: false,
-            },
-            replay: None,
-            ghosts: &[],
-            ghosts_shown: true,
-            split: None,
-            spectate: None,
+            ..blank(&view)
         };
         let json = describe(&shot(hud(Some(&card))), Path::new("c.png"), 960, 540);
         let json: serde_json::Value = serde_json::from_str(&json).expect("JSON");
