@@ -28,6 +28,7 @@ use crate::draw::camera::{self, Camera};
 use crate::draw::ghost::{self, GhostSprite};
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
 use crate::draw::{card, chat as chat_view, fx, hud, scene};
+use crate::frame::{sound_notice, FrameClock};
 use crate::input::keys::{Bindings, Gamepads};
 use crate::input::script::Script;
 use crate::input::typing;
@@ -37,16 +38,10 @@ use crate::splits::{Split, Splits};
 use crate::{play, shot};
 use ledge_shared::protocol::PlayerId;
 
-/// How long "sound off: why" stays on screen, seconds from the start.
-const SOUND_NOTICE_SECONDS: f64 = 6.0;
-
 /// The controls hint stays this long after the first move, then fades
 /// out over [`HINT_FADE`] seconds.
 const HINT_STAYS: f64 = 4.0;
 const HINT_FADE: f64 = 1.5;
-
-/// Frames are not drawn faster than this (no vsync under Xvfb).
-const MAX_FPS: f64 = 240.0;
 
 /// Frames drawn with a failure's banner before `--exit-after-ticks` ends
 /// the run (and `--screenshot` takes the last): the first frames of a
@@ -132,7 +127,7 @@ pub async fn game(setup: Setup) {
     // Closing the window ends the loop below, so we leave the server.
     prevent_quit();
     while game.frame() {
-        game.pace();
+        game.frame_clock.pace();
         next_frame().await;
     }
     game.leave();
@@ -167,7 +162,7 @@ struct GameLoop {
     restart_key: String,
     /// Ticks of play so far: the script's clock and --exit-after-ticks'.
     played: u64,
-    last_frame: Instant,
+    frame_clock: FrameClock,
     art: ArtView,
     /// The server's art arrives with its level (downloaded or cached).
     server_art: bool,
@@ -261,7 +256,7 @@ impl GameLoop {
             first_move: None,
             restart_key,
             played: 0,
-            last_frame: Instant::now(),
+            frame_clock: FrameClock::new(),
             art,
             server_art: false,
             failed: None,
@@ -285,7 +280,7 @@ impl GameLoop {
         if !chatting && !self.chat.is_open() {
             self.toggle_overlays();
         }
-        let dt = self.frame_time();
+        let dt = self.frame_clock.lap();
         let before = self.played;
         self.simulate(now);
         self.race_ghosts(now);
@@ -408,13 +403,6 @@ impl GameLoop {
             let ghost = self.setup.play.ghosts().first();
             self.splits.observe(&me, ghost, now);
         }
-    }
-
-    /// The time since the last frame (and this frame's start noted).
-    fn frame_time(&mut self) -> Duration {
-        let frame = self.last_frame.elapsed();
-        self.last_frame = Instant::now();
-        frame
     }
 
     /// Simulates the ticks due, with the script's or the player's buttons.
@@ -708,9 +696,7 @@ impl GameLoop {
 
     /// "sound off: why", for the first seconds after the start.
     fn sound_notice(&self, now: f64) -> Option<&str> {
-        self.sound_off
-            .as_deref()
-            .filter(|_| now < SOUND_NOTICE_SECONDS)
+        sound_notice(self.sound_off.as_deref(), now)
     }
 
     /// Draws the HUD (unless a failure covers the scene) and the status banner.
@@ -880,17 +866,6 @@ impl GameLoop {
                 .followed
                 .and_then(|id| self.setup.play.server_player(id)),
         })
-    }
-
-    /// Waits out the rest of the frame's time natively (no vsync under Xvfb or some drivers: do not spin; a browser calls us once per display frame).
-    fn pace(&self) {
-        #[cfg(not(target_arch = "wasm32"))]
-        {
-            let spent = self.last_frame.elapsed().as_secs_f64();
-            if spent < 1.0 / MAX_FPS {
-                std::thread::sleep(Duration::from_secs_f64(1.0 / MAX_FPS - spent));
-            }
-        }
     }
 
     /// Leaves the server (if connected) before the window closes, then stops the in-process server, if any.

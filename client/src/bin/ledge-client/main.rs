@@ -51,6 +51,7 @@
 
 mod chat;
 mod draw;
+mod frame;
 mod game_loop;
 mod input;
 #[cfg(not(target_arch = "wasm32"))]

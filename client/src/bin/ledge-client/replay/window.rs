@@ -12,7 +12,6 @@
 //! free camera (WASD moves it).
 
 use std::path::PathBuf;
-use std::time::Duration;
 
 use ledge_client::replay::{Follow, ReplayViewer};
 use ledge_client::time::Instant;
@@ -29,6 +28,7 @@ use crate::draw::hud::{self, BannerLayout, ResultRow, RunInfo};
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
 use crate::draw::replay_hud::{self, ReplayHud, ReplayLines};
 use crate::draw::{fx, scene};
+use crate::frame::{sound_notice, FrameClock};
 use crate::input::follow::FollowCamera;
 use crate::input::keys::Bindings;
 use crate::outcome::{fail, EXIT_FAILED};
@@ -45,12 +45,6 @@ pub const SKIP_SECONDS: f64 = 5.0;
 /// `--screenshot` takes the last): a new window's first frames may not be
 /// on screen yet.
 const MIN_FRAMES: u32 = 3;
-
-/// Frames are not drawn faster than this (no vsync under Xvfb).
-const MAX_FPS: f64 = 240.0;
-
-/// How long "sound off: why" stays on screen, seconds.
-const SOUND_NOTICE_SECONDS: f64 = 6.0;
 
 /// Everything the replay's window needs, prepared before it opens.
 pub struct Watch {
@@ -83,7 +77,7 @@ pub async fn watch(watch: Watch) {
     let mut window = ReplayLoop::new(watch);
     prevent_quit();
     while window.frame() {
-        window.pace();
+        window.frame_clock.pace();
         next_frame().await;
     }
 }
@@ -92,7 +86,7 @@ pub async fn watch(watch: Watch) {
 struct ReplayLoop {
     watch: Watch,
     started: Instant,
-    last_frame: Instant,
+    frame_clock: FrameClock,
     camera: Camera,
     animator: Animator,
     effects: fx::Fx,
@@ -145,7 +139,7 @@ impl ReplayLoop {
         let cues = Cues::new(&watch.viewer.game().config().player);
         ReplayLoop {
             started: Instant::now(),
-            last_frame: Instant::now(),
+            frame_clock: FrameClock::new(),
             camera: Camera::new(),
             animator: Animator::new(),
             effects: fx::Fx::default(),
@@ -169,7 +163,7 @@ impl ReplayLoop {
             return false;
         }
         let now = self.started.elapsed().as_secs_f64();
-        let dt = self.frame_time().as_secs_f32();
+        let dt = self.frame_clock.lap().as_secs_f32();
         self.frames += 1;
         self.toggle_overlays();
         self.keys(dt);
@@ -256,13 +250,6 @@ impl ReplayLoop {
             fail(EXIT_FAILED, &message);
             self.failed = Some(message);
         }
-    }
-
-    /// The time since the last frame (and this frame's start noted).
-    fn frame_time(&mut self) -> Duration {
-        let frame = self.last_frame.elapsed();
-        self.last_frame = Instant::now();
-        frame
     }
 
     /// Steps the ticks due (at most those `--exit-after-ticks` leaves).
@@ -449,9 +436,7 @@ impl ReplayLoop {
 
     /// "sound off: why", for the first seconds.
     fn sound_notice(&self, now: f64) -> Option<&str> {
-        self.sound_off
-            .as_deref()
-            .filter(|_| now < SOUND_NOTICE_SECONDS)
+        sound_notice(self.sound_off.as_deref(), now)
     }
 
     /// Whether `--exit-after-ticks` is reached (or the replay's end); the
@@ -532,15 +517,6 @@ impl ReplayLoop {
         };
         if let Err(e) = shot::save(path, &shot) {
             fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));
-        }
-    }
-
-    /// Waits out the rest of the frame's time (no vsync under Xvfb or some
-    /// drivers: do not spin).
-    fn pace(&self) {
-        let spent = self.last_frame.elapsed().as_secs_f64();
-        if spent < 1.0 / MAX_FPS {
-            std::thread::sleep(Duration::from_secs_f64(1.0 / MAX_FPS - spent));
         }
     }
 }
