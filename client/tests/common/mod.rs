@@ -66,6 +66,24 @@ impl TestServer {
         }
     }
 
+    /// Runs `name`, a runner bot, along the default level's route to the
+    /// goal (it leaves once its run is recorded, or after 40 s) and
+    /// returns its report.
+    pub fn runner_to_goal(&self, name: &str) -> ledge_client::bot::BotReport {
+        use ledge_client::bot::{connect_and_run, BotOptions, Brain, Runner};
+        let mut runner = Runner::new(ledge_levels::default_route());
+        let options = BotOptions {
+            stop_when_done: true,
+            ..BotOptions::new(name, Duration::from_secs(40))
+        };
+        self.block_on(connect_and_run(
+            &self.addr.to_string(),
+            &ledge_client::Trust::Pinned(self.fingerprint),
+            &mut runner as &mut dyn Brain,
+            &options,
+        ))
+    }
+
     /// The server's certificate directory, where its records are by
     /// default ([`ledge_server::records::RecordsTarget::in_state_dir`]).
     pub fn cert_dir(&self) -> &std::path::Path {
@@ -253,4 +271,40 @@ pub fn client_under_xvfb(
         .args(["--window", "960x540"])
         .env("LIBGL_ALWAYS_SOFTWARE", "1");
     command
+}
+
+/// The run replay of `name` saved in the replays folder of a server whose
+/// certificate directory is `cert_dir` (written shortly after the run is
+/// recorded, by another task: waited for, up to 10 s), and its id (the
+/// file's name, as the records keep it).
+pub fn run_replay(
+    cert_dir: &std::path::Path,
+    name: &str,
+) -> (String, ledge_shared::replay::Replay) {
+    use ledge_shared::replay::{self, ReplayKind};
+    let dir = cert_dir.join("replays");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+            let Ok(bytes) = std::fs::read(entry.path()) else {
+                continue;
+            };
+            let Ok(replay) = replay::decode(&bytes) else {
+                continue;
+            };
+            if let ReplayKind::Run { player, .. } = replay.header.kind {
+                if replay.name_of(player) == Some(name) {
+                    let path = entry.path();
+                    let id = path.file_stem().unwrap_or_default().to_string_lossy();
+                    return (id.into_owned(), replay);
+                }
+            }
+        }
+        assert!(
+            Instant::now() < deadline,
+            "no run replay of {name} in {}",
+            dir.display()
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
 }

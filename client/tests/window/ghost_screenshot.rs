@@ -9,14 +9,11 @@
 
 use crate::common;
 
-use std::path::Path;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use common::{run_to_end, TestServer};
 use glam::IVec2;
-use ledge_client::bot::{connect_and_run, BotOptions, Brain, Runner};
-use ledge_client::Trust;
-use ledge_levels::{default_level, default_route};
+use ledge_levels::default_level;
 use ledge_shared::replay::{self, Playback, ReplayKind};
 use serde_json::Value;
 
@@ -25,34 +22,6 @@ const CLIENT_TIMEOUT: Duration = Duration::from_secs(120);
 
 /// Ticks of play before the screenshot (the run starts on the first).
 const TICKS: u64 = 150;
-
-/// The run replay of `name` saved in the server's replays folder (written
-/// shortly after the run is recorded: waited for).
-fn run_replay(cert_dir: &Path, name: &str) -> replay::Replay {
-    let dir = cert_dir.join("replays");
-    let deadline = Instant::now() + Duration::from_secs(10);
-    loop {
-        for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
-            let Ok(bytes) = std::fs::read(entry.path()) else {
-                continue;
-            };
-            let Ok(replay) = replay::decode(&bytes) else {
-                continue;
-            };
-            if let ReplayKind::Run { player, .. } = replay.header.kind {
-                if replay.name_of(player) == Some(name) {
-                    return replay;
-                }
-            }
-        }
-        assert!(
-            Instant::now() < deadline,
-            "no run replay of {name} in {}",
-            dir.display()
-        );
-        std::thread::sleep(Duration::from_millis(100));
-    }
-}
 
 /// Where the runner of the run `replay` was at tick `run_tick` of its
 /// run timer (its centre, units), the replay played with the shared
@@ -85,19 +54,9 @@ fn the_record_runs_beside_us_as_a_ghost_where_its_replay_says() {
     let server = TestServer::start();
     let (addr, fingerprint) = (server.addr.to_string(), server.fingerprint);
     // "bob", a runner bot, to the goal: his run is the level's record.
-    let mut runner = Runner::new(default_route());
-    let options = BotOptions {
-        stop_when_done: true,
-        ..BotOptions::new("bob", Duration::from_secs(40))
-    };
-    let bob = server.block_on(connect_and_run(
-        &addr,
-        &Trust::Pinned(fingerprint),
-        &mut runner as &mut dyn Brain,
-        &options,
-    ));
+    let bob = server.runner_to_goal("bob");
     assert!(matches!(bob.standing, Some(Ok(_))), "bob's run: {bob}");
-    let record = run_replay(server.cert_dir(), "bob");
+    let (_, record) = common::run_replay(server.cert_dir(), "bob");
     // Then "ada" runs right in the window, the record's ghost beside her.
     let tmp = tempfile::tempdir().unwrap();
     let png = common::screenshot_dir(tmp.path()).join("ghost.png");

@@ -175,10 +175,6 @@ fn a_server_without_the_replay_or_refusing_says_so() {
 /// just finished there, and the client checks it to the server's hashes.
 #[test]
 fn a_run_finished_on_a_server_checks_out_from_its_web_port() {
-    use ledge_client::bot::{connect_and_run, BotOptions, Brain, Runner};
-    use ledge_client::net::trust::Trust;
-    use ledge_levels::default_route;
-
     let page = tempfile::tempdir().unwrap();
     let server = crate::common::TestServer::start_with(|c| {
         let mut web = ledge_server::config::WebConfig::new(([127, 0, 0, 1], 0).into());
@@ -186,34 +182,13 @@ fn a_run_finished_on_a_server_checks_out_from_its_web_port() {
         web.webtransport = None;
         c.web = Some(web);
     });
-    let mut runner = Runner::new(default_route());
-    let options = BotOptions {
-        stop_when_done: true,
-        ..BotOptions::new("bob", Duration::from_secs(40))
-    };
-    let bob = server.block_on(connect_and_run(
-        &server.addr.to_string(),
-        &Trust::Pinned(server.fingerprint),
-        &mut runner as &mut dyn Brain,
-        &options,
-    ));
+    let bob = server.runner_to_goal("bob");
     assert!(matches!(bob.standing, Some(Ok(_))), "bob's run: {bob}");
     // His run's replay, by the id the records keep (the file's name).
-    let dir = server.cert_dir().join("replays");
-    let runs: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| {
-            let path = e.unwrap().path();
-            let bytes = std::fs::read(&path).ok()?;
-            let r = replay::decode(&bytes).ok()?;
-            matches!(r.header.kind, replay::ReplayKind::Run { .. })
-                .then(|| path.file_stem().unwrap().to_string_lossy().into_owned())
-        })
-        .collect();
-    assert_eq!(runs.len(), 1, "bob's run in {}", dir.display());
+    let (id, _) = crate::common::run_replay(server.cert_dir(), "bob");
     let web = server.web_addr.expect("a web port");
     let cache = tempfile::tempdir().unwrap();
-    let out = check(&format!("http://{web}/replays/{}", runs[0]), cache.path());
+    let out = check(&format!("http://{web}/replays/{id}"), cache.path());
     let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
     assert_eq!(out.status.code(), Some(0), "{stdout}\n{stderr}");
     assert!(stdout.starts_with("replay OK: "), "{stdout}");

@@ -443,17 +443,7 @@ fn a_finished_online_run_shows_where_it_stands_in_the_records() {
     let server = TestServer::start();
     let (addr, fingerprint) = (server.addr.to_string(), server.fingerprint);
     // First "bob", a runner bot, to the goal: his run is the level's first.
-    let mut runner = Runner::new(default_route());
-    let options = BotOptions {
-        stop_when_done: true,
-        ..BotOptions::new("bob", Duration::from_secs(40))
-    };
-    let bob = server.block_on(connect_and_run(
-        &addr,
-        &Trust::Pinned(fingerprint),
-        &mut runner as &mut dyn Brain,
-        &options,
-    ));
+    let bob = server.runner_to_goal("bob");
     assert!(matches!(bob.standing, Some(Ok(_))), "bob's run: {bob}");
     // Then we, "ada", the next player, run the route in the window.
     let ada = PlayerId(bob.player.expect("bob joined").0 + 1);
