@@ -802,17 +802,7 @@ impl GameLoop {
             tile_px: level.tilemap.tile_size() / UNITS_PER_PX,
             server: self.setup.play.server_me(),
             drawn: scene.local.as_ref().map(|p| p.pos),
-            remotes: scene
-                .remotes
-                .iter()
-                .zip(&scene.labels)
-                .map(|(p, label)| shot::RemoteShot {
-                    id: p.id,
-                    label,
-                    pos: p.pos,
-                    size: p.size,
-                })
-                .collect(),
+            remotes: shot::remotes(&scene.remotes, &scene.labels),
             hud: (self.show_hud && hud.failure.is_none()).then(|| shot::HudShot {
                 name: &hud.name,
                 run: hud.run,

@@ -111,7 +111,7 @@ use crate::draw::camera::View;
 use crate::draw::card::{millis_time, Card, Says};
 use crate::draw::ghost::GhostSprite;
 use crate::draw::hud::{BannerLayout, FAILURE_PANEL};
-use crate::draw::render::palette;
+use crate::draw::render::{palette, PlayerSprite};
 use crate::splits::Split;
 
 /// What a screenshot records.
@@ -247,6 +247,21 @@ pub struct RemoteShot<'a> {
     pub pos: Vec2,
     /// Size of its box, world px.
     pub size: Vec2,
+}
+
+/// The remote players drawn (`sprites`), each with its label (`labels`,
+/// in the same order).
+pub fn remotes<'a>(sprites: &[PlayerSprite], labels: &'a [String]) -> Vec<RemoteShot<'a>> {
+    sprites
+        .iter()
+        .zip(labels)
+        .map(|(p, label)| RemoteShot {
+            id: p.id,
+            label,
+            pos: p.pos,
+            size: p.size,
+        })
+        .collect()
 }
 
 /// The JSON path for screenshot `png`: `png` with `.json` appended.

@@ -480,17 +480,7 @@ impl ReplayLoop {
             tile_px: level.tilemap.tile_size() / UNITS_PER_PX,
             server: scene.me.map(|m| (viewer.tick(), m.id.0, m.pos, m.half)),
             drawn: scene.local.as_ref().map(|p| p.pos),
-            remotes: scene
-                .remotes
-                .iter()
-                .zip(&scene.labels)
-                .map(|(p, label)| shot::RemoteShot {
-                    id: p.id,
-                    label,
-                    pos: p.pos,
-                    size: p.size,
-                })
-                .collect(),
+            remotes: shot::remotes(&scene.remotes, &scene.labels),
             hud: (self.show_hud && shown.failure.is_none()).then(|| shot::HudShot {
                 name: &shown.name,
                 run: shown.run,
