@@ -3,12 +3,13 @@
 //! again to the server's state hashes and ends with that player finished in
 //! the time the records show; the match is saved when the room empties.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use ledge_levels::default_level;
 use ledge_shared::replay::{self, Event, Playback, Replay, ReplayKind};
 use ledge_tests::web::http_get_from;
+use ledge_tests::TestServer;
 
 use crate::records::race;
 use crate::web_transports::{page, web_server};
@@ -26,16 +27,29 @@ fn replays_in(dir: &Path) -> Vec<Replay> {
     out
 }
 
-#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn each_finished_run_and_the_match_replay_to_the_servers_hashes() {
+/// A server with the web port saving replays in a folder of its own
+/// (at most `cap` bytes of them, if given): the server, the folder, and
+/// the temporary directories to keep while it runs.
+async fn server_saving_replays(
+    cap: Option<u64>,
+) -> (TestServer, PathBuf, (tempfile::TempDir, tempfile::TempDir)) {
     let root = page();
     let dir = tempfile::tempdir().unwrap();
     let replays = dir.path().join("replays");
     let folder = replays.clone();
     let server = web_server(root.path(), move |c| {
         c.replays = Some(ledge_server::replays::ReplaysTarget::Dir(folder));
+        if let Some(cap) = cap {
+            c.replays_cap = cap;
+        }
     })
     .await;
+    (server, replays, (root, dir))
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn each_finished_run_and_the_match_replay_to_the_servers_hashes() {
+    let (server, replays, _keep) = server_saving_replays(None).await;
     let web = server.web_addr.unwrap();
     let hash = server.level_offer.hex();
     let reports = race(&server, &["ann", "bob"]).await;
@@ -146,16 +160,8 @@ async fn wait_for_kinds(dir: &Path, want: (usize, usize)) -> (usize, usize) {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn past_the_cap_the_oldest_replays_go_but_not_the_records_own() {
-    let root = page();
-    let dir = tempfile::tempdir().unwrap();
-    let replays = dir.path().join("replays");
-    let folder = replays.clone();
     // A cap no replay fits: everything that may go, goes.
-    let server = web_server(root.path(), move |c| {
-        c.replays = Some(ledge_server::replays::ReplaysTarget::Dir(folder));
-        c.replays_cap = 1;
-    })
-    .await;
+    let (server, replays, _keep) = server_saving_replays(Some(1)).await;
     race(&server, &["ann"]).await;
     // Her run's replay, then the match's (the newest always stays).
     assert_eq!(wait_for_kinds(&replays, (1, 1)).await, (1, 1));
