@@ -28,7 +28,7 @@
 use clap::Parser;
 use glam::IVec2;
 use ledge_shared::broad::standard::{StandardScene, SEED};
-use ledge_shared::broad::{aabb_mtv, Bounds, BroadPhase, BroadPhaseConfig};
+use ledge_shared::broad::{aabb_mtv, Bounds, BroadPhase, BroadPhaseConfig, Isa};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::query::Contact;
 use ledge_shared::shape::{Aabb, Circle};
@@ -60,6 +60,10 @@ struct Args {
     /// `log2` of the finest strip height in units.
     #[arg(long, default_value_t = BroadPhaseConfig::default().strip_shift)]
     strip_shift: u32,
+    /// Run the x86-64 baseline versions of our hot loops (`Isa::Baseline`)
+    /// rather than the best the CPU has, to compare the two.
+    #[arg(long)]
+    baseline: bool,
     /// Also time the update and the pair search apart.
     #[arg(long)]
     breakdown: bool,
@@ -578,6 +582,7 @@ fn check(what: &str, n: usize, reference: &Trace, other: &Trace, mtv: bool) {
 fn run(n: usize, a: &Args, pools: &[(usize, rayon::ThreadPool)]) -> Row {
     let cfg = BroadPhaseConfig {
         strip_shift: a.strip_shift,
+        isa: if a.baseline { Isa::Baseline } else { Isa::Best },
         ..BroadPhaseConfig::default()
     };
     // Ours, AABB fast path, one thread, no rayon.

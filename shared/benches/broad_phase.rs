@@ -6,11 +6,13 @@
 //! comparison with brute force and rapier2d is the `ledge-bench` CLI
 //! (`bench/`), whose table is in `docs/PERFORMANCE.md`. The scene moves
 //! between timed ticks (motion is not timed), so the incremental update sees
-//! the usual few strip changes per tick.
+//! the usual few strip changes per tick. `contacts_aabb_baseline` is
+//! `contacts_aabb` with the x86-64 baseline versions of the hot loops
+//! (`Isa::Baseline`), to compare with the best the CPU has.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use ledge_shared::broad::standard::{StandardScene, SEED};
-use ledge_shared::broad::BroadPhase;
+use ledge_shared::broad::{BroadPhase, BroadPhaseConfig, Isa};
 use std::time::{Duration, Instant};
 
 const SIZES: [usize; 4] = [1_000, 10_000, 50_000, 100_000];
@@ -45,6 +47,19 @@ fn broad_phase(c: &mut Criterion) {
                 ticks(&mut scene, iters, |s| {
                     bp.update_dynamic(&s.boxes);
                     bp.contacts_aabb(&mut out);
+                    out.len()
+                })
+            })
+        });
+        let mut baseline = BroadPhase::new(BroadPhaseConfig {
+            isa: Isa::Baseline,
+            ..BroadPhaseConfig::default()
+        });
+        g.bench_with_input(BenchmarkId::new("contacts_aabb_baseline", n), &n, |b, _| {
+            b.iter_custom(|iters| {
+                ticks(&mut scene, iters, |s| {
+                    baseline.update_dynamic(&s.boxes);
+                    baseline.contacts_aabb(&mut out);
                     out.len()
                 })
             })

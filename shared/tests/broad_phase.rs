@@ -1,14 +1,16 @@
 //! The broad phase against brute force: same pairs, same MTVs, same order,
 //! whatever the scene (huge and tiny boxes, touching boxes, boxes at the
 //! world bounds, static and dynamic mixes, many updates in a row), the
-//! configuration and the number of threads; box queries against both sets
-//! equal brute force too; and no allocation per tick in steady state.
+//! configuration, the number of threads and the compiled versions of the
+//! hot loops (the best the CPU has and the x86-64 baseline, [`Isa`]); box
+//! queries against both sets equal brute force too; and no allocation per
+//! tick in steady state.
 
 use std::sync::OnceLock;
 
 use glam::IVec2;
 use ledge_shared::broad::standard::{SplitMix64, StandardScene};
-use ledge_shared::broad::{aabb_mtv, brute_force, Bounds, BroadPhase, BroadPhaseConfig};
+use ledge_shared::broad::{aabb_mtv, brute_force, Bounds, BroadPhase, BroadPhaseConfig, Isa};
 use ledge_shared::fixed::{px, MAX_COORD, MAX_EXTENT};
 use ledge_shared::query::{Contact, Proximity};
 use ledge_shared::shape::Aabb;
@@ -42,29 +44,49 @@ fn pools() -> &'static [rayon::ThreadPool] {
     })
 }
 
+/// Both choices of compiled versions: the best the CPU has, and always the
+/// x86-64 baseline, which a machine with AVX2 would otherwise never run.
+const ISAS: [Isa; 2] = [Isa::Best, Isa::Baseline];
+
+/// The default configuration with the versions `isa`.
+fn default_with(isa: Isa) -> BroadPhaseConfig {
+    BroadPhaseConfig {
+        isa,
+        ..BroadPhaseConfig::default()
+    }
+}
+
 /// The configurations every scene is checked under: the default, tiny strips
-/// with many levels, and huge strips (everything on one level).
-fn configs() -> [BroadPhaseConfig; 3] {
-    [
+/// with many levels, and huge strips (everything on one level), each under
+/// both [`ISAS`].
+fn configs() -> [BroadPhaseConfig; 6] {
+    let shapes = [
         BroadPhaseConfig::default(),
         BroadPhaseConfig {
             strip_shift: 4,
             level_shift: 1,
             batch: 1,
+            ..BroadPhaseConfig::default()
         },
         BroadPhaseConfig {
             strip_shift: 30,
             level_shift: 2,
             batch: 3,
+            ..BroadPhaseConfig::default()
         },
-    ]
+    ];
+    core::array::from_fn(|k| BroadPhaseConfig {
+        isa: ISAS[k / shapes.len()],
+        ..shapes[k % shapes.len()]
+    })
 }
 
-/// Every output of `bp` for the current sets, checked against `expect`: the
-/// pairs, the AABB contacts and the general path, on this thread and on 1, 2
-/// and 8 threads.
+/// Every output of `bp` (built with `cfg`, which failures name) for the
+/// current sets, checked against `expect`: the pairs, the AABB contacts and
+/// the general path, on this thread and on 1, 2 and 8 threads.
 fn check_all(
     bp: &mut BroadPhase,
+    cfg: &BroadPhaseConfig,
     dynamics: &[(u32, Bounds)],
     all: &[(u32, Bounds)],
     expect: &Contacts,
@@ -74,29 +96,34 @@ fn check_all(
     let narrow = |a: u32, b: u32| aabb_mtv(&lookup(a), &lookup(b));
     let (mut p, mut c) = (Vec::new(), Vec::new());
     bp.find_pairs(&mut p);
-    assert_eq!(p, pairs, "pairs, one thread");
+    assert_eq!(p, pairs, "pairs, one thread, {cfg:?}");
     bp.contacts_aabb(&mut c);
-    assert_eq!(&c, expect, "aabb contacts, one thread");
+    assert_eq!(&c, expect, "aabb contacts, one thread, {cfg:?}");
     bp.contacts_with(&narrow, &mut c);
-    assert_eq!(&c, expect, "general path, one thread");
+    assert_eq!(&c, expect, "general path, one thread, {cfg:?}");
     for pool in pools() {
         let n = pool.current_num_threads();
         pool.install(|| {
             bp.update_dynamic_par(dynamics);
             bp.find_pairs_par(&mut p);
-            assert_eq!(p, pairs, "pairs, {n} threads");
+            assert_eq!(p, pairs, "pairs, {n} threads, {cfg:?}");
             bp.contacts_aabb_par(&mut c);
-            assert_eq!(&c, expect, "aabb contacts, {n} threads");
+            assert_eq!(&c, expect, "aabb contacts, {n} threads, {cfg:?}");
             bp.contacts_with_par(&narrow, &mut c);
-            assert_eq!(&c, expect, "general path, {n} threads");
+            assert_eq!(&c, expect, "general path, {n} threads, {cfg:?}");
         });
     }
 }
 
 /// The box queries: every box of both sets (and a point at each one's
 /// corner) as a query finds exactly the boxes of each set whose interior
-/// overlaps it.
-fn check_queries(bp: &BroadPhase, statics: &[(u32, Bounds)], dynamics: &[(u32, Bounds)]) {
+/// overlaps it. Failures name `cfg`, `bp`'s configuration.
+fn check_queries(
+    bp: &BroadPhase,
+    cfg: &BroadPhaseConfig,
+    statics: &[(u32, Bounds)],
+    dynamics: &[(u32, Bounds)],
+) {
     let brute = |set: &[(u32, Bounds)], q: &Bounds| {
         let mut v: Vec<u32> = set
             .iter()
@@ -113,11 +140,11 @@ fn check_queries(bp: &BroadPhase, statics: &[(u32, Bounds)], dynamics: &[(u32, B
             got.clear();
             bp.query_static(&q, |id| got.push(id));
             got.sort_unstable();
-            assert_eq!(got, brute(statics, &q), "static query {q:?}");
+            assert_eq!(got, brute(statics, &q), "static query {q:?}, {cfg:?}");
             got.clear();
             bp.query_dynamic(&q, |id| got.push(id));
             got.sort_unstable();
-            assert_eq!(got, brute(dynamics, &q), "dynamic query {q:?}");
+            assert_eq!(got, brute(dynamics, &q), "dynamic query {q:?}, {cfg:?}");
         }
     }
 }
@@ -131,8 +158,8 @@ fn check_scene(statics: &[(u32, Bounds)], dynamics: &[(u32, Bounds)]) {
         let mut bp = BroadPhase::new(cfg);
         bp.set_static(statics);
         bp.update_dynamic(dynamics);
-        check_all(&mut bp, dynamics, &all, &expect);
-        check_queries(&bp, statics, dynamics);
+        check_all(&mut bp, &cfg, dynamics, &all, &expect);
+        check_queries(&bp, &cfg, statics, dynamics);
     }
 }
 
@@ -264,7 +291,7 @@ proptest! {
             let mut expect = Vec::new();
             brute_force(&s, &d, &mut expect);
             let all: Vec<_> = s.iter().chain(&d).copied().collect();
-            for bp in &mut bps {
+            for (bp, cfg) in bps.iter_mut().zip(&all_cfgs) {
                 // Alternate the serial and the parallel update on the moving
                 // set, so that both see strips change.
                 if tick % 2 == 0 {
@@ -272,8 +299,8 @@ proptest! {
                 } else {
                     pools()[tick % 3].install(|| bp.update_dynamic_par(&d));
                 }
-                check_all(bp, &d, &all, &expect);
-                check_queries(bp, &s, &d);
+                check_all(bp, cfg, &d, &all, &expect);
+                check_queries(bp, cfg, &s, &d);
             }
         }
     }
@@ -380,28 +407,35 @@ fn crowded_first_id_sorts_like_brute_force() {
 #[test]
 fn standard_scene_over_ticks() {
     let mut scene = StandardScene::new(3000, 7);
-    let mut bp = BroadPhase::default();
+    let mut bps = ISAS.map(|isa| BroadPhase::new(default_with(isa)));
     let mut expect = Vec::new();
     let mut got = Vec::new();
-    let mut coherent_ticks = 0;
+    let mut coherent_ticks = [0; ISAS.len()];
     for _ in 0..20 {
         scene.step();
-        bp.update_dynamic(&scene.boxes);
-        coherent_ticks += usize::from(!bp.stats().full_sort);
         brute_force(&[], &scene.boxes, &mut expect);
         assert!(!expect.is_empty());
-        bp.contacts_aabb(&mut got);
-        assert_eq!(got, expect);
-        for pool in pools() {
-            pool.install(|| {
-                bp.update_dynamic_par(&scene.boxes);
-                bp.contacts_aabb_par(&mut got)
-            });
-            assert_eq!(got, expect);
+        for ((bp, isa), coherent) in bps.iter_mut().zip(ISAS).zip(&mut coherent_ticks) {
+            bp.update_dynamic(&scene.boxes);
+            *coherent += usize::from(!bp.stats().full_sort);
+            bp.contacts_aabb(&mut got);
+            assert_eq!(got, expect, "{isa:?}");
+            for pool in pools() {
+                pool.install(|| {
+                    bp.update_dynamic_par(&scene.boxes);
+                    bp.contacts_aabb_par(&mut got)
+                });
+                assert_eq!(
+                    got,
+                    expect,
+                    "{isa:?}, {} threads",
+                    pool.current_num_threads()
+                );
+            }
         }
     }
     // Every tick after the first reuses the previous order.
-    assert_eq!(coherent_ticks, 19);
+    assert_eq!(coherent_ticks, [19; ISAS.len()]);
 }
 
 #[test]
@@ -409,27 +443,36 @@ fn many_pairs_sort_in_parallel_like_on_one_thread() {
     // Enough pairs (about 4,700) that the parallel paths sort their output
     // in parallel, by id-range parts; the one-thread output is checked
     // against brute force on the last tick.
+    // Both versions must also agree with each other on every tick.
     let mut scene = StandardScene::new(20_000, 5);
-    let mut bp = BroadPhase::default();
-    let (mut one, mut many, mut pairs) = (Vec::new(), Vec::new(), Vec::new());
+    let mut bps = ISAS.map(|isa| BroadPhase::new(default_with(isa)));
+    let mut ones = [Vec::new(), Vec::new()];
+    let (mut many, mut pairs) = (Vec::new(), Vec::new());
     for _ in 0..3 {
         scene.step();
-        bp.update_dynamic(&scene.boxes);
-        bp.contacts_aabb(&mut one);
-        assert!(one.len() > 4096, "{} pairs", one.len());
-        for pool in &pools()[1..] {
-            pool.install(|| {
-                bp.update_dynamic_par(&scene.boxes);
-                bp.contacts_aabb_par(&mut many);
-                bp.find_pairs_par(&mut pairs);
-            });
-            assert_eq!(many, one, "{} threads", pool.current_num_threads());
-            assert!(pairs.iter().copied().eq(one.iter().map(|c| (c.0, c.1))));
+        for ((bp, isa), one) in bps.iter_mut().zip(ISAS).zip(&mut ones) {
+            bp.update_dynamic(&scene.boxes);
+            bp.contacts_aabb(one);
+            assert!(one.len() > 4096, "{} pairs", one.len());
+            for pool in &pools()[1..] {
+                let n = pool.current_num_threads();
+                pool.install(|| {
+                    bp.update_dynamic_par(&scene.boxes);
+                    bp.contacts_aabb_par(&mut many);
+                    bp.find_pairs_par(&mut pairs);
+                });
+                assert_eq!(&many, one, "{isa:?}, {n} threads");
+                let ids = one.iter().map(|c| (c.0, c.1));
+                assert!(pairs.iter().copied().eq(ids), "{isa:?}, {n} threads");
+            }
         }
+        assert_eq!(ones[0], ones[1], "{:?} against {:?}", ISAS[0], ISAS[1]);
     }
     let mut expect = Vec::new();
     brute_force(&[], &scene.boxes, &mut expect);
-    assert_eq!(one, expect);
+    for (one, isa) in ones.iter().zip(ISAS) {
+        assert_eq!(one, &expect, "{isa:?}");
+    }
 }
 
 #[test]
@@ -437,20 +480,25 @@ fn parallel_update_over_ticks() {
     // Only parallel updates, on 2 and 8 threads, small batches.
     for pool in &pools()[1..] {
         let mut scene = StandardScene::new(4000, 3);
-        let mut bp = BroadPhase::new(BroadPhaseConfig {
-            batch: 64,
-            ..BroadPhaseConfig::default()
+        let mut bps = ISAS.map(|isa| {
+            BroadPhase::new(BroadPhaseConfig {
+                batch: 64,
+                ..default_with(isa)
+            })
         });
         let (mut expect, mut got) = (Vec::new(), Vec::new());
         for _ in 0..15 {
             scene.step();
-            pool.install(|| {
-                bp.update_dynamic_par(&scene.boxes);
-                bp.contacts_aabb_par(&mut got);
-            });
             brute_force(&[], &scene.boxes, &mut expect);
-            assert_eq!(got, expect);
-            assert!(!bp.stats().full_sort || expect.is_empty() || got.len() == expect.len());
+            for (bp, isa) in bps.iter_mut().zip(ISAS) {
+                pool.install(|| {
+                    bp.update_dynamic_par(&scene.boxes);
+                    bp.contacts_aabb_par(&mut got);
+                });
+                let n = pool.current_num_threads();
+                assert_eq!(got, expect, "{isa:?}, {n} threads");
+                assert!(!bp.stats().full_sort || expect.is_empty() || got.len() == expect.len());
+            }
         }
     }
 }
@@ -467,43 +515,50 @@ fn no_allocation_per_tick_in_steady_state() {
             )
         })
         .collect();
-    let mut bp = BroadPhase::default();
-    bp.set_static(&statics);
+    let mut bps = ISAS.map(|isa| BroadPhase::new(default_with(isa)));
+    for bp in &mut bps {
+        bp.set_static(&statics);
+    }
     let mut pairs = Vec::new();
     let mut contacts = Vec::new();
     let narrow = |_: u32, _: u32| Some(IVec2::ZERO);
-    let mut tick = |bp: &mut BroadPhase, scene: &mut StandardScene| {
+    // One tick of the scene through both broad phases.
+    let mut tick = |bps: &mut [BroadPhase], scene: &mut StandardScene| {
         scene.step();
-        bp.update_dynamic(&scene.boxes);
-        bp.find_pairs(&mut pairs);
-        bp.contacts_aabb(&mut contacts);
-        bp.contacts_with(&narrow, &mut contacts);
+        for bp in bps {
+            bp.update_dynamic(&scene.boxes);
+            bp.find_pairs(&mut pairs);
+            bp.contacts_aabb(&mut contacts);
+            bp.contacts_with(&narrow, &mut contacts);
+        }
     };
     // Warm up until every buffer has reached its high-water mark.
     for _ in 0..300 {
-        tick(&mut bp, &mut scene);
+        tick(&mut bps, &mut scene);
     }
     let n = allocations(|| {
         for _ in 0..50 {
-            tick(&mut bp, &mut scene);
+            tick(&mut bps, &mut scene);
         }
     });
-    assert_eq!(n, 0, "allocations in 50 ticks");
+    assert_eq!(n, 0, "allocations in 50 ticks, {ISAS:?}");
 }
 
 #[test]
 fn empty_sets() {
-    let mut bp = BroadPhase::default();
-    let mut out = vec![(1, 2)];
-    bp.find_pairs(&mut out);
-    assert!(out.is_empty());
-    bp.set_static(&ided(0, &[Bounds::new(IVec2::ZERO, IVec2::ONE)]));
-    bp.find_pairs_par(&mut out);
-    assert!(out.is_empty());
-    bp.update_dynamic(&[]);
-    bp.find_pairs(&mut out);
-    assert!(out.is_empty());
-    bp.update_dynamic(&ided(5, &[Bounds::new(IVec2::ZERO, IVec2::ONE)]));
-    bp.find_pairs(&mut out);
-    assert_eq!(out, vec![(0, 5)]);
+    for isa in ISAS {
+        let mut bp = BroadPhase::new(default_with(isa));
+        let mut out = vec![(1, 2)];
+        bp.find_pairs(&mut out);
+        assert!(out.is_empty(), "{isa:?}");
+        bp.set_static(&ided(0, &[Bounds::new(IVec2::ZERO, IVec2::ONE)]));
+        bp.find_pairs_par(&mut out);
+        assert!(out.is_empty(), "{isa:?}");
+        bp.update_dynamic(&[]);
+        bp.find_pairs(&mut out);
+        assert!(out.is_empty(), "{isa:?}");
+        bp.update_dynamic(&ided(5, &[Bounds::new(IVec2::ZERO, IVec2::ONE)]));
+        bp.find_pairs(&mut out);
+        assert_eq!(out, vec![(0, 5)], "{isa:?}");
+    }
 }

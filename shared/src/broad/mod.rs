@@ -46,7 +46,10 @@
 //!   instructions (blends, 32-bit lane min/max, inserts and extracts,
 //!   three-operand forms) make it about 7 % faster at N = 10,000
 //!   (`docs/PERFORMANCE.md`). Integer code only: both versions give the
-//!   same results bit for bit.
+//!   same results bit for bit. [`BroadPhaseConfig::isa`] can instead pin
+//!   the baseline ([`Isa::Baseline`]), which a machine with AVX2 would
+//!   otherwise never run: the broad-phase tests check every scene under
+//!   both choices, on any machine, and benchmarks compare the two.
 //!
 //! Pairs are reported only when the interiors overlap (`a.min < b.max` and
 //! `b.min < a.max` on both axes): boxes that share an edge are not a pair.
@@ -55,20 +58,42 @@
 //!
 //! [`standard`] is the benchmark scene of `docs/PERFORMANCE.md`.
 
-/// Compiles `fn` for x86-64-v3 as well as the baseline and picks one at run
-/// time (see the module docs). Kept to thin wrappers around
-/// `#[inline(always)]` bodies, so that everything the body calls is part of
-/// each version and rustfmt formats the bodies. Built with
-/// the `baseline-only` feature, only the baseline version exists: CI runs
-/// the broad-phase tests so too, since a machine with AVX2 never runs it
-/// otherwise.
+/// Compiles `fn` for x86-64-v3 as well as the baseline (see the module
+/// docs) and makes it take an [`Isa`] first: [`Isa::Best`] calls the
+/// `multiversion` version, which picks the best the CPU has at run time,
+/// [`Isa::Baseline`] a plain copy of the same body compiled for the
+/// baseline only (what a CPU without AVX2 runs), so that the tests check
+/// both versions on any machine. The choice is one branch on a value per
+/// call: the wrapped functions run per batch or chunk, not per box. Kept to
+/// thin wrappers around `#[inline(always)]` bodies, so that everything the
+/// body calls is part of each version and rustfmt formats the bodies. The
+/// signature takes `name: Type` arguments and `<T: Bound>` generics only.
 macro_rules! multiversioned {
-    ($(#[$attr:meta])* $vis:vis fn $($rest:tt)*) => {
+    (
+        $(#[$attr:meta])*
+        $vis:vis fn $name:ident $(<$($g:ident: $bound:path),+ $(,)?>)?
+            ($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)?
+        $body:block
+    ) => {
         $(#[$attr])*
-        #[cfg_attr(not(feature = "baseline-only"), multiversion::multiversion(targets(
-            "x86_64+avx2+avx+bmi1+bmi2+fma+lzcnt+popcnt+movbe+f16c"
-        )))]
-        $vis fn $($rest)*
+        #[inline]
+        $vis fn $name $(<$($g: $bound),+>)? (
+            isa: $crate::broad::Isa,
+            $($arg: $ty),*
+        ) $(-> $ret)? {
+            #[multiversion::multiversion(targets(
+                "x86_64+avx2+avx+bmi1+bmi2+fma+lzcnt+popcnt+movbe+f16c"
+            ))]
+            fn best $(<$($g: $bound),+>)? ($($arg: $ty),*) $(-> $ret)? $body
+            // Out of line, like the versions of `best`: the copy does not
+            // grow the caller, which the `Best` path runs through too.
+            #[inline(never)]
+            fn baseline $(<$($g: $bound),+>)? ($($arg: $ty),*) $(-> $ret)? $body
+            match isa {
+                $crate::broad::Isa::Best => best($($arg),*),
+                $crate::broad::Isa::Baseline => baseline($($arg),*),
+            }
+        }
     };
 }
 
@@ -141,6 +166,24 @@ pub struct BroadPhaseConfig {
     pub level_shift: u32,
     /// Least number of dynamic boxes per parallel batch; default 1024.
     pub batch: usize,
+    /// Which compiled versions of the hot loops run (module docs, "Compiled
+    /// twice"): the best the CPU has (the default), or always the x86-64
+    /// baseline, to test the baseline on a machine with AVX2 and to compare
+    /// the two in benchmarks. The results are the same bit for bit.
+    pub isa: Isa,
+}
+
+/// A choice of instruction-set versions for the broad phase's hot loops
+/// ([`BroadPhaseConfig::isa`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Isa {
+    /// The best version the CPU has, picked at run time: x86-64-v3 (AVX2,
+    /// BMI1/2, ...) where available, else the baseline. The default.
+    #[default]
+    Best,
+    /// Always the x86-64 baseline version, even on a CPU with AVX2: what a
+    /// CPU without it runs, for tests on any machine and for benchmarks.
+    Baseline,
 }
 
 impl Default for BroadPhaseConfig {
@@ -149,6 +192,7 @@ impl Default for BroadPhaseConfig {
             strip_shift: 15,
             level_shift: 2,
             batch: 1024,
+            isa: Isa::Best,
         }
     }
 }
@@ -178,6 +222,7 @@ enum Work {
 pub struct BroadPhase {
     levels: Levels,
     batch: usize,
+    isa: Isa,
     statics: Strips,
     dynamics: Strips,
     work: Vec<Work>,
@@ -214,6 +259,7 @@ impl BroadPhase {
         Self {
             levels: Levels::new(config.strip_shift, config.level_shift),
             batch: config.batch.max(1),
+            isa: config.isa,
             statics: Strips::default(),
             dynamics: Strips::default(),
             work: Vec::new(),
@@ -226,21 +272,23 @@ impl BroadPhase {
     /// Replaces the static set (bodies that never move): indexed once here,
     /// then only read by every tick.
     pub fn set_static(&mut self, items: &[(u32, Bounds)]) {
-        self.statics.update(&self.levels, items, false, 0);
+        self.statics.update(&self.levels, items, false, 0, self.isa);
     }
 
     /// Replaces the dynamic set with this tick's boxes. Passing the same
     /// bodies in the same order every tick (the usual case) makes the update
     /// incremental; any other input is still correct, just sorted afresh.
     pub fn update_dynamic(&mut self, items: &[(u32, Bounds)]) {
-        self.dynamics.update(&self.levels, items, false, 0);
+        self.dynamics
+            .update(&self.levels, items, false, 0, self.isa);
     }
 
     /// [`Self::update_dynamic`] with the work split over the current rayon
     /// pool; the resulting state is identical.
     pub fn update_dynamic_par(&mut self, items: &[(u32, Bounds)]) {
         let chunk = self.chunk_target(items.len());
-        self.dynamics.update(&self.levels, items, true, chunk);
+        self.dynamics
+            .update(&self.levels, items, true, chunk, self.isa);
     }
 
     /// Boxes per parallel batch: at least `batch`, about two batches per
@@ -334,7 +382,7 @@ impl BroadPhase {
     {
         self.plan(par);
         let n = self.work.len();
-        let (lv, dy, st) = (&self.levels, &self.dynamics, &self.statics);
+        let (lv, dy, st, isa) = (&self.levels, &self.dynamics, &self.statics, self.isa);
         let (mut id_lo, mut id_hi) = (dy.id_lo, dy.id_hi);
         if st.len() > 0 {
             id_lo = id_lo.min(st.id_lo);
@@ -358,7 +406,7 @@ impl BroadPhase {
                 out: Parts::new(out, split),
                 kernel,
             };
-            run_work(lv, dy, st, *w, c, &mut sink);
+            run_work(lv, dy, st, isa, *w, c, &mut sink);
         };
         if par {
             use rayon::prelude::*;
@@ -372,7 +420,7 @@ impl BroadPhase {
                 .zip(scratch.iter_mut())
                 .for_each(job);
         }
-        bufs.finish(out, par);
+        bufs.finish(out, par, isa);
     }
 
     /// Cuts the work into batches: one of each kind on one thread; batches of
@@ -427,17 +475,22 @@ fn run_work<S: Sink>(
     lv: &Levels,
     dy: &Strips,
     st: &Strips,
+    isa: Isa,
     w: Work,
     scratch: &mut sweep::Scratch,
     sink: &mut S,
 ) {
     match w {
-        Work::Rows(s, e) => sweep::same_level(lv, dy, st, s as usize..e as usize, scratch, sink),
-        Work::CrossDynamic(s, e) => {
-            sweep::cross_level(lv, dy, s as usize..e as usize, dy, sink);
-            sweep::cross_level(lv, dy, s as usize..e as usize, st, sink);
+        Work::Rows(s, e) => {
+            sweep::same_level(isa, lv, dy, st, s as usize..e as usize, scratch, sink)
         }
-        Work::CrossStatic(s, e) => sweep::cross_level(lv, st, s as usize..e as usize, dy, sink),
+        Work::CrossDynamic(s, e) => {
+            sweep::cross_level(isa, lv, dy, s as usize..e as usize, dy, sink);
+            sweep::cross_level(isa, lv, dy, s as usize..e as usize, st, sink);
+        }
+        Work::CrossStatic(s, e) => {
+            sweep::cross_level(isa, lv, st, s as usize..e as usize, dy, sink)
+        }
     }
 }
 

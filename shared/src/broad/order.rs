@@ -20,6 +20,7 @@
 //! histogram per buffer and each bucket sorted on the pool, took 300-540 µs:
 //! too many small tasks.)
 
+use super::Isa;
 use glam::IVec2;
 use rayon::join;
 
@@ -159,8 +160,9 @@ impl<T: Keyed> Buffers<T> {
 
     /// Sorts the pairs of the prepared buffers into `out` (replacing its
     /// contents), each part on its own (on the current rayon pool with
-    /// `par`, when there are enough pairs to pay for it).
-    pub fn finish(&mut self, out: &mut Vec<T>, par: bool) {
+    /// `par`, when there are enough pairs to pay for it), with the `isa`
+    /// versions of the sort.
+    pub fn finish(&mut self, out: &mut Vec<T>, par: bool, isa: Isa) {
         let (split, items) = (self.split, self.items);
         let bufs = &self.bufs[..items * split.parts];
         let total: usize = bufs.iter().map(Vec::len).sum();
@@ -169,7 +171,7 @@ impl<T: Keyed> Buffers<T> {
         // write of the whole output, 370 KB at N = 100,000); `resize` only
         // truncates, or fills the new tail.
         out.resize(total, T::default());
-        let all = Whole { bufs, split };
+        let all = Whole { bufs, split, isa };
         let par = par && total >= PAR_SORT_MIN;
         all.sort(0..split.parts, out, &mut self.starts[..split.parts], par);
     }
@@ -180,6 +182,8 @@ impl<T: Keyed> Buffers<T> {
 struct Whole<'a, T> {
     bufs: &'a [Vec<T>],
     split: Split,
+    /// Which versions of [`sort_part`] run.
+    isa: Isa,
 }
 
 impl<T: Keyed> Whole<'_, T> {
@@ -198,7 +202,7 @@ impl<T: Keyed> Whole<'_, T> {
         par: bool,
     ) {
         if parts.len() == 1 {
-            return sort_part(self, parts.start, out, &mut starts[0]);
+            return sort_part(self.isa, self, parts.start, out, &mut starts[0]);
         }
         let mid = parts.start + parts.len() / 2;
         let left: usize = (parts.start..mid)
@@ -265,7 +269,7 @@ impl<T: Keyed> Whole<'_, T> {
 }
 
 multiversioned! {
-    /// [`Whole::sort_part`], compiled for each target.
+    /// [`Whole::sort_part`], in the version `isa` picks.
     fn sort_part<T: Keyed>(w: &Whole<'_, T>, p: usize, out: &mut [T], starts: &mut Vec<u32>) {
         w.sort_part(p, out, starts)
     }
@@ -361,7 +365,8 @@ mod tests {
         expect.sort_unstable();
         let (lo, hi) = (expect[0].0, expect[expect.len() - 1].0);
         for (parts, items) in [(1, 1), (4, 3), (32, 7)] {
-            for par in [false, true] {
+            let runs = [false, true].map(|par| [(par, Isa::Best), (par, Isa::Baseline)]);
+            for (par, isa) in runs.into_iter().flatten() {
                 let mut b = Buffers::default();
                 let (bufs, split) = b.prepare(items, parts, lo, hi);
                 for (k, t) in pairs.iter().enumerate() {
@@ -369,8 +374,11 @@ mod tests {
                     Parts::new(&mut bufs[w * split.parts..(w + 1) * split.parts], split).push(*t);
                 }
                 let mut out = vec![(7, 7)];
-                b.finish(&mut out, par);
-                assert_eq!(out, expect, "{parts} parts, {items} items, par {par}");
+                b.finish(&mut out, par, isa);
+                assert_eq!(
+                    out, expect,
+                    "{parts} parts, {items} items, par {par}, {isa:?}"
+                );
             }
         }
     }

@@ -22,6 +22,7 @@
 //! and fixed blocks of [`BLOCK`] entries can be read anywhere in a strip.
 
 use super::bounds::Bounds;
+use super::Isa;
 use core::ops::Range;
 use wide::i32x4;
 
@@ -337,7 +338,7 @@ impl Chunk {
 }
 
 multiversioned! {
-    /// [`Chunk::split`], compiled for each target.
+    /// [`Chunk::split`], in the version `isa` picks.
     fn split_chunk(
         c: &mut Chunk,
         lv: &Levels,
@@ -350,7 +351,7 @@ multiversioned! {
 }
 
 multiversioned! {
-    /// [`Chunk::layout`], compiled for each target.
+    /// [`Chunk::layout`], in the version `isa` picks.
     fn layout_chunk(c: &mut Chunk, movers: &[Entry], out: Slices<'_>) {
         c.layout(movers, out)
     }
@@ -524,8 +525,16 @@ impl Strips {
     ///
     /// With `par`, the old strips are cut into chunks of about `chunk` boxes
     /// that are re-keyed and laid out in parallel on the current rayon pool;
-    /// the arrays come out identical either way.
-    pub fn update(&mut self, lv: &Levels, items: &[(u32, Bounds)], par: bool, chunk: usize) {
+    /// the arrays come out identical either way, as they do whichever `isa`
+    /// versions of the hot loops run.
+    pub fn update(
+        &mut self,
+        lv: &Levels,
+        items: &[(u32, Bounds)],
+        par: bool,
+        chunk: usize,
+        isa: Isa,
+    ) {
         let n = items.len();
         let mut full = !(n == self.count && n > 0);
         self.movers.clear();
@@ -533,7 +542,7 @@ impl Strips {
             self.plan_chunks(if par { chunk.max(1) } else { usize::MAX });
             let nc = self.chunks.len();
             let (rows, idx) = (&self.rows, &self.idx);
-            let job = |c: &mut Chunk| split_chunk(c, lv, rows, idx, items);
+            let job = |c: &mut Chunk| split_chunk(isa, c, lv, rows, idx, items);
             if par {
                 use rayon::prelude::*;
                 self.chunks[..nc].par_iter_mut().for_each(job);
@@ -591,7 +600,7 @@ impl Strips {
             super::order::sort_nearly_sorted_by_key(&mut self.movers, 16, |m| m.key);
         }
         self.count = n;
-        self.layout(par);
+        self.layout(par, isa);
     }
 
     /// Cuts the old strips into chunks of about `target` boxes.
@@ -620,7 +629,7 @@ impl Strips {
 
     /// Merges the kept boxes and the movers into the sweep arrays, adding a
     /// sentinel after each strip, and indexes the strips.
-    fn layout(&mut self, par: bool) {
+    fn layout(&mut self, par: bool, isa: Isa) {
         // Hand each chunk the movers of its key range: from its first old
         // strip up to the next chunk's first.
         let nc = self.chunks.len();
@@ -667,7 +676,7 @@ impl Strips {
             id: &mut self.id[..used],
             idx: &mut self.idx[..used],
         };
-        lay_chunks(&mut self.chunks, &self.movers, out, par);
+        lay_chunks(&mut self.chunks, &self.movers, out, par, isa);
         // Padding sentinels.
         let mut pad = Slices {
             minx: &mut self.minx,
@@ -766,12 +775,12 @@ impl<'a> Slices<'a> {
 
 /// Lays out `chunks` into `out` (which starts at the first chunk's base),
 /// splitting the work over the rayon pool when `par`.
-fn lay_chunks(chunks: &mut [Chunk], movers: &[Entry], out: Slices<'_>, par: bool) {
+fn lay_chunks(chunks: &mut [Chunk], movers: &[Entry], out: Slices<'_>, par: bool, isa: Isa) {
     if chunks.len() == 1 || !par {
         let mut out = out;
         for c in chunks {
             let (mine, rest) = out.split_at(c.size);
-            layout_chunk(c, movers, mine);
+            layout_chunk(isa, c, movers, mine);
             out = rest;
         }
         return;
@@ -780,7 +789,7 @@ fn lay_chunks(chunks: &mut [Chunk], movers: &[Entry], out: Slices<'_>, par: bool
     let (left, right) = chunks.split_at_mut(mid);
     let (lo, hi) = out.split_at(right[0].base - left[0].base);
     rayon::join(
-        || lay_chunks(left, movers, lo, par),
-        || lay_chunks(right, movers, hi, par),
+        || lay_chunks(left, movers, lo, par, isa),
+        || lay_chunks(right, movers, hi, par, isa),
     );
 }
