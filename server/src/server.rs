@@ -270,24 +270,11 @@ fn bind_metrics(addr: SocketAddr) -> Result<(tokio::net::TcpListener, SocketAddr
 /// Binds the web port (`--web-bind`), loads the page's directory and binds
 /// WebTransport if on.
 fn bind_web(w: &WebConfig, idle_timeout: Duration) -> Result<WebParts, ServerError> {
-    let listener = web::bind(w.bind).map_err(bind_error(w.bind, "--web-bind"))?;
-    let addr = listener
-        .local_addr()
-        .map_err(bind_error(w.bind, "--web-bind"))?;
+    let (listener, addr, webtransport) = bind_web_ports(w, idle_timeout)?;
     let root = WebRoot::load(&w.root)?;
     if let Some(missing) = root.missing() {
         warn!("{missing}; / answers 503 until then");
     }
-    let webtransport = match w.webtransport {
-        Some(mut bind) => {
-            // The same port number as the web port by default.
-            if bind.port() == 0 && w.webtransport == Some(w.bind) {
-                bind.set_port(addr.port());
-            }
-            Some(bind_webtransport(bind, idle_timeout, w.cert_life)?)
-        }
-        None => None,
-    };
     Ok(WebParts {
         listener,
         addr,
@@ -295,6 +282,52 @@ fn bind_web(w: &WebConfig, idle_timeout: Duration) -> Result<WebParts, ServerErr
         webtransport,
         limits: w.limits,
     })
+}
+
+/// Tries of an ephemeral web port whose number WebTransport's UDP socket
+/// shares, when another program holds that UDP port.
+const EPHEMERAL_WEB_TRIES: usize = 16;
+
+/// The web port's TCP listener, its address, and WebTransport's endpoint
+/// (UDP, on the same port number by default). With port 0 the system picks
+/// the TCP port, and its UDP twin may be taken by another program: then
+/// another TCP port is tried, up to [`EPHEMERAL_WEB_TRIES`] times.
+fn bind_web_ports(
+    w: &WebConfig,
+    idle_timeout: Duration,
+) -> Result<
+    (
+        tokio::net::TcpListener,
+        SocketAddr,
+        Option<WebTransportParts>,
+    ),
+    ServerError,
+> {
+    // The same port number as the web port by default.
+    let shared_ephemeral = w.bind.port() == 0 && w.webtransport == Some(w.bind);
+    let mut tries = 1;
+    loop {
+        let listener = web::bind(w.bind).map_err(bind_error(w.bind, "--web-bind"))?;
+        let addr = listener
+            .local_addr()
+            .map_err(bind_error(w.bind, "--web-bind"))?;
+        let Some(mut bind) = w.webtransport else {
+            return Ok((listener, addr, None));
+        };
+        if shared_ephemeral {
+            bind.set_port(addr.port());
+        }
+        match bind_webtransport(bind, idle_timeout, w.cert_life) {
+            Err(ServerError::Bind { source, .. })
+                if shared_ephemeral
+                    && source.kind() == std::io::ErrorKind::AddrInUse
+                    && tries < EPHEMERAL_WEB_TRIES =>
+            {
+                tries += 1;
+            }
+            result => return Ok((listener, addr, Some(result?))),
+        }
+    }
 }
 
 /// Binds WebTransport's endpoint at `bind` with its first certificates.

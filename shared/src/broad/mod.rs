@@ -98,12 +98,14 @@ macro_rules! multiversioned {
 }
 
 mod bounds;
+mod isa;
 mod order;
 pub mod standard;
 mod strips;
 mod sweep;
 
 pub use bounds::Bounds;
+pub use isa::Isa;
 
 use glam::IVec2;
 use order::{Buffers, Keyed, Parts};
@@ -171,19 +173,6 @@ pub struct BroadPhaseConfig {
     /// baseline, to test the baseline on a machine with AVX2 and to compare
     /// the two in benchmarks. The results are the same bit for bit.
     pub isa: Isa,
-}
-
-/// A choice of instruction-set versions for the broad phase's hot loops
-/// ([`BroadPhaseConfig::isa`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum Isa {
-    /// The best version the CPU has, picked at run time: x86-64-v3 (AVX2,
-    /// BMI1/2, ...) where available, else the baseline. The default.
-    #[default]
-    Best,
-    /// Always the x86-64 baseline version, even on a CPU with AVX2: what a
-    /// CPU without it runs, for tests on any machine and for benchmarks.
-    Baseline,
 }
 
 impl Default for BroadPhaseConfig {

@@ -20,7 +20,7 @@
 //! histogram per buffer and each bucket sorted on the pool, took 300-540 µs:
 //! too many small tasks.)
 
-use super::Isa;
+use super::isa::Isa;
 use glam::IVec2;
 use rayon::join;
 

@@ -22,7 +22,7 @@
 //! and fixed blocks of [`BLOCK`] entries can be read anywhere in a strip.
 
 use super::bounds::Bounds;
-use super::Isa;
+use super::isa::Isa;
 use core::ops::Range;
 use wide::i32x4;
 
