@@ -40,30 +40,28 @@ fn broad_phase(c: &mut Criterion) {
     for &n in &SIZES {
         g.throughput(Throughput::Elements(n as u64));
         let mut scene = StandardScene::new(n, SEED);
-        let mut bp = BroadPhase::default();
         let mut out = Vec::new();
-        g.bench_with_input(BenchmarkId::new("contacts_aabb", n), &n, |b, _| {
-            b.iter_custom(|iters| {
-                ticks(&mut scene, iters, |s| {
-                    bp.update_dynamic(&s.boxes);
-                    bp.contacts_aabb(&mut out);
-                    out.len()
-                })
+        let mut bps = [Isa::Best, Isa::Baseline].map(|isa| {
+            BroadPhase::new(BroadPhaseConfig {
+                isa,
+                ..BroadPhaseConfig::default()
             })
         });
-        let mut baseline = BroadPhase::new(BroadPhaseConfig {
-            isa: Isa::Baseline,
-            ..BroadPhaseConfig::default()
-        });
-        g.bench_with_input(BenchmarkId::new("contacts_aabb_baseline", n), &n, |b, _| {
-            b.iter_custom(|iters| {
-                ticks(&mut scene, iters, |s| {
-                    baseline.update_dynamic(&s.boxes);
-                    baseline.contacts_aabb(&mut out);
-                    out.len()
+        for (name, bp) in ["contacts_aabb", "contacts_aabb_baseline"]
+            .into_iter()
+            .zip(&mut bps)
+        {
+            g.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
+                b.iter_custom(|iters| {
+                    ticks(&mut scene, iters, |s| {
+                        bp.update_dynamic(&s.boxes);
+                        bp.contacts_aabb(&mut out);
+                        out.len()
+                    })
                 })
-            })
-        });
+            });
+        }
+        let [bp, _] = &mut bps;
         let mut pairs = Vec::new();
         g.bench_with_input(BenchmarkId::new("find_pairs", n), &n, |b, _| {
             b.iter_custom(|iters| {
