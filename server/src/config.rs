@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use clap::Parser;
-use ledge_shared::protocol::{MAX_LEVEL_BUNDLE, MAX_ROOMS};
+use ledge_shared::protocol::{VoteRule, MAX_LEVEL_BUNDLE, MAX_ROOMS};
 use serde::Deserialize;
 
 use ledge_shared::game::{GameConfig, MAX_RESPAWN_DELAY_TICKS};
@@ -117,11 +117,15 @@ pub struct ServerConfig {
     pub bind: SocketAddr,
     /// Where the certificate and key are kept (created if missing).
     pub cert_dir: PathBuf,
-    /// Level file to play; `None`: the embedded default level.
-    pub level: Option<PathBuf>,
+    /// The levels to play in turn: level files, folders of them,
+    /// playlists (`.txt`) or Tiled worlds (`.world`); none: the embedded
+    /// default level ([`crate::levels::LevelSet::load`]).
+    pub levels: Vec<PathBuf>,
     /// The level's settings file (`None`: `LEVEL.ledge.toml` beside the
-    /// level, when there is one).
+    /// level, when there is one); only with a single level.
     pub level_settings: Option<PathBuf>,
+    /// When a room moves to the next level, and how players vote.
+    pub rotation: RotationConfig,
     /// Simulation ticks per second.
     pub tick_rate: u32,
     /// Snapshots per second (rounded to a whole number of ticks between
@@ -235,8 +239,9 @@ impl Default for ServerConfig {
         ServerConfig {
             bind: DEFAULT_BIND.parse().expect("valid default address"),
             cert_dir: PathBuf::from(DEFAULT_CERT_DIR),
-            level: None,
+            levels: Vec::new(),
             level_settings: None,
+            rotation: RotationConfig::default(),
             tick_rate: DEFAULT_TICK_RATE,
             snapshot_rate: DEFAULT_SNAPSHOT_RATE,
             max_players: DEFAULT_MAX_PLAYERS,
@@ -444,9 +449,26 @@ pub struct Cli {
     /// 0.0.0.0:4433].
     #[arg(long, value_name = "ADDR:PORT", value_parser = parse_bind)]
     pub bind: Option<SocketAddr>,
-    /// Level file to play [default: the embedded default level].
+    /// Level to play: a level file (OGMO .json, Tiled .tmx), a folder of
+    /// them, a playlist (.txt, a path per line) or a Tiled .world;
+    /// repeated, the rooms play them in turn [default: the embedded
+    /// default level].
     #[arg(long, value_name = "PATH")]
-    pub level: Option<PathBuf>,
+    pub level: Vec<PathBuf>,
+    /// With several levels, a room moves to the next one this many
+    /// seconds after the level started, finished or not (0: only when
+    /// everyone finished or by vote) [default: 300].
+    #[arg(long, value_name = "SECS")]
+    pub level_time: Option<f64>,
+    /// Seconds between everyone finishing (or a vote's majority) and the
+    /// move to the next level, for the results [default: 8].
+    #[arg(long, value_name = "SECS")]
+    pub results_time: Option<f64>,
+    /// How players choose the next level: majority (more than half of a
+    /// room's players), host (the room's longest-present player decides)
+    /// or off (the levels come in turn) [default: majority].
+    #[arg(long, value_name = "RULE", value_parser = parse_vote)]
+    pub vote: Option<VoteRule>,
     /// The level's settings file [default: LEVEL.ledge.toml beside the
     /// level, when there is one].
     #[arg(long, value_name = "PATH")]
@@ -571,13 +593,69 @@ pub struct Cli {
     pub web_address_mbps: Option<f64>,
 }
 
+/// When a room moves to its next level and how players vote
+/// ([`crate::rotation`]). Only a server with several levels moves on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RotationConfig {
+    /// A level is played at most this long (`None`: until everyone
+    /// finished, or a vote).
+    pub level_time: Option<Duration>,
+    /// The pause between the decision (everyone finished, a majority)
+    /// and the change, for the results card.
+    pub results_time: Duration,
+    /// How votes count.
+    pub vote: VoteRule,
+}
+
+impl Default for RotationConfig {
+    fn default() -> RotationConfig {
+        RotationConfig {
+            level_time: Some(Duration::from_secs(300)),
+            results_time: Duration::from_secs(8),
+            vote: VoteRule::Majority,
+        }
+    }
+}
+
+/// `--vote`'s values.
+fn parse_vote(s: &str) -> Result<VoteRule, String> {
+    [VoteRule::Majority, VoteRule::Host, VoteRule::Off]
+        .into_iter()
+        .find(|r| r.name() == s)
+        .ok_or_else(|| format!("{s:?} is not a vote rule: majority, host or off"))
+}
+
+/// A TOML value that is one path or a list of them (`level`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+enum OneOrMany {
+    One(PathBuf),
+    Many(Vec<PathBuf>),
+}
+
+impl OneOrMany {
+    fn into_vec(self) -> Vec<PathBuf> {
+        match self {
+            OneOrMany::One(p) => vec![p],
+            OneOrMany::Many(v) => v,
+        }
+    }
+}
+
 /// The TOML file: every key optional.
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FileConfig {
     /// As `--bind`: ADDR:PORT, HOST:PORT or PORT.
     bind: Option<String>,
-    level: Option<PathBuf>,
+    /// A path, or a list of them.
+    level: Option<OneOrMany>,
+    /// Seconds.
+    level_time: Option<f64>,
+    /// Seconds.
+    results_time: Option<f64>,
+    /// As `--vote`.
+    vote: Option<String>,
     level_settings: Option<PathBuf>,
     tick_rate: Option<u32>,
     snapshot_rate: Option<u32>,
@@ -710,6 +788,31 @@ impl Cli {
         }
     }
 
+    /// The rotation's times and vote rule: the file's, then the flags'.
+    fn resolve_rotation(
+        &self,
+        file: &FileConfig,
+        r: &mut RotationConfig,
+    ) -> Result<(), ConfigError> {
+        if let Some(secs) = self.level_time.or(file.level_time) {
+            r.level_time = (secs != 0.0)
+                .then(|| seconds(secs, "level_time"))
+                .transpose()?;
+        }
+        if let Some(secs) = self.results_time.or(file.results_time) {
+            r.results_time = seconds(secs, "results_time")?;
+        }
+        if let Some(rule) = self.vote {
+            r.vote = rule;
+        } else if let Some(rule) = &file.vote {
+            r.vote = parse_vote(rule).map_err(|message| ConfigError::Parse {
+                path: self.config.clone().unwrap_or_default(),
+                message: format!("vote: {message}"),
+            })?;
+        }
+        Ok(())
+    }
+
     /// The configuration: defaults, then the file (if any), then the flags.
     pub fn resolve(&self) -> Result<ServerConfig, ConfigError> {
         let file = match &self.config {
@@ -736,7 +839,10 @@ impl Cli {
                 message: format!("bind: {message}"),
             })?;
         }
-        set(&mut c.level, file.level.map(|p| Some(relative(p))));
+        if let Some(levels) = file.level.clone() {
+            c.levels = levels.into_vec().into_iter().map(relative).collect();
+        }
+        self.resolve_rotation(&file, &mut c.rotation)?;
         set(
             &mut c.level_settings,
             file.level_settings.map(|p| Some(relative(p))),
@@ -784,7 +890,9 @@ impl Cli {
         }
         // Flags win.
         set(&mut c.bind, self.bind);
-        set(&mut c.level, self.level.clone().map(Some));
+        if !self.level.is_empty() {
+            c.levels.clone_from(&self.level);
+        }
         set(&mut c.level_settings, self.level_settings.clone().map(Some));
         set(&mut c.tick_rate, self.tick_rate);
         set(&mut c.snapshot_rate, self.snapshot_rate);
@@ -922,7 +1030,7 @@ mod tests {
         assert_eq!(c.bind, "0.0.0.0:4433".parse().unwrap());
         assert_eq!((c.tick_rate, c.snapshot_rate), (60, 30));
         assert_eq!(c.snapshot_interval(), 2);
-        assert_eq!(c.level, None);
+        assert!(c.levels.is_empty());
         assert_eq!(c.metrics_bind, None);
         assert_eq!(c.threads, None, "one thread per core unless told");
     }
@@ -989,7 +1097,7 @@ datagrams_per_second = 500.0
         assert_eq!(c.snapshot_interval(), 6);
         assert_eq!((c.max_players, c.rooms), (4, 3));
         assert_eq!(c.cert_dir, dir.path().join("my-certs"));
-        assert_eq!(c.level, Some(dir.path().join("levels/one.json")));
+        assert_eq!(c.levels, vec![dir.path().join("levels/one.json")]);
         assert_eq!(c.metrics_bind, Some("127.0.0.1:9100".parse().unwrap()));
         assert_eq!(c.idle_timeout, Duration::from_millis(2500));
         assert_eq!(c.threads, Some(1));

@@ -743,7 +743,8 @@ impl Client<'_> {
                     }
                 }
                 ClientControl::Leave => return Err(Ending::Left),
-                ClientControl::GetLevel { offset } => self.send_level(offset)?,
+                ClientControl::GetLevel { offset, sha256 } => self.send_level(offset, &sha256)?,
+                ClientControl::Vote { level } => self.room.vote(self.player_id, level),
             }
         }
         Ok(())
@@ -752,8 +753,13 @@ impl Client<'_> {
     /// Starts sending the level bundle from `offset` on a stream of its own
     /// (so the control stream is never stuck behind it); one download at a
     /// time, at most [`MAX_LEVEL_DOWNLOADS`] per connection.
-    fn send_level(&mut self, offset: u64) -> Result<(), Ending> {
-        let bundle = self.shared.level_bundle.clone();
+    fn send_level(&mut self, offset: u64, sha256: &[u8; 32]) -> Result<(), Ending> {
+        let Some(level) = self.shared.levels.by_sha256(sha256) else {
+            return Err(Ending::malformed(
+                "asked for a level this server does not play".into(),
+            ));
+        };
+        let bundle = level.bundle.clone();
         let Some(rest) = usize::try_from(offset)
             .ok()
             .and_then(|at| bundle.get(at..).map(<[u8]>::len))

@@ -65,6 +65,7 @@ pub mod replays;
 pub mod room;
 pub mod room_logic;
 pub mod room_registry;
+pub mod rotation;
 pub mod server;
 pub mod sessions;
 pub mod shared;

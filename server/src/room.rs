@@ -99,6 +99,10 @@ enum Command {
         from: PlayerId,
         text: String,
     },
+    Vote {
+        from: PlayerId,
+        level: u32,
+    },
 }
 
 /// A cheap, cloneable way to talk to a running room. The room stops when
@@ -191,6 +195,11 @@ impl RoomHandle {
     /// Relays a chat line to everyone in the room.
     pub fn chat(&self, from: PlayerId, text: String) {
         let _ = self.commands.send(Command::Chat { from, text });
+    }
+
+    /// Records a player's vote for the next level.
+    pub fn vote(&self, from: PlayerId, level: u32) {
+        let _ = self.commands.send(Command::Vote { from, level });
     }
 
     /// The latest published status.
@@ -432,7 +441,7 @@ impl Room {
                 };
                 if answer.is_ok() {
                     if !spectate {
-                        self.send_ghosts(&link.control, name);
+                        Room::send_ghosts(self.logic.config(), &link.control, name);
                     }
                     self.peers.insert(player_id, Peer::new(link));
                     self.sync_players();
@@ -463,6 +472,10 @@ impl Room {
             } => self.rejoin(player_id, link, reply),
             Command::Chat { from, text } => {
                 self.logic.chat(from, text);
+                self.carry_out(Instant::now());
+            }
+            Command::Vote { from, level } => {
+                self.logic.vote(from, level);
                 self.carry_out(Instant::now());
             }
         }
@@ -557,6 +570,11 @@ impl Room {
                     self.peers.remove(&id);
                 }
                 Action::SaveReplay(replay) => self.logic.config().replays.save(*replay),
+                Action::FindGhosts { to, name } => {
+                    if let Some(peer) = self.peers.get(&to) {
+                        Room::send_ghosts(self.logic.config(), &peer.link.control, name);
+                    }
+                }
                 Action::RunFinished { to, mut run } => {
                     run.finished_at_ms = crate::records::unix_millis();
                     let control = self.peers.get(&to).map(|p| p.link.control.clone());
@@ -575,8 +593,7 @@ impl Room {
 
     /// Sends a new player the runs to race against (the record, its own
     /// best), read off the room's thread, when records and replays are on.
-    fn send_ghosts(&self, control: &mpsc::Sender<Outbound>, name: String) {
-        let config = self.logic.config();
+    fn send_ghosts(config: &RoomConfig, control: &mpsc::Sender<Outbound>, name: String) {
         let (Some(store), Some(dir)) = (config.records.store(), config.replays.dir()) else {
             return;
         };

@@ -32,18 +32,21 @@ use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
     clip_text, encode_sim_config, name_key, write_frame, InputPacket, LevelOffer, NetTiming,
     NoticeKind, Outgoing, PlayerId, RejectReason, RosterEntry, ServerControl, SessionToken,
-    Snapshot, Welcome, MAX_ROSTER,
+    Snapshot, Welcome, MAX_REASON_LEN, MAX_ROSTER,
 };
 use ledge_shared::replay::{ReplayHeader, MAX_LEVEL_NAME_LEN};
 use prometheus_client::metrics::counter::Counter;
 use tracing::{error, info, warn};
 
+use crate::config::RotationConfig;
 use crate::inputs::{InputBuffer, Received};
+use crate::levels::LevelSet;
 use crate::metrics::{DropReason, KickLabel, KickReason, Metrics, RoomLabel, SnapshotKind};
 use crate::record::Recorder;
 use crate::records::{FinishedRun, RecordsHandle};
 use crate::replays::recording::ToSave;
 use crate::replays::{MatchRecording, ReplaysHandle};
+use crate::rotation::Rotation;
 use crate::snapshots::RoomSnapshots;
 use crate::tls::DATAGRAM_SEND_BUFFER;
 
@@ -97,6 +100,11 @@ pub struct RoomConfig {
     pub replays: ReplaysHandle,
     /// Most spectators at once (they take no player's place).
     pub max_spectators: usize,
+    /// The levels the room plays in turn (`level_id`, `level_hash` and
+    /// `level` above are the current one's).
+    pub levels: LevelSet,
+    /// When the room moves to its next level, and how players vote.
+    pub rotation: RotationConfig,
 }
 
 /// The room's progress, published after every tick.
@@ -108,6 +116,8 @@ pub struct RoomStatus {
     pub state_hash: u64,
     /// Players currently in the room.
     pub players: usize,
+    /// The level being played (an index into [`RoomConfig::levels`]).
+    pub level: usize,
 }
 
 /// Inputs and acknowledgements of one client, written by its connection
@@ -237,6 +247,14 @@ pub enum Action {
     },
     /// Save a replay (a run's, or a match's).
     SaveReplay(Box<ToSave>),
+    /// The room moved to another level: send player `to` (named `name`)
+    /// the new level's ghosts.
+    FindGhosts {
+        /// The player.
+        to: PlayerId,
+        /// Its name (records go by name).
+        name: String,
+    },
 }
 
 /// A player in the room.
@@ -264,6 +282,10 @@ struct Member {
     attached: bool,
     /// Watching, with no body in the game.
     spectator: bool,
+    /// After a level change at this tick: snapshots go on the control
+    /// stream (after the `LevelChange`, so never before it) until the
+    /// client acknowledges one of this tick or later.
+    stream_until: Option<u64>,
 }
 
 impl Member {
@@ -280,6 +302,7 @@ impl Member {
         self.packets_seen = 0;
         self.packets_at_snapshot = 0;
         self.last_snapshot = None;
+        self.stream_until = None;
     }
 
     /// The acknowledged baseline and the timing to report in a snapshot
@@ -318,6 +341,8 @@ pub struct RoomLogic {
     actions: Vec<Action>,
     /// The match, while anyone is in the room (replays on).
     recording: Option<MatchRecording>,
+    /// Which level, which next, the votes.
+    rotation: Rotation,
 }
 
 impl RoomLogic {
@@ -331,7 +356,14 @@ impl RoomLogic {
             .replays
             .is_on()
             .then(|| MatchRecording::new(replay_header(&game, &config), config.instance.clone()));
+        let rotation = Rotation::new(
+            config.levels.choices(),
+            &config.rotation,
+            config.tick_rate,
+            game.tick(),
+        );
         RoomLogic {
+            rotation,
             recording,
             starvation: metrics.input_starvation.get_or_create_owned(&label),
             snapshots: RoomSnapshots::new(config.history),
@@ -370,6 +402,7 @@ impl RoomLogic {
             tick: self.game.tick(),
             state_hash: self.game.state_hash(),
             players: self.players(),
+            level: self.rotation.current(),
         }
     }
 
@@ -423,6 +456,7 @@ impl RoomLogic {
         info!(room = %self.config.name, spectator = %id, %name, "spectator joined");
         let joined = self.add_member(id, name, true);
         self.send_roster(id);
+        self.send_levels(id);
         Ok(joined)
     }
 
@@ -459,6 +493,7 @@ impl RoomLogic {
             packets_at_snapshot: 0,
             last_snapshot: None,
             spectator,
+            stream_until: None,
         };
         self.members.insert(id, member);
         Joined {
@@ -512,6 +547,7 @@ impl RoomLogic {
         info!(room = %self.config.name, %player_id, generation, tick, "player resumed");
         // The room as it is now: who joined and left meanwhile.
         self.send_roster(player_id);
+        self.send_levels(player_id);
         Some(Resumed {
             joined: Joined {
                 welcome: self.welcome(player_id, tick),
@@ -554,6 +590,141 @@ impl RoomLogic {
         self.broadcast(&ServerControl::Chat { from, text });
     }
 
+    /// Records a player's vote for the next level and tells everyone the
+    /// new counts; a spectator's vote, or one the rotation refuses, is
+    /// answered with why.
+    pub fn vote(&mut self, from: PlayerId, level: u32) {
+        let refused = match self.members.get(&from) {
+            None => return,
+            Some(m) if m.spectator => {
+                Err("spectators cannot vote: join as a player to choose the next level".into())
+            }
+            Some(_) => self.rotation.vote(from, level),
+        };
+        match refused {
+            Ok(true) => self.broadcast_levels(),
+            Ok(false) => {}
+            Err(text) => {
+                let text = clip_text(&text, MAX_REASON_LEN);
+                let notice = NoticeKind::Info { text };
+                self.send_control(from, &ServerControl::Notice { kind: notice });
+            }
+        }
+    }
+
+    /// The level being played (an index into [`RoomConfig::levels`]).
+    pub fn level_index(&self) -> usize {
+        self.rotation.current()
+    }
+
+    /// Runs the rotation for the tick just stepped: tells everyone when
+    /// its plan changes, and moves to the next level when it says so.
+    fn rotate(&mut self) {
+        if !self.rotation.is_on() {
+            return;
+        }
+        let players = self.finished();
+        let step = self.rotation.tick(self.game.tick(), &players);
+        match step.change_to {
+            Some(level) => self.change_level(level),
+            None if step.changed => self.broadcast_levels(),
+            None => {}
+        }
+    }
+
+    /// The players by id, each with whether it finished the level.
+    fn finished(&self) -> Vec<(PlayerId, bool)> {
+        self.members
+            .iter()
+            .filter(|(_, m)| !m.spectator)
+            .map(|(&id, _)| {
+                let done = self.game.player(id).is_some_and(|v| v.place.is_some());
+                (id, done)
+            })
+            .collect()
+    }
+
+    /// Moves the room to level `index` of its rotation: the match so far is
+    /// saved, a fresh game of the new level continues the tick count with
+    /// every player in it again (respawned, run timers reset), and each
+    /// member gets a [`ServerControl::LevelChange`], its snapshots on the
+    /// control stream until it acknowledges one of the new level, the new
+    /// list and (players) the new level's ghosts.
+    pub fn change_level(&mut self, index: usize) {
+        let tick = self.game.tick();
+        if let Some(done) = self.recording.as_mut().and_then(|r| r.end(&self.game)) {
+            self.actions.push(Action::SaveReplay(Box::new(done)));
+        }
+        let level = self.config.levels.get(index).clone();
+        let mut game = level.game;
+        game.start_at(tick);
+        self.config.level_id = level.id;
+        self.config.level_hash = level.hash;
+        self.config.level = level.offer;
+        if self.config.record.take().is_some() {
+            info!(room = %self.config.name, "the match record stops at the level change");
+        }
+        self.game = game;
+        self.recording = self.config.replays.is_on().then(|| {
+            MatchRecording::new(
+                replay_header(&self.game, &self.config),
+                self.config.instance.clone(),
+            )
+        });
+        let players: Vec<(PlayerId, String)> = names(&self.members)
+            .map(|(id, name)| (id, name.to_owned()))
+            .collect();
+        for (id, name) in &players {
+            if let Some(r) = &mut self.recording {
+                // The game is empty before the first: nobody to name.
+                r.before_join(&self.game, std::iter::empty());
+            }
+            if let Err(e) = self.game.add_player(*id) {
+                error!(room = %self.config.name, player = %id, "the new level refused a player: {e}");
+            } else if let Some(r) = &mut self.recording {
+                r.joined(*id, name);
+            }
+        }
+        self.snapshots = RoomSnapshots::new(self.config.history);
+        self.rotation.changed_to(index, tick);
+        let ids: Vec<PlayerId> = self.members.keys().copied().collect();
+        for id in ids {
+            let welcome = self.welcome(id, tick);
+            if let Some(m) = self.members.get_mut(&id) {
+                m.last_snapshot = None;
+                m.stream_pending = None;
+                m.stream_until = Some(tick);
+                lock(&m.inbox).ack = None;
+                if !m.spectator {
+                    let name = m.name.clone();
+                    self.actions.push(Action::FindGhosts { to: id, name });
+                }
+            }
+            self.send_control(id, &ServerControl::LevelChange(welcome));
+        }
+        self.broadcast_levels();
+        info!(room = %self.config.name, level = %self.config.level_id, tick, "moved to the next level");
+    }
+
+    /// Queues the rotation's list for member `id` (none when the room
+    /// plays one level: there is nothing to choose).
+    fn send_levels(&mut self, id: PlayerId) {
+        if !self.rotation.is_on() {
+            return;
+        }
+        let list = self.rotation.list(&self.finished());
+        self.send_control(id, &ServerControl::Levels(list));
+    }
+
+    /// Queues the rotation's list for every member.
+    fn broadcast_levels(&mut self) {
+        if !self.rotation.is_on() {
+            return;
+        }
+        let list = self.rotation.list(&self.finished());
+        self.broadcast(&ServerControl::Levels(list));
+    }
+
     /// Runs one tick at `now`. `datagram_size` is a player's connection's
     /// largest datagram now (`None`: datagrams unavailable).
     pub fn tick(&mut self, now: Instant, datagram_size: impl Fn(PlayerId) -> Option<usize>) {
@@ -567,6 +738,7 @@ impl RoomLogic {
             }
         }
         self.collect_finished(tick);
+        self.rotate();
         if let Some(r) = &self.config.record {
             r.tick(tick, &self.inputs, || self.game.state_hash());
         }
@@ -718,6 +890,9 @@ impl RoomLogic {
             }
             info!(room = %self.config.name, %player_id, name = %member.name, "player left");
             self.broadcast(&ServerControl::PlayerLeft { id: player_id });
+            if self.rotation.left(player_id) {
+                self.broadcast_levels();
+            }
             self.actions.push(Action::Left(player_id));
         }
     }
@@ -785,6 +960,12 @@ impl RoomLogic {
                     m.stream_pending = None;
                 }
             }
+            // After a level change, an acknowledgement of the old level's
+            // ticks names no baseline: full snapshots on the stream until
+            // one of the new level is acknowledged.
+            let changed_at = m.stream_until.filter(|&at| ack.is_none_or(|a| a < at));
+            m.stream_until = changed_at;
+            let ack = ack.filter(|_| changed_at.is_none());
             let encoded = self
                 .snapshots
                 .encode_for(ack, m.last_snapshot, m.last_applied, timing);
@@ -796,7 +977,9 @@ impl RoomLogic {
                 }
             };
             let kind = snapshot_kind(&snapshot);
-            let max = datagram_size(id).map(|max| max.min(DATAGRAM_SEND_BUFFER / 2));
+            let max = datagram_size(id)
+                .filter(|_| changed_at.is_none())
+                .map(|max| max.min(DATAGRAM_SEND_BUFFER / 2));
             let outgoing = match snapshot.into_outgoing(max) {
                 Ok(o) => o,
                 Err(e) => {
@@ -825,6 +1008,7 @@ impl RoomLogic {
     /// joined.
     fn announce_join(&mut self, id: PlayerId) {
         self.send_roster(id);
+        self.send_levels(id);
         let Some(joined) = self.members.get_key_value(&id).map(roster_entry) else {
             return;
         };
@@ -945,6 +1129,8 @@ mod tests {
             records: RecordsHandle::default(),
             replays: Default::default(),
             max_spectators: 2,
+            levels: crate::levels::LevelSet::load(&[], None, Default::default(), 32).unwrap(),
+            rotation: Default::default(),
         }
     }
 
@@ -1540,5 +1726,197 @@ mod tests {
         room.leave(sam, 0);
         assert_eq!(actions(&mut room), [Action::Left(sam)]);
         assert_eq!(room.spectators(), 1);
+    }
+}
+
+#[cfg(test)]
+mod level_change_tests {
+    use std::path::PathBuf;
+
+    use ledge_shared::protocol::{decode_sim_config, FrameDecoder, Message, VoteRule};
+
+    use super::*;
+    use crate::metrics::Metrics;
+
+    /// The default level, and a copy of it named `second` (another
+    /// content hash, the same route).
+    pub(crate) fn two_levels(dir: &std::path::Path) -> Vec<PathBuf> {
+        let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../levels/default");
+        std::fs::copy(format!("{src}/ledge.ogmo"), dir.join("ledge.ogmo")).unwrap();
+        let second = dir.join("second.json");
+        std::fs::copy(format!("{src}/default.json"), &second).unwrap();
+        vec![PathBuf::from(format!("{src}/default.json")), second]
+    }
+
+    fn room(dir: &std::path::Path, rule: VoteRule) -> RoomLogic {
+        room_of(
+            LevelSet::load(&two_levels(dir), None, Default::default(), 32).unwrap(),
+            rule,
+        )
+    }
+
+    fn room_of(levels: LevelSet, rule: VoteRule) -> RoomLogic {
+        let first = levels.get(0).clone();
+        let config = RoomConfig {
+            name: "test".into(),
+            tick_rate: 60,
+            snapshot_interval: 2,
+            max_players: 4,
+            max_catch_up: 15,
+            input_window: 64,
+            input_redundancy: 16,
+            history: 64,
+            level_id: first.id.clone(),
+            level_hash: first.hash,
+            level: first.offer,
+            record: None,
+            idle_kick: Duration::from_secs(30),
+            instance: "test".into(),
+            records: RecordsHandle::default(),
+            replays: Default::default(),
+            max_spectators: 2,
+            levels,
+            rotation: RotationConfig {
+                level_time: None,
+                results_time: Duration::from_secs(1),
+                vote: rule,
+            },
+        };
+        let (metrics, _registry) = Metrics::new();
+        RoomLogic::new(first.game, config, metrics)
+    }
+
+    /// The control messages in `actions` for `to`.
+    fn controls(actions: &[Action], to: PlayerId) -> Vec<ServerControl> {
+        let mut decoder = FrameDecoder::new(ledge_shared::protocol::MAX_FRAME);
+        for a in actions {
+            if let Action::Control { to: t, frame } = a {
+                if *t == to {
+                    decoder.push(frame).unwrap();
+                }
+            }
+        }
+        std::iter::from_fn(|| decoder.pop())
+            .map(|f| ServerControl::decode(&f).unwrap())
+            .collect()
+    }
+
+    fn step(room: &mut RoomLogic, n: u64, t0: Instant) -> Vec<Action> {
+        let mut all = Vec::new();
+        for _ in 0..n {
+            room.tick(t0 + Duration::from_millis(16 * room.game().tick()), |_| {
+                Some(1200)
+            });
+            room.take_actions(&mut all);
+        }
+        all
+    }
+
+    #[test]
+    fn a_majority_vote_moves_the_room_to_the_next_level_ticks_going_on() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut room = room(dir.path(), VoteRule::Majority);
+        let t0 = Instant::now();
+        let ann = room.join(PlayerId(1), "ann".into()).unwrap();
+        let watcher = room.spectate(PlayerId(2), "eve".into()).unwrap();
+        let mut joined = Vec::new();
+        room.take_actions(&mut joined);
+        let listed = controls(&joined, PlayerId(1));
+        let Some(ServerControl::Levels(list)) = listed.last() else {
+            panic!("no level list after the roster: {listed:?}");
+        };
+        assert_eq!((list.current, list.next, list.change_at), (0, 1, None));
+        assert_eq!(list.levels[1].id, "second");
+        step(&mut room, 30, t0);
+
+        // The spectator may not vote; ann's vote is a majority of one.
+        room.vote(PlayerId(2), 1);
+        room.vote(PlayerId(1), 1);
+        let mut voted = Vec::new();
+        room.take_actions(&mut voted);
+        assert!(matches!(
+            &controls(&voted, PlayerId(2))[0],
+            ServerControl::Notice { .. }
+        ));
+        let before = step(&mut room, 1, t0);
+        let Some(ServerControl::Levels(list)) = controls(&before, PlayerId(1)).pop() else {
+            panic!("the vote's decision not announced");
+        };
+        let at = list.change_at.expect("a change planned");
+        assert_eq!(list.votes, vec![0, 1]);
+        assert_eq!(at, 31 + 60, "one second of results after the vote's tick");
+        assert_eq!(room.level_index(), 0);
+
+        let left = at - room.game().tick();
+        let until = step(&mut room, left, t0);
+        assert_eq!(room.level_index(), 1);
+        assert_eq!(room.game().tick(), at, "the tick count goes on");
+        for who in [PlayerId(1), PlayerId(2)] {
+            let got = controls(&until, who);
+            let change = got.iter().find_map(|m| match m {
+                ServerControl::LevelChange(w) => Some(w.clone()),
+                _ => None,
+            });
+            let w = change.expect("a LevelChange");
+            assert_eq!(
+                (w.player_id, w.level_id.as_str(), w.server_tick),
+                (who, "second", at)
+            );
+            assert_eq!(w.level, room.config().levels.get(1).offer);
+            assert!(decode_sim_config::<ledge_shared::game::GameConfig>(&w.sim_config).is_ok());
+        }
+        assert!(
+            room.game().player(PlayerId(1)).is_some(),
+            "ann is in the new level"
+        );
+        assert!(
+            room.game().player(PlayerId(2)).is_none(),
+            "the spectator has no body"
+        );
+
+        // New-level snapshots go on the stream until one is acknowledged.
+        let after = step(&mut room, 4, t0);
+        let sent: Vec<(u64, bool)> = after
+            .iter()
+            .filter_map(|a| match a {
+                Action::Snapshot {
+                    to, tick, outgoing, ..
+                } if *to == PlayerId(1) => Some((*tick, matches!(outgoing, Outgoing::Datagram(_)))),
+                _ => None,
+            })
+            .collect();
+        assert!(
+            !sent.is_empty() && sent.iter().all(|&(t, dgram)| t > at && !dgram),
+            "{sent:?}"
+        );
+        room.stream_queued(PlayerId(1), sent[0].0, t0);
+        // An old level's acknowledgement changes nothing; a new one does.
+        lock(&ann.inbox).ack = Some(at - 2);
+        let old_ack = step(&mut room, 2, t0);
+        assert!(old_ack.iter().all(|a| !matches!(a, Action::Snapshot { to, outgoing: Outgoing::Datagram(_), .. } if *to == PlayerId(1))));
+        lock(&ann.inbox).ack = Some(sent[0].0);
+        let acked = step(&mut room, 2, t0);
+        assert!(acked.iter().any(|a| matches!(a, Action::Snapshot { to, outgoing: Outgoing::Datagram(_), .. } if *to == PlayerId(1))), "datagrams again once acknowledged");
+        drop(watcher);
+    }
+
+    #[test]
+    fn one_level_sends_no_list_and_refuses_votes() {
+        let levels = LevelSet::load(&[], None, Default::default(), 32).unwrap();
+        let mut room = room_of(levels, VoteRule::Majority);
+        room.join(PlayerId(1), "ann".into()).unwrap();
+        let mut joined = Vec::new();
+        room.take_actions(&mut joined);
+        assert!(!controls(&joined, PlayerId(1))
+            .iter()
+            .any(|m| matches!(m, ServerControl::Levels(_))));
+        room.vote(PlayerId(1), 0);
+        let mut voted = Vec::new();
+        room.take_actions(&mut voted);
+        let refused = controls(&voted, PlayerId(1));
+        assert!(
+            matches!(&refused[..], [ServerControl::Notice { kind: NoticeKind::Info { text } }] if text.contains("one level")),
+            "{refused:?}"
+        );
     }
 }

@@ -113,7 +113,7 @@ impl Rooms {
             .iter()
             .map(|e| RoomInfo {
                 name: e.handle.name().to_owned(),
-                level_id: self.template.level_id.clone(),
+                level_id: self.template.levels.get(e.handle.status().level).id.clone(),
                 players: u32::try_from(e.handle.players()).unwrap_or(u32::MAX),
                 capacity: u32::try_from(self.template.max_players).unwrap_or(u32::MAX),
             })
@@ -239,6 +239,8 @@ mod tests {
             records: Default::default(),
             replays: Default::default(),
             max_spectators: 2,
+            levels: crate::levels::LevelSet::load(&[], None, Default::default(), 32).unwrap(),
+            rotation: Default::default(),
         };
         let (metrics, _registry) = Metrics::new();
         Rooms::new(game, template, max_rooms, metrics)

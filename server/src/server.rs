@@ -7,8 +7,7 @@ use std::sync::atomic::AtomicU32;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use ledge_levels::LevelBundle;
-use ledge_shared::game::{Game, GameError};
+use ledge_shared::game::GameError;
 use ledge_shared::level::Level;
 use ledge_shared::protocol::{CloseCode, LevelOffer, DEFAULT_INPUT_REDUNDANCY};
 use prometheus_client::registry::Registry;
@@ -21,7 +20,7 @@ use crate::admission::{Admission, Refusal, Ticket, Verdict};
 use crate::config::{ConfigError, ServerConfig, WebConfig};
 use crate::connection::{self, SHUTDOWN_LINGER};
 use crate::fingerprint::Fingerprint;
-use crate::levels::{self, LevelLoadError};
+use crate::levels::{self, LevelLoadError, LevelSet};
 use crate::link::Incoming;
 use crate::metrics::{self, Metrics};
 use crate::quic_cert::{CertError, Identity};
@@ -70,18 +69,6 @@ pub enum ServerError {
     /// The TLS/QUIC configuration was refused.
     #[error(transparent)]
     Tls(#[from] TlsError),
-    /// The level, with its art, is bigger than clients may download.
-    #[error(
-        "the level and its images are {size} bytes once encoded for clients, more than \
-         the server's limit of {max_mib} MiB: raise --max-level-mib (at most 96), or use \
-         fewer or smaller images"
-    )]
-    LevelTooLarge {
-        /// The bundle's size, bytes.
-        size: u64,
-        /// The limit, MiB.
-        max_mib: u64,
-    },
     /// The web page's directory cannot be served (`--web-root`).
     #[error("--web-root {0}")]
     WebRoot(#[from] WebRootError),
@@ -371,10 +358,8 @@ pub struct Server {
     local_addr: SocketAddr,
     fingerprint: Fingerprint,
     config: ServerConfig,
-    level: Level,
-    /// The level bundle clients download, and its name.
-    level_bundle: Arc<Vec<u8>>,
-    level_offer: LevelOffer,
+    /// The levels played, in rotation order.
+    levels: LevelSet,
     metrics: Arc<Metrics>,
     registry: Arc<Registry>,
     metrics_listener: Option<(tokio::net::TcpListener, SocketAddr)>,
@@ -400,16 +385,13 @@ impl Server {
                     .into(),
             ));
         }
-        let bundle = levels::load(config.level.as_deref(), config.level_settings.as_deref())?;
-        Game::with_config(&bundle.level, config.game_config())?;
-        let bundle_bytes = bundle.encode();
-        if bundle_bytes.len() as u64 > config.max_level_mib << 20 {
-            return Err(ServerError::LevelTooLarge {
-                size: bundle_bytes.len() as u64,
-                max_mib: config.max_level_mib,
-            });
-        }
-        let level = bundle.level;
+        let levels = LevelSet::load(
+            &config.levels,
+            config.level_settings.as_deref(),
+            config.game_config(),
+            config.max_level_mib,
+        )?;
+        let level = &levels.get(0).level;
         let identity = Identity::load_or_generate(&config.cert_dir)?;
         if identity.generated {
             info!(dir = %config.cert_dir.display(), "generated a new self-signed certificate");
@@ -427,7 +409,7 @@ impl Server {
         let (metrics, registry) = Metrics::new();
         let recorders = match config.record_ticks {
             Some(limit) => {
-                let (id, hash) = (levels::level_id(&level), level.content_hash());
+                let (id, hash) = (levels::level_id(level), level.content_hash());
                 (1..=config.rooms)
                     .map(|i| Recorder::new(&format!("room-{i}"), &id, hash, limit))
                     .collect()
@@ -439,9 +421,7 @@ impl Server {
             local_addr,
             fingerprint: identity.fingerprint,
             config,
-            level,
-            level_offer: LevelBundle::offer(&bundle_bytes),
-            level_bundle: Arc::new(bundle_bytes),
+            levels,
             metrics,
             registry: Arc::new(registry),
             metrics_listener,
@@ -496,14 +476,19 @@ impl Server {
         &self.config
     }
 
-    /// The level played.
+    /// The first level played.
     pub fn level(&self) -> &Level {
-        &self.level
+        &self.levels.get(0).level
     }
 
-    /// The level bundle clients download (hash and size).
+    /// The first level's bundle, as clients download it (hash and size).
     pub fn level_offer(&self) -> LevelOffer {
-        self.level_offer
+        self.levels.get(0).offer
+    }
+
+    /// Every level played, in rotation order.
+    pub fn levels(&self) -> &LevelSet {
+        &self.levels
     }
 
     /// The match record of room `room` (e.g. `room-1`), when recording is
@@ -526,9 +511,7 @@ impl Server {
             endpoint,
             local_addr,
             config,
-            level,
-            level_bundle,
-            level_offer,
+            levels,
             metrics,
             registry,
             metrics_listener,
@@ -544,8 +527,7 @@ impl Server {
         let replays_dir = replays.dir().map(Path::to_owned);
         let rooms = open_rooms(
             &config,
-            &level,
-            level_offer,
+            &levels,
             &recorders,
             metrics.clone(),
             (records.clone(), replays),
@@ -557,7 +539,7 @@ impl Server {
         let shared = Arc::new(Shared {
             rooms,
             sessions: Sessions::new(config.reconnect_grace),
-            level_bundle,
+            levels: levels.clone(),
             metrics,
             limits: config.limits,
             next_player: AtomicU32::new(1),
@@ -572,8 +554,9 @@ impl Server {
         let _ = fingerprint;
         info!(
             %local_addr,
-            level = %levels::level_id(&level),
-            level_bundle_bytes = level_offer.size,
+            level = %levels.get(0).id,
+            levels = levels.len(),
+            level_bundle_bytes = levels.get(0).offer.size,
             rooms = config.rooms,
             tick_rate = config.tick_rate,
             snapshot_interval = config.snapshot_interval(),
@@ -583,7 +566,7 @@ impl Server {
         // accept loop; WebTransport sessions are accepted there like QUIC
         // ones.
         let (accepted_tx, accepted) = mpsc::channel::<web::Accepted>(64);
-        let browsers = serve_browsers(web, &shared, level_offer, &config, accepted_tx, &stop);
+        let browsers = serve_browsers(web, &shared, &config, accepted_tx, &stop);
         let mut serving = Serving {
             endpoint,
             webtransport: browsers.webtransport,
@@ -747,8 +730,7 @@ fn open_replays(
 /// permanent ones (`room-1` ..), each with its recorder if recording.
 fn open_rooms(
     config: &ServerConfig,
-    level: &Level,
-    level_offer: LevelOffer,
+    levels: &LevelSet,
     recorders: &[Recorder],
     metrics: Arc<Metrics>,
     (records, replays): (RecordsHandle, ReplaysHandle),
@@ -763,9 +745,11 @@ fn open_rooms(
         input_window: config.tick_rate.max(32) as usize,
         input_redundancy: DEFAULT_INPUT_REDUNDANCY,
         history: DEFAULT_HISTORY,
-        level_id: levels::level_id(level),
-        level_hash: level.content_hash(),
-        level: level_offer,
+        level_id: levels.get(0).id.clone(),
+        level_hash: levels.get(0).hash,
+        level: levels.get(0).offer,
+        levels: levels.clone(),
+        rotation: config.rotation,
         record: None,
         idle_kick: config.idle_kick,
         instance: instance_id(),
@@ -773,7 +757,7 @@ fn open_rooms(
         replays,
     };
     let rooms = Rooms::new(
-        Game::with_config(level, config.game_config())?,
+        levels.get(0).game.clone(),
         template,
         config.max_rooms as usize,
         metrics,
@@ -824,7 +808,6 @@ struct Browsers {
 fn serve_browsers(
     web: Option<WebParts>,
     shared: &Arc<Shared>,
-    level_offer: LevelOffer,
     config: &ServerConfig,
     accepted: mpsc::Sender<web::Accepted>,
     stop: &watch::Receiver<bool>,
@@ -859,8 +842,8 @@ fn serve_browsers(
     let state = Arc::new(WebState {
         shared: shared.clone(),
         root: w.root,
-        level_hex: level_offer.hex(),
-        level: bytes::Bytes::from(Vec::clone(&shared.level_bundle)),
+        level_hex: shared.levels.get(0).offer.hex(),
+        level: shared.levels.get(0).bundle.clone(),
         webtransport: wt_port,
         accepted,
         idle_timeout: config.idle_timeout,

@@ -13,6 +13,7 @@ use tokio::sync::watch;
 
 use crate::admission::Admission;
 use crate::config::Limits;
+use crate::levels::LevelSet;
 use crate::metrics::Metrics;
 use crate::records::RecordsHandle;
 use crate::room_registry::Rooms;
@@ -25,9 +26,9 @@ pub struct Shared {
     pub rooms: Rooms,
     /// Sessions, for resuming a lost connection's player.
     pub sessions: Sessions,
-    /// The level bundle clients download
+    /// The levels played, whose bundles clients download
     /// ([`ClientControl::GetLevel`](ledge_shared::protocol::ClientControl::GetLevel)).
-    pub level_bundle: Arc<Vec<u8>>,
+    pub levels: LevelSet,
     /// Metrics.
     pub metrics: Arc<Metrics>,
     /// Per-client limits.

@@ -138,13 +138,16 @@ fn router(state: Arc<WebState>) -> Router {
         .route(
             "/levels/:hex",
             get(|s: State<Arc<WebState>>, Path(hex): Path<String>, request: Request| async move {
-                if hex.eq_ignore_ascii_case(&s.level_hex) {
-                    level(s, request).await
-                } else {
-                    text(
+                let found = s.shared.levels.levels().iter().find(|l| l.offer.hex().eq_ignore_ascii_case(&hex));
+                match found {
+                    Some(l) => {
+                        let etag = format!("\"{}\"", l.offer.hex());
+                        download(&s, &request, "application/octet-stream", &etag, l.bundle.clone())
+                    }
+                    None => text(
                         StatusCode::NOT_FOUND,
-                        format!("this server does not play level {hex} (GET /level is its level)\n"),
-                    )
+                        format!("this server does not play level {hex} (GET /level is its first level)\n"),
+                    ),
                 }
             }),
         )

@@ -630,6 +630,19 @@ impl Game {
         self.tick
     }
 
+    /// Sets the clock of a fresh game (no players, never stepped) to
+    /// `tick`, platforms placed for it: a room moving to another level
+    /// keeps counting its ticks, so no tick names two states. Refused
+    /// (`false`, nothing changed) once the game has players or has run.
+    pub fn start_at(&mut self, tick: u64) -> bool {
+        if !self.players.is_empty() || self.tick != 0 {
+            return false;
+        }
+        self.tick = tick;
+        self.place_platforms();
+        true
+    }
+
     /// The last step's events.
     pub fn events(&self) -> &[GameEvent] {
         &self.events

@@ -5,8 +5,10 @@ use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
+use super::bounded;
 use super::codec::{bytes, Message};
 use super::datagram::Snapshot;
+use super::rotation::{LevelList, MAX_LEVELS};
 use super::{ProtocolError, MAX_FRAME, PROTOCOL_VERSION};
 
 /// Longest player name, in bytes of UTF-8.
@@ -292,67 +294,19 @@ pub fn check_rooms(rooms: &[RoomInfo]) -> Result<(), ProtocolError> {
     })
 }
 
-/// Serde helpers for bounded lists ([`ServerControl::Roster`],
-/// [`ServerControl::Rooms`]): the list grows as entries arrive (never by
-/// the claimed length) and one entry more than the bound is an error at
-/// once, so a hostile count allocates nothing.
-mod bounded {
-    use std::marker::PhantomData;
+/// A roster of at most [`MAX_ROSTER`] entries, read without trusting its count.
+fn roster_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<RosterEntry>, D::Error> {
+    bounded::seq(d, MAX_ROSTER, "roster entries")
+}
 
-    use serde::de::{Deserialize, Error, SeqAccess, Visitor};
-    use serde::Deserializer;
+/// A top list of at most [`MAX_TOP`] runs, read without trusting its count.
+fn top_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<TopRun>, D::Error> {
+    bounded::seq(d, MAX_TOP, "top runs")
+}
 
-    use super::{RoomInfo, RosterEntry, TopRun, MAX_ROOMS, MAX_ROSTER, MAX_TOP};
-
-    struct Bounded<T> {
-        max: usize,
-        what: &'static str,
-        item: PhantomData<T>,
-    }
-
-    impl<'de, T: Deserialize<'de>> Visitor<'de> for Bounded<T> {
-        type Value = Vec<T>;
-        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            write!(f, "at most {} {}", self.max, self.what)
-        }
-        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
-            let mut v = Vec::new();
-            while let Some(entry) = seq.next_element()? {
-                if v.len() == self.max {
-                    return Err(A::Error::custom(format!(
-                        "more than {} {}",
-                        self.max, self.what
-                    )));
-                }
-                v.push(entry);
-            }
-            Ok(v)
-        }
-    }
-
-    pub fn roster<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<RosterEntry>, D::Error> {
-        d.deserialize_seq(Bounded {
-            max: MAX_ROSTER,
-            what: "roster entries",
-            item: PhantomData,
-        })
-    }
-
-    pub fn top<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<TopRun>, D::Error> {
-        d.deserialize_seq(Bounded {
-            max: MAX_TOP,
-            what: "top runs",
-            item: PhantomData,
-        })
-    }
-
-    pub fn rooms<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<RoomInfo>, D::Error> {
-        d.deserialize_seq(Bounded {
-            max: MAX_ROOMS,
-            what: "rooms",
-            item: PhantomData,
-        })
-    }
+/// A room list of at most [`MAX_ROOMS`] rooms, read without trusting its count.
+fn rooms_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<RoomInfo>, D::Error> {
+    bounded::seq(d, MAX_ROOMS, "rooms")
 }
 
 /// One player's best run on a level, as [`Standing::top`] lists it.
@@ -380,7 +334,7 @@ pub struct Standing {
     /// first).
     pub rank: u32,
     /// The level's best players, fastest first, at most [`MAX_TOP`].
-    #[serde(deserialize_with = "bounded::top")]
+    #[serde(deserialize_with = "top_list")]
     pub top: Vec<TopRun>,
 }
 
@@ -457,6 +411,10 @@ pub enum ClientControl {
     GetLevel {
         /// First byte wanted; at most the bundle's size.
         offset: u64,
+        /// The bundle's SHA-256 ([`LevelOffer::sha256`] of the `Welcome` or
+        /// of a [`ServerControl::LevelChange`]): a server rotating levels
+        /// serves any of its own (added in protocol version 11).
+        sha256: [u8; 32],
     },
     /// Instead of a hello, as the first message, after a lost connection:
     /// asks for the player the [`Welcome::session_token`] names (same id,
@@ -488,6 +446,13 @@ pub enum ClientControl {
         /// The room to watch (`None`: the one with the most players),
         /// checked like a room name.
         room: Option<String>,
+    },
+    /// A vote for the level the room plays next (an index into the
+    /// [`ServerControl::Levels`] list); a later vote replaces it. Added in
+    /// protocol version 11.
+    Vote {
+        /// The level's index in the list.
+        level: u32,
     },
 }
 
@@ -566,6 +531,12 @@ impl Message for ClientControl {
             | ClientControl::Leave
             | ClientControl::ListRooms { .. }
             | ClientControl::GetLevel { .. } => Ok(()),
+            ClientControl::Vote { level } => {
+                if *level as usize >= MAX_LEVELS {
+                    return Err(ProtocolError::malformed("vote", "no such level"));
+                }
+                Ok(())
+            }
         }
     }
 }
@@ -646,6 +617,23 @@ pub struct Welcome {
     /// the world (opaque here), at most [`MAX_SIM_CONFIG_LEN`] bytes.
     #[serde(with = "bytes")]
     pub sim_config: Vec<u8>,
+}
+
+impl Welcome {
+    /// Checks the names, the timing and the config's size.
+    fn validate(&self) -> Result<(), ProtocolError> {
+        check_text("room name", &self.room, 1, MAX_ID_LEN)?;
+        check_text("level id", &self.level_id, 1, MAX_ID_LEN)?;
+        self.timing.validate()?;
+        if self.sim_config.len() > MAX_SIM_CONFIG_LEN {
+            return Err(ProtocolError::too_large(
+                "welcome sim config",
+                self.sim_config.len(),
+                MAX_SIM_CONFIG_LEN,
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Why the server refused a `Hello`.
@@ -744,7 +732,7 @@ pub enum ServerControl {
     /// version 4.
     Roster {
         /// The players.
-        #[serde(deserialize_with = "bounded::roster")]
+        #[serde(deserialize_with = "roster_list")]
         players: Vec<RosterEntry>,
     },
     /// A player joined the room (sent to everyone else in it). Added in
@@ -760,7 +748,7 @@ pub enum ServerControl {
     /// connection next. Added in protocol version 5.
     Rooms {
         /// The rooms.
-        #[serde(deserialize_with = "bounded::rooms")]
+        #[serde(deserialize_with = "rooms_list")]
         rooms: Vec<RoomInfo>,
     },
     /// The receiver's run finished and is stored in the server's records
@@ -778,6 +766,19 @@ pub enum ServerControl {
     /// receiver's own best. Sent after the roster when the server has one.
     /// Added in protocol version 10.
     Ghost(GhostRun),
+    /// The room's levels, votes and when it moves on: after the roster on
+    /// joining, then whenever any of it changes. Added in protocol
+    /// version 11.
+    Levels(LevelList),
+    /// The room moved to another level. This `Welcome` replaces the one
+    /// the session began with: same player id (its `session_token` is not
+    /// sent: the first one stays valid), the new level (download it as on
+    /// joining, [`ClientControl::GetLevel`]), the room's tick at the change
+    /// and the new simulation config. Snapshots of earlier ticks are of the
+    /// old level: drop them; those of the new level come on the control
+    /// stream, after this message, until one of them is acknowledged.
+    /// Added in protocol version 11.
+    LevelChange(Welcome),
 }
 
 /// A ghost: who ran it, in what time, and the run's replay.
@@ -816,6 +817,8 @@ impl ServerControl {
             ServerControl::RunRecorded(_) => "RunRecorded",
             ServerControl::RunNotRecorded { .. } => "RunNotRecorded",
             ServerControl::Ghost(_) => "Ghost",
+            ServerControl::Levels(_) => "Levels",
+            ServerControl::LevelChange(_) => "LevelChange",
         }
     }
 }
@@ -826,19 +829,8 @@ impl Message for ServerControl {
 
     fn validate(&self) -> Result<(), ProtocolError> {
         match self {
-            ServerControl::Welcome(w) => {
-                check_text("room name", &w.room, 1, MAX_ID_LEN)?;
-                check_text("level id", &w.level_id, 1, MAX_ID_LEN)?;
-                w.timing.validate()?;
-                if w.sim_config.len() > MAX_SIM_CONFIG_LEN {
-                    return Err(ProtocolError::too_large(
-                        "welcome sim config",
-                        w.sim_config.len(),
-                        MAX_SIM_CONFIG_LEN,
-                    ));
-                }
-                Ok(())
-            }
+            ServerControl::Welcome(w) | ServerControl::LevelChange(w) => w.validate(),
+            ServerControl::Levels(list) => list.validate(),
             ServerControl::Reject { reason } => match reason {
                 RejectReason::Other { reason } => {
                     check_text("reject reason", reason, 0, MAX_REASON_LEN)
@@ -1014,7 +1006,10 @@ mod tests {
     #[test]
     fn new_first_messages_keep_their_variant_numbers_and_resume_hides_its_token() {
         let list = ClientControl::ListRooms { version: 5 };
-        let get = ClientControl::GetLevel { offset: 3 };
+        let get = ClientControl::GetLevel {
+            offset: 3,
+            sha256: [7; 32],
+        };
         let resume = ClientControl::Resume {
             version: PROTOCOL_VERSION,
             name: "ana".into(),

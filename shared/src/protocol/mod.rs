@@ -18,6 +18,7 @@
 //! hand-written varint format ([`snapshot`]). `docs/PROTOCOL.md` documents
 //! the wire format byte by byte.
 
+mod bounded;
 mod codec;
 mod control;
 mod datagram;
@@ -25,6 +26,7 @@ mod error;
 mod fingerprint;
 mod frame;
 mod outgoing;
+mod rotation;
 pub mod snapshot;
 mod varint;
 pub mod web;
@@ -43,6 +45,7 @@ pub use error::ProtocolError;
 pub use fingerprint::{Fingerprint, ParseFingerprintError};
 pub use frame::{write_frame, FrameDecoder, FRAME_HEADER};
 pub use outgoing::{fits, Outgoing};
+pub use rotation::{LevelChoice, LevelList, VoteRule, MAX_LEVELS};
 pub use snapshot::{
     decode_delta, encode_delta, extrapolate, extrapolates_to, is_replicated, EntityState,
     SnapshotHistory, StateSnapshot,
@@ -73,7 +76,10 @@ pub use snapshot::{
 /// 9: records: `ServerControl::RunRecorded` (where a finished run stands,
 /// sent once it is stored) and `ServerControl::RunNotRecorded`.
 /// 10: spectators (`ClientControl::Spectate`) and ghosts (`ServerControl::Ghost`).
-pub const PROTOCOL_VERSION: u32 = 10;
+/// 11: level rotation and votes: `ServerControl::Levels`,
+/// `ServerControl::LevelChange`, `ClientControl::Vote`, and
+/// `ClientControl::GetLevel::sha256` (which of the server's levels).
+pub const PROTOCOL_VERSION: u32 = 11;
 
 /// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
 /// an unrelated QUIC peer. It names the application, not the version:

@@ -13,6 +13,7 @@ use ledge_client::bot::{BotOptions, RandomWalker};
 use ledge_client::net::bundle::{fetch_level, FetchOptions, LevelCache};
 use ledge_client::ClientError;
 use ledge_levels::bundle::sha256;
+use ledge_server::levels::LevelLoadError;
 use ledge_server::{Server, ServerConfig, ServerError};
 use ledge_tests::e2e::{bot_options, spawn_bot};
 use ledge_tests::{corpus_file, metric, TestServer};
@@ -31,7 +32,7 @@ fn downloads(server: &TestServer) -> (f64, f64, f64) {
 
 async fn level_server(map: &Path) -> TestServer {
     let map = map.to_owned();
-    TestServer::start_with(move |c| c.level = Some(map)).await
+    TestServer::start_with(move |c| c.levels = vec![map]).await
 }
 
 fn cache_options(dir: &Path) -> FetchOptions {
@@ -227,12 +228,12 @@ async fn a_level_bigger_than_the_cap_stops_the_server_at_start() {
     let config = |cap| ServerConfig {
         bind: "127.0.0.1:0".parse().unwrap(),
         cert_dir: dir.path().join("certs"),
-        level: Some(map.clone()),
+        levels: vec![map.clone()],
         max_level_mib: cap,
         ..ServerConfig::default()
     };
     match Server::bind(config(1)) {
-        Err(e @ ServerError::LevelTooLarge { .. }) => {
+        Err(e @ ServerError::Level(LevelLoadError::TooLarge { .. })) => {
             let text = e.to_string();
             assert!(text.contains("--max-level-mib"), "{text}");
             assert!(text.contains("1 MiB"), "{text}");

@@ -114,7 +114,7 @@ async fn the_browser_protocol_downloads_a_real_level_joins_and_moves() {
     let Some(map) = corpus_file(STICKER_KNIGHT) else {
         return;
     };
-    let server = TestServer::start_with(move |c| c.level = Some(map)).await;
+    let server = TestServer::start_with(move |c| c.levels = vec![map]).await;
     // A native player in the room first.
     let native = ledge_client::connect_with(
         server.addr,

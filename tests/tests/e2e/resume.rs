@@ -85,7 +85,7 @@ async fn cut_and_resume(cut: Duration) {
     let map = dir.path().join("corridor.tmx");
     std::fs::write(&map, CORRIDOR).unwrap();
     let level = ledge_levels::load_level(&map, None).unwrap().level;
-    let server = TestServer::start_with(|c| c.level = Some(map.clone())).await;
+    let server = TestServer::start_with(|c| c.levels = vec![map.clone()]).await;
     let relay = UdpRelay::start(server.addr).await;
     let mut ana = join(&server, relay.addr, None).await;
     let id = ana.welcome().player_id;

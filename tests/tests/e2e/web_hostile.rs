@@ -292,7 +292,7 @@ async fn a_level_flood_is_held_to_its_budget_while_an_honest_browser_downloads_a
     let root = page();
     let (uplink_mbps, address_mbps) = (80.0, 16.0);
     let server = web_server(root.path(), move |c| {
-        c.level = Some(map.clone());
+        c.levels = vec![map.clone()];
         let web = c.web.as_mut().expect("the web port");
         web.limits.uplink_bytes_per_second = mbps_to_bytes(uplink_mbps);
         web.limits.address_bytes_per_second = mbps_to_bytes(address_mbps);

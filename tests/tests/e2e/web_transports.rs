@@ -253,8 +253,11 @@ async fn the_level_downloads_over_both_web_transports_and_http() {
     let mut ws = Web::Ws(WsClient::connect(server.web_addr.unwrap()).await.unwrap());
     let welcome = ws.join("ws-level", "room-1").await;
     assert_eq!(welcome.level, offer);
-    ws.send_control(&ClientControl::GetLevel { offset: 0 })
-        .await;
+    ws.send_control(&ClientControl::GetLevel {
+        offset: 0,
+        sha256: offer.sha256,
+    })
+    .await;
     let level = loop {
         match ws.next(WAIT).await.expect("the level in time") {
             WebEvent::Level(bytes) => break bytes,
@@ -264,8 +267,11 @@ async fn the_level_downloads_over_both_web_transports_and_http() {
     };
     check(&level, "WebSocket");
     // Resumed from an offset: the rest.
-    ws.send_control(&ClientControl::GetLevel { offset: 10 })
-        .await;
+    ws.send_control(&ClientControl::GetLevel {
+        offset: 10,
+        sha256: offer.sha256,
+    })
+    .await;
     let rest = loop {
         match ws.next(WAIT).await.expect("the rest in time") {
             WebEvent::Level(bytes) => break bytes,
@@ -282,8 +288,11 @@ async fn the_level_downloads_over_both_web_transports_and_http() {
             .unwrap(),
     );
     wt.join("wt-level", "room-1").await;
-    wt.send_control(&ClientControl::GetLevel { offset: 0 })
-        .await;
+    wt.send_control(&ClientControl::GetLevel {
+        offset: 0,
+        sha256: offer.sha256,
+    })
+    .await;
     let level = loop {
         match wt.next(WAIT).await.expect("the level in time") {
             WebEvent::Level(bytes) => break bytes,
