@@ -393,3 +393,38 @@ fn the_default_level_runs() {
         step(&mut g);
     }
 }
+
+#[test]
+fn a_game_started_at_a_later_tick_runs_like_one_restored_there() {
+    // A room moving to another level keeps counting its ticks: a fresh
+    // game set to tick T has its platforms where a game run to T has them,
+    // and restores from its own snapshots like any other.
+    let level = full_level();
+    let mut ran = Game::from_level(&level).unwrap();
+    for _ in 0..500 {
+        ran.step(&[]);
+    }
+    let mut late = Game::from_level(&level).unwrap();
+    assert!(late.start_at(500));
+    assert_eq!(late.tick(), 500);
+    let platforms = |g: &Game| {
+        g.entities()
+            .filter(|e| e.ty == ledge_shared::game::EntityType::Platform)
+            .map(|e| e.pos)
+            .collect::<Vec<_>>()
+    };
+    assert!(!platforms(&late).is_empty());
+    assert_eq!(platforms(&late), platforms(&ran));
+    late.add_player(PlayerId(1)).unwrap();
+    assert!(!late.start_at(900), "refused once it has players");
+    for _ in 0..60 {
+        step(&mut late);
+    }
+    let mut copy = Game::from_level(&level).unwrap();
+    copy.restore(&late.snapshot()).unwrap();
+    for _ in 0..120 {
+        step(&mut late);
+        step(&mut copy);
+        assert_eq!(late.state_hash(), copy.state_hash(), "tick {}", late.tick());
+    }
+}
