@@ -92,8 +92,51 @@ impl ClientGame {
         rtt: Duration,
         now: Instant,
     ) -> Result<ClientGame, ClientError> {
-        check_level(welcome, &level, "our level")?;
         let clock = SyncClock::for_welcome(welcome, rtt, now);
+        ClientGame::with_clock(welcome, level, rtt, clock)
+    }
+
+    /// The game of the room's next level, replacing this one: `welcome` is
+    /// the level change's (the new level, the tick it started at, its
+    /// config) and `level` must be its level (its hash is checked). The
+    /// room's tick goes on across a change, so the clock carries on where
+    /// it is (when it is not behind the new welcome's tick, at the same
+    /// rate), as do the names known and whether we watch; the prediction,
+    /// the remote players and the figures start afresh.
+    pub fn next_level(
+        &self,
+        welcome: &Welcome,
+        level: Level,
+        now: Instant,
+    ) -> Result<ClientGame, ClientError> {
+        let rtt = self.stats.latest_rtt().unwrap_or(Duration::from_millis(50));
+        let fresh = SyncClock::for_welcome(welcome, rtt, now);
+        let mut going = self.clock.clone();
+        going.advance(now);
+        let same_rate = self
+            .welcome
+            .as_ref()
+            .is_some_and(|w| w.timing.tick_rate == welcome.timing.tick_rate);
+        let clock = if same_rate && going.position() >= fresh.position() {
+            going
+        } else {
+            fresh
+        };
+        let mut game = ClientGame::with_clock(welcome, level, rtt, clock)?;
+        game.name = self.name.clone();
+        game.names = self.names.clone();
+        game.spectating = self.spectating;
+        Ok(game)
+    }
+
+    /// [`ClientGame::new`] with its clock.
+    fn with_clock(
+        welcome: &Welcome,
+        level: Level,
+        rtt: Duration,
+        clock: SyncClock,
+    ) -> Result<ClientGame, ClientError> {
+        check_level(welcome, &level, "our level")?;
         // The server's constants (an older or minimal server may send none).
         let mut config: GameConfig = if welcome.sim_config.is_empty() {
             GameConfig::default()
@@ -471,6 +514,72 @@ mod tests {
         assert_eq!(wall_side(both, false), None);
         assert_eq!(wall_side(Sides::BOTTOM, false), None);
         assert_eq!(wall_side(Sides::NONE, false), None);
+    }
+
+    /// The next level's game keeps the clock where it is (the room's tick
+    /// goes on), unless the change's tick is ahead of it; names and
+    /// watching carry over, the prediction starts afresh.
+    #[test]
+    fn the_next_level_carries_the_clock_on() {
+        use ledge_shared::protocol::NetTiming;
+        let level = ledge_levels::default_level();
+        let welcome = |tick: u64, hash: u64| Welcome {
+            player_id: PlayerId(1),
+            room: "room-1".into(),
+            level_id: "default".into(),
+            level_hash: hash,
+            level: Default::default(),
+            session_token: Default::default(),
+            server_tick: tick,
+            timing: NetTiming {
+                tick_rate: 60,
+                snapshot_interval: 2,
+                input_redundancy: 16,
+            },
+            sim_config: vec![],
+        };
+        let hash = level.content_hash();
+        let start = Instant::now();
+        let rtt = Duration::from_millis(20);
+        let mut old = ClientGame::new(&welcome(1000, hash), level.clone(), rtt, start).unwrap();
+        old.set_name("ada");
+        old.on_player_joined(PlayerId(2), "bo");
+        // Two seconds on, the change of tick 1060 is processed (its level
+        // took that long to download).
+        let later = start + Duration::from_secs(2);
+        old.advance(later);
+        let was = old.clock().position();
+        let next = old
+            .next_level(&welcome(1060, hash), level.clone(), later)
+            .unwrap();
+        assert!(
+            next.clock().position() >= was,
+            "{} {was}",
+            next.clock().position()
+        );
+        assert_eq!(next.next_tick(), next.clock().tick());
+        assert!(
+            !next.synced(),
+            "prediction waits for the new level's snapshot"
+        );
+        assert_eq!(
+            next.player_names().get(&PlayerId(2)).map(String::as_str),
+            Some("bo")
+        );
+        assert_eq!(
+            next.view().local.map(|p| p.name),
+            None,
+            "no body until synced"
+        );
+        // A change ahead of our clock: the clock starts from it.
+        let ahead = old
+            .next_level(&welcome(50_000, hash), level.clone(), later)
+            .unwrap();
+        assert!(ahead.clock().tick() >= 50_000);
+        // Another level than the welcome's: refused.
+        assert!(old
+            .next_level(&welcome(1060, hash ^ 1), level, later)
+            .is_err());
     }
 
     /// A spectator's game: the welcome's id is in no snapshot; every

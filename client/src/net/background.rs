@@ -12,6 +12,13 @@
 //! into a [`NetStatus`]. Both directions are bounded queues: when one is
 //! full (a front end that stopped polling), new events or commands are
 //! dropped and counted rather than piling up.
+//!
+//! When the room moves to another level, the thread gets that level
+//! (embedded, cached or downloaded, with [`NetEvent::LevelProgress`]) and
+//! reports it ([`NetEvent::Level`]), then the change
+//! ([`NetEvent::LevelChanged`]); a session resumed after the room moved on
+//! while we were away is reported the same way. Votes go out with
+//! [`NetThread::vote`].
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -20,12 +27,14 @@ use std::sync::{mpsc, Arc, Mutex};
 use std::thread;
 use std::time::{Duration, Instant};
 
+use ledge_levels::LevelBundle;
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::{CloseCode, Fingerprint, PlayerId};
+use ledge_shared::protocol::{CloseCode, Fingerprint, LevelOffer, PlayerId, Welcome};
 use tokio::sync::oneshot;
 
 use crate::error::ClientError;
-use crate::net::bundle::{fetch_level, FetchOptions, LevelCache};
+use crate::net::bundle::{fetch_level, FetchOptions, Fetched, LevelCache};
+use crate::net::download::level_change_failed;
 use crate::net::session::{handshake, JoinOptions, Session, SessionEvent};
 use crate::net::trust::{dial_trusted, Trust};
 use crate::net::Network;
@@ -94,6 +103,9 @@ pub enum NetCommand {
     },
     /// Say something in the room.
     Chat(String),
+    /// Vote for the level the room plays next (an index into the
+    /// [`NetEvent::Levels`] list).
+    Vote(u32),
 }
 
 /// A running network thread. Dropping it leaves the server and joins the
@@ -173,6 +185,12 @@ impl NetThread {
         self.send(NetCommand::Chat(text.to_owned()))
     }
 
+    /// Votes for the level the room plays next (an index into the
+    /// [`NetEvent::Levels`] list).
+    pub fn vote(&self, level: u32) -> bool {
+        self.send(NetCommand::Vote(level))
+    }
+
     /// QUIC's byte counters and RTT, read by the network thread every
     /// quarter second (`None` before connecting).
     pub fn transport(&self) -> Option<TransportSample> {
@@ -209,6 +227,10 @@ impl Network for NetThread {
 
     fn chat(&mut self, text: &str) -> bool {
         NetThread::chat(self, text)
+    }
+
+    fn vote(&mut self, level: u32) -> bool {
+        NetThread::vote(self, level)
     }
 
     fn transport(&self) -> Option<TransportSample> {
@@ -270,37 +292,24 @@ async fn run(
         resume: None,
         spectate: options.spectate,
     };
+    let mut levels = Levels {
+        fetch: FetchOptions {
+            cache: options.level_cache.clone().map(LevelCache::new),
+            cut_after: None,
+        },
+        have: None,
+        reported: None,
+    };
     // Set once joined: then a lost connection is resumed.
     let mut lost: Option<(Instant, u32)> = None;
-    let mut joined_once = false;
     loop {
-        let connecting = async {
-            let hello = join.hello();
-            ledge_shared::protocol::Message::validate(&hello)?;
-            let dial = dial_trusted(&request.server, &trust);
-            let (dialed, trusted) = if joined_once {
-                // A reconnect attempt through a dead link must not hang for
-                // the whole QUIC idle timeout, but only the QUIC handshake
-                // is cut short: once our hello is out, the server may have
-                // given our player to this connection, and dropping it
-                // then closes it without a `Leave`, which the server takes
-                // as leaving (the player gone, the next attempt a new
-                // player). Past the handshake the link works, and the idle
-                // timeout bounds the rest.
-                tokio::time::timeout(RECONNECT_ATTEMPT, dial)
-                    .await
-                    .unwrap_or(Err(ClientError::Timeout))?
-            } else {
-                dial.await?
-            };
-            Ok::<_, ClientError>((handshake(dialed, hello).await?, trusted))
-        };
+        let joined_once = levels.have.is_some();
         let result = tokio::select! {
             _ = &mut quit => return,
-            result = connecting => result,
+            result = connect(&request.server, &trust, &join, joined_once) => result,
         };
         let mut session = match (result, lost) {
-            (Ok((session, _)), _) => session,
+            (Ok(session), _) => session,
             (Err(e), None) => {
                 let untrusted = matches!(
                     e,
@@ -314,20 +323,9 @@ async fn run(
                 return;
             }
             (Err(e), Some((since, attempt))) => {
-                if !reconnectable(&e) || since.elapsed() >= RECONNECT_FOR {
-                    events.send(NetEvent::Disconnected(format!(
-                        "lost the connection and could not reconnect within {} s: {e}",
-                        RECONNECT_FOR.as_secs()
-                    )));
-                    return;
-                }
-                let attempt = attempt + 1;
-                lost = Some((since, attempt));
-                events.send(NetEvent::Reconnecting { attempt });
-                let backoff = RECONNECT_BACKOFF * 2u32.pow(attempt.min(4));
-                tokio::select! {
-                    _ = &mut quit => return,
-                    () = tokio::time::sleep(backoff.min(RECONNECT_BACKOFF_MAX)) => {}
+                match retry(&e, since, attempt, &events, &mut quit).await {
+                    Some(again) => lost = Some(again),
+                    None => return,
                 }
                 continue;
             }
@@ -340,39 +338,20 @@ async fn run(
                 session.welcome().player_id
             );
         }
-        if options.download_level && !joined_once {
-            let fetch = FetchOptions {
-                cache: options.level_cache.clone().map(LevelCache::new),
-                cut_after: None,
-            };
-            let total = session.welcome().level.size;
-            let mut shown = 0;
-            let fetched = fetch_level(&mut session, &fetch, |got, total| {
-                // A few dozen updates, not one per read.
-                if got == total || got >= shown + total / 32 {
-                    shown = got;
-                    events.send(NetEvent::LevelProgress { got, total });
-                }
-            });
-            let result = tokio::select! {
-                _ = &mut quit => return,
-                result = fetched => result,
-            };
-            match result {
-                Ok((bundle, fetched)) => {
-                    tracing::info!("{}", fetched.describe(total));
-                    events.send(NetEvent::Level(Box::new(bundle), fetched));
-                }
-                Err(e) => {
-                    events.send(NetEvent::Failed(e.to_string()));
-                    session.close().await;
-                    return;
-                }
-            }
-        }
-        joined_once = true;
-        match serve(&mut session, &events, &mut commands, &mut quit).await {
+        let served = match levels
+            .joined(&mut session, &options, &events, &mut quit)
+            .await
+        {
+            Ok(()) => serve(&mut session, &mut levels, &events, &mut commands, &mut quit).await,
+            Err(served) => served,
+        };
+        match served {
             Served::Quit => {
+                session.close().await;
+                return;
+            }
+            Served::NoLevel(message) => {
+                events.send(NetEvent::Failed(message));
                 session.close().await;
                 return;
             }
@@ -389,12 +368,172 @@ async fn run(
     }
 }
 
+/// A reconnect attempt (`attempt` failed ones since the connection was
+/// lost at `since`) failed with `e`: waits before the next one and
+/// returns the new count, or `None` when reconnecting is over (not
+/// reconnectable, too late: reported; or the front end quit).
+async fn retry(
+    e: &ClientError,
+    since: Instant,
+    attempt: u32,
+    events: &Events,
+    quit: &mut oneshot::Receiver<()>,
+) -> Option<(Instant, u32)> {
+    if !reconnectable(e) || since.elapsed() >= RECONNECT_FOR {
+        events.send(NetEvent::Disconnected(format!(
+            "lost the connection and could not reconnect within {} s: {e}",
+            RECONNECT_FOR.as_secs()
+        )));
+        return None;
+    }
+    let attempt = attempt + 1;
+    events.send(NetEvent::Reconnecting { attempt });
+    let backoff = RECONNECT_BACKOFF * 2u32.pow(attempt.min(4));
+    tokio::select! {
+        _ = &mut *quit => None,
+        () = tokio::time::sleep(backoff.min(RECONNECT_BACKOFF_MAX)) => Some((since, attempt)),
+    }
+}
+
+/// Dials `server` and sends the hello `join` says. A reconnect attempt
+/// (`reconnecting`) gives the QUIC handshake [`RECONNECT_ATTEMPT`].
+async fn connect(
+    server: &str,
+    trust: &Trust,
+    join: &JoinOptions,
+    reconnecting: bool,
+) -> Result<Session, ClientError> {
+    let hello = join.hello();
+    ledge_shared::protocol::Message::validate(&hello)?;
+    let dial = dial_trusted(server, trust);
+    let (dialed, _trusted) = if reconnecting {
+        // A reconnect attempt through a dead link must not hang for the
+        // whole QUIC idle timeout, but only the QUIC handshake is cut
+        // short: once our hello is out, the server may have given our
+        // player to this connection, and dropping it then closes it
+        // without a `Leave`, which the server takes as leaving (the player
+        // gone, the next attempt a new player). Past the handshake the
+        // link works, and the idle timeout bounds the rest.
+        tokio::time::timeout(RECONNECT_ATTEMPT, dial)
+            .await
+            .unwrap_or(Err(ClientError::Timeout))?
+    } else {
+        dial.await?
+    };
+    handshake(dialed, hello).await
+}
+
+/// The levels the front end was given: how to fetch one, and which it has.
+struct Levels {
+    fetch: FetchOptions,
+    /// The level the front end has (`None`: not joined yet).
+    have: Option<LevelOffer>,
+    /// The welcome the front end was last given (on joining or by a level
+    /// change): a level change the join already had is not one.
+    reported: Option<Welcome>,
+}
+
+impl Levels {
+    /// A session was welcomed: on the first join the level is fetched if
+    /// the options say so ([`NetOptions::download_level`]); on a resume,
+    /// if the room plays another level than the front end has (it moved
+    /// on while we were away), that one is fetched and reported as a level
+    /// change. `Err`: the session ends so.
+    async fn joined(
+        &mut self,
+        session: &mut Session,
+        options: &NetOptions,
+        events: &Events,
+        quit: &mut oneshot::Receiver<()>,
+    ) -> Result<(), Served> {
+        let offer = session.welcome().level;
+        let first = self.have.is_none();
+        // `serve` reports this welcome first.
+        self.reported = Some(session.welcome().clone());
+        if (first && !options.download_level) || self.have == Some(offer) {
+            self.have = Some(offer);
+            return Ok(());
+        }
+        let (bundle, fetched) = match fetch(session, &self.fetch, events, quit).await {
+            None => return Err(Served::Quit),
+            Some(Ok(level)) => level,
+            Some(Err(e)) if first => return Err(Served::NoLevel(e.to_string())),
+            Some(Err(e)) => {
+                return Err(Served::NoLevel(level_change_failed(session.welcome(), &e)))
+            }
+        };
+        self.have = Some(offer);
+        events.send(NetEvent::Level(Box::new(bundle), fetched));
+        if !first {
+            events.send(NetEvent::LevelChanged(Box::new(session.welcome().clone())));
+        }
+        Ok(())
+    }
+
+    /// The room moved to the level of `welcome`: fetch it (the session's
+    /// latest welcome; an older change still queued is skipped), then
+    /// report it and the change.
+    async fn changed(
+        &mut self,
+        session: &mut Session,
+        welcome: &Welcome,
+        events: &Events,
+        quit: &mut oneshot::Receiver<()>,
+    ) -> Result<(), Served> {
+        if welcome != session.welcome() || self.reported.as_ref() == Some(welcome) {
+            // Another change came after this one (that one is fetched), or
+            // the welcome of our join already was this level's.
+            return Ok(());
+        }
+        let (bundle, fetched) = match fetch(session, &self.fetch, events, quit).await {
+            None => return Err(Served::Quit),
+            Some(Ok(level)) => level,
+            Some(Err(e)) => return Err(Served::NoLevel(level_change_failed(welcome, &e))),
+        };
+        self.have = Some(welcome.level);
+        self.reported = Some(welcome.clone());
+        events.send(NetEvent::Level(Box::new(bundle), fetched));
+        events.send(NetEvent::LevelChanged(Box::new(welcome.clone())));
+        Ok(())
+    }
+}
+
+/// Gets the session's current level (embedded, cached or downloaded),
+/// reporting the download's progress; `None` if the front end quit
+/// meanwhile.
+async fn fetch(
+    session: &mut Session,
+    options: &FetchOptions,
+    events: &Events,
+    quit: &mut oneshot::Receiver<()>,
+) -> Option<Result<(LevelBundle, Fetched), ClientError>> {
+    let total = session.welcome().level.size;
+    let mut shown = 0;
+    let fetched = fetch_level(session, options, |got, total| {
+        // A few dozen updates, not one per read.
+        if got == total || got >= shown + total / 32 {
+            shown = got;
+            events.send(NetEvent::LevelProgress { got, total });
+        }
+    });
+    let result = tokio::select! {
+        _ = &mut *quit => return None,
+        result = fetched => result,
+    };
+    if let Ok((_, fetched)) = &result {
+        tracing::info!("{}", fetched.describe(total));
+    }
+    Some(result)
+}
+
 /// How a joined session's loop ended.
 enum Served {
     /// The front end is gone or asked to quit.
     Quit,
     /// The session failed.
     Failed(ClientError),
+    /// The level could not be had (the message says which and why).
+    NoLevel(String),
 }
 
 /// Whether a session that failed with `e` may come back by reconnecting:
@@ -414,10 +553,11 @@ fn reconnectable(e: &ClientError) -> bool {
     }
 }
 
-/// Runs a joined session: inputs and chat out, events in, until it fails
-/// or the front end quits.
+/// Runs a joined session: inputs, chat and votes out, events in (a level
+/// change fetched on the way), until it fails or the front end quits.
 async fn serve(
     session: &mut Session,
+    levels: &mut Levels,
     events: &Events,
     commands: &mut tokio::sync::mpsc::Receiver<NetCommand>,
     quit: &mut oneshot::Receiver<()>,
@@ -425,11 +565,6 @@ async fn serve(
     let sample = |s: &Session| {
         if let Ok(mut slot) = events.transport.lock() {
             *slot = Some(TransportSample::of(s.connection()));
-        }
-    };
-    let roster = |s: &Session| {
-        if let Ok(mut slot) = events.players.lock() {
-            slot.clone_from(s.players());
         }
     };
     sample(session);
@@ -444,27 +579,20 @@ async fn serve(
                 Ok(true)
             }
             command = commands.recv() => match command {
-                Some(NetCommand::Input { tick, buttons }) => {
-                    // A full datagram queue is not fatal: the next input
-                    // repeats this one.
-                    if let Err(e) = session.send_input(tick, buttons) {
-                        tracing::debug!("input not sent: {e}");
-                    }
-                    Ok(true)
-                }
-                Some(NetCommand::Chat(text)) => session.chat(&text).await.map(|()| true),
+                Some(command) => run_command(session, command).await,
                 None => return Served::Quit,
             },
             _ = ticker.tick() => session.send_ping().await.map(|_| true),
-            event = session.recv() => event.map(|event| {
-                if matches!(
-                    event,
-                    SessionEvent::PlayerJoined { .. } | SessionEvent::PlayerLeft { .. }
-                ) {
-                    roster(session);
+            event = session.recv() => match event {
+                Ok(SessionEvent::LevelChange(welcome)) => {
+                    if let Err(served) = levels.changed(session, &welcome, events, quit).await {
+                        return served;
+                    }
+                    Ok(true)
                 }
-                NetEvent::from_session(event).is_none_or(|event| events.send(event))
-            }),
+                Ok(event) => Ok(report(session, events, event)),
+                Err(e) => Err(e),
+            },
         };
         match result {
             Ok(true) => {}
@@ -472,6 +600,36 @@ async fn serve(
             Err(e) => return Served::Failed(e),
         }
     }
+}
+
+/// Does what the front end asked.
+async fn run_command(session: &mut Session, command: NetCommand) -> Result<bool, ClientError> {
+    match command {
+        NetCommand::Input { tick, buttons } => {
+            // A full datagram queue is not fatal: the next input repeats
+            // this one.
+            if let Err(e) = session.send_input(tick, buttons) {
+                tracing::debug!("input not sent: {e}");
+            }
+            Ok(true)
+        }
+        NetCommand::Chat(text) => session.chat(&text).await.map(|()| true),
+        NetCommand::Vote(level) => session.vote(level).await.map(|()| true),
+    }
+}
+
+/// Hands a session's event to the front end (the roster kept up to date
+/// first); `false` once the front end is gone.
+fn report(session: &Session, events: &Events, event: SessionEvent) -> bool {
+    if matches!(
+        event,
+        SessionEvent::PlayerJoined { .. } | SessionEvent::PlayerLeft { .. }
+    ) {
+        if let Ok(mut slot) = events.players.lock() {
+            slot.clone_from(session.players());
+        }
+    }
+    NetEvent::from_session(event).is_none_or(|event| events.send(event))
 }
 
 #[cfg(test)]

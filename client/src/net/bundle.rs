@@ -170,10 +170,12 @@ pub struct FetchOptions {
     pub cut_after: Option<u64>,
 }
 
-/// The level the session's server offers: the embedded default, the
-/// cached copy, or downloaded (resuming a cut download), checked by hash
-/// and decoded with every bound checked. `progress(got, total)` is called
-/// as bytes arrive.
+/// The level the session's server offers (the welcome's, or the latest
+/// level change's: [`Session::welcome`]): the embedded default, the
+/// cached copy, or downloaded (resuming a cut download; the request names
+/// the bundle by its SHA-256, so a server rotating levels sends this one),
+/// checked by hash and decoded with every bound checked.
+/// `progress(got, total)` is called as bytes arrive.
 pub async fn fetch_level(
     session: &mut Session,
     options: &FetchOptions,
@@ -205,6 +207,7 @@ pub async fn fetch_level(
         session
             .send_control(&ClientControl::GetLevel {
                 offset: resumed_from,
+                sha256: offer.sha256,
             })
             .await?;
         let mut stream =

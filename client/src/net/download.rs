@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 
 use ledge_levels::bundle::sha256;
 use ledge_levels::LevelBundle;
-use ledge_shared::protocol::{LevelOffer, MAX_LEVEL_BUNDLE};
+use ledge_shared::protocol::{LevelOffer, Welcome, MAX_LEVEL_BUNDLE};
 
 use crate::error::ClientError;
 
@@ -146,6 +146,16 @@ impl Download {
         };
         Ok((level, fetched))
     }
+}
+
+/// Why the room's next level, that of the level change's `welcome`,
+/// cannot be played: the level's id and what failed, `e` (the session
+/// ends with it).
+pub fn level_change_failed(welcome: &Welcome, e: &ClientError) -> String {
+    format!(
+        "the room moved to level {:?}, and getting it failed: {e}",
+        welcome.level_id
+    )
 }
 
 /// Decodes a bundle (every bound checked by `ledge-levels`).

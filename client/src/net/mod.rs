@@ -51,7 +51,7 @@ use std::time::Duration;
 
 use ledge_levels::LevelBundle;
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::{GhostRun, NoticeKind, PlayerId, Standing, Welcome};
+use ledge_shared::protocol::{GhostRun, LevelList, NoticeKind, PlayerId, Standing, Welcome};
 
 use crate::net::download::Fetched;
 use crate::net::session::{SessionEvent, SnapshotUpdate};
@@ -67,6 +67,9 @@ pub trait Network {
     fn send_input(&mut self, tick: u64, buttons: Buttons) -> bool;
     /// Says `text` in the room; `false` if it could not be queued.
     fn chat(&mut self, text: &str) -> bool;
+    /// Votes for the level the room plays next (an index into the
+    /// [`NetEvent::Levels`] list); `false` if it could not be queued.
+    fn vote(&mut self, level: u32) -> bool;
     /// The transport's byte counters and round-trip time, when known.
     fn transport(&self) -> Option<TransportSample>;
     /// Who is in our room, by id (us included), as last heard.
@@ -86,7 +89,8 @@ pub enum NetEvent {
     },
     /// The server's level (natively with
     /// `background::NetOptions::download_level`), just
-    /// before [`NetEvent::Connected`].
+    /// before [`NetEvent::Connected`]; or the room's next level, just
+    /// before [`NetEvent::LevelChanged`].
     Level(Box<LevelBundle>, Fetched),
     /// The server welcomed us.
     Connected(Welcome),
@@ -121,6 +125,16 @@ pub enum NetEvent {
     RunRecorded(Result<Standing, String>),
     /// A run to race against, as its replay ([`crate::ghost::Ghost`]).
     Ghost(Box<GhostRun>),
+    /// The room's levels, votes and when it moves on (after the roster,
+    /// then whenever any of it changes).
+    Levels(Box<LevelList>),
+    /// The room moved to another level (or a resumed session found it on
+    /// another than ours): this welcome replaces the one of
+    /// [`NetEvent::Connected`] (same player, the new level, the tick the
+    /// level started at, its config), and the new level's
+    /// [`NetEvent::Level`] came just before. Snapshots after it are of the
+    /// new level.
+    LevelChanged(Box<Welcome>),
     /// Connecting failed; the thread has ended.
     Failed(String),
     /// Connecting failed because the server's certificate is not the one
@@ -140,7 +154,9 @@ pub enum NetEvent {
 
 impl NetEvent {
     /// The event a session's event becomes (`None`: a pong without a
-    /// round-trip time, which tells a front end nothing).
+    /// round-trip time, which tells a front end nothing; and a level
+    /// change, which the driver turns into [`NetEvent::Level`] and
+    /// [`NetEvent::LevelChanged`] once it has the new level).
     pub fn from_session(event: SessionEvent) -> Option<NetEvent> {
         Some(match event {
             SessionEvent::Snapshot(update) => NetEvent::Snapshot(update),
@@ -152,6 +168,8 @@ impl NetEvent {
             SessionEvent::PlayerLeft { id, .. } => NetEvent::PlayerLeft { id },
             SessionEvent::RunRecorded(r) => NetEvent::RunRecorded(r),
             SessionEvent::Ghost(g) => NetEvent::Ghost(Box::new(g)),
+            SessionEvent::Levels(list) => NetEvent::Levels(Box::new(list)),
+            SessionEvent::LevelChange(_) => return None,
         })
     }
 }
@@ -194,6 +212,17 @@ impl NetStatus {
     pub fn apply(&mut self, event: NetEvent) {
         *self = match (std::mem::take(self), event) {
             (_, NetEvent::Connected(welcome)) => NetStatus::Connected { welcome, rtt: None },
+            // On the next level (its download, if any, is over).
+            (NetStatus::Connected { rtt, .. }, NetEvent::LevelChanged(welcome)) => {
+                NetStatus::Connected {
+                    welcome: *welcome,
+                    rtt,
+                }
+            }
+            (_, NetEvent::LevelChanged(welcome)) => NetStatus::Connected {
+                welcome: *welcome,
+                rtt: None,
+            },
             (NetStatus::Connected { welcome, .. }, NetEvent::Rtt(rtt)) => NetStatus::Connected {
                 welcome,
                 rtt: Some(rtt),
@@ -210,7 +239,8 @@ impl NetStatus {
                 | NetEvent::PlayerJoined { .. }
                 | NetEvent::PlayerLeft { .. }
                 | NetEvent::RunRecorded(_)
-                | NetEvent::Ghost(_),
+                | NetEvent::Ghost(_)
+                | NetEvent::Levels(_),
             ) => status,
             (_, NetEvent::Failed(reason) | NetEvent::Untrusted(reason)) => {
                 NetStatus::Failed(reason)

@@ -35,7 +35,9 @@ use ledge_shared::input::Buttons;
 use ledge_shared::level::Level;
 #[cfg(not(target_arch = "wasm32"))]
 use ledge_shared::protocol::Fingerprint;
-use ledge_shared::protocol::{GhostRun, NoticeKind, PlayerId, Standing, StateSnapshot};
+use ledge_shared::protocol::{
+    GhostRun, LevelList, NoticeKind, PlayerId, Standing, StateSnapshot, Welcome,
+};
 
 use crate::game::ClientGame;
 use crate::ghost::Ghost;
@@ -144,6 +146,13 @@ pub struct OnlineGame<
     fresh: bool,
     /// We watch rather than play ([`OnlineGame::spectating`]).
     spectate: bool,
+    /// The room's levels and votes, as last heard.
+    levels: Option<LevelList>,
+    /// The room is moving to another level and we are downloading it:
+    /// bytes so far and the level's size.
+    changing: Option<(u64, u64)>,
+    /// Level changes taken so far ([`OnlineGame::level_changes`]).
+    level_changes: u64,
 }
 
 #[cfg(not(target_arch = "wasm32"))]
@@ -224,6 +233,9 @@ impl<N: Network> OnlineGame<N> {
             last_news: None,
             fresh: false,
             spectate: false,
+            levels: None,
+            changing: None,
+            level_changes: 0,
         }
     }
 
@@ -283,29 +295,13 @@ impl<N: Network> OnlineGame<N> {
     fn handle(&mut self, event: &NetEvent, now: Instant) {
         match event {
             NetEvent::Connected(welcome) => {
-                // The clock starts from QUIC's round-trip estimate of the
-                // handshake (or a guess).
-                let rtt = self
-                    .net
-                    .transport()
-                    .map_or(Duration::from_millis(50), |t| t.rtt);
-                let level = match &self.bundle {
-                    Some(bundle) => check_level(welcome, &bundle.level, "the downloaded level")
-                        .map(|()| bundle.level.clone()),
-                    None => level_for(welcome, self.level_file.as_deref()),
-                };
-                let made = level.and_then(|level| ClientGame::new(welcome, level, rtt, now));
-                match made {
-                    Ok(mut game) => {
-                        game.set_name(&self.name);
-                        game.set_spectating(self.spectate);
-                        game.set_player_names(&self.net.players());
-                        self.game = Some(game);
-                        self.fresh = true;
-                        self.last_news = Some(now);
-                    }
-                    Err(e) => self.error = Some(e.to_string()),
-                }
+                self.changing = None;
+                self.start_game(welcome, now, false);
+            }
+            NetEvent::LevelChanged(welcome) => self.level_changed(welcome, now),
+            NetEvent::Levels(list) => self.levels = Some((**list).clone()),
+            NetEvent::LevelProgress { got, total } if self.game.is_some() => {
+                self.changing = Some((*got, *total));
             }
             NetEvent::Snapshot(update) => {
                 self.last_news = Some(now);
@@ -348,12 +344,62 @@ impl<N: Network> OnlineGame<N> {
             }
             NetEvent::Ghost(run) => self.add_ghost(run),
             NetEvent::Untrusted(reason) => self.untrusted = Some(reason.clone()),
-            NetEvent::Failed(_)
-            | NetEvent::Disconnected(_)
-            | NetEvent::Reconnecting { .. }
+            NetEvent::Failed(_) | NetEvent::Disconnected(_) => self.changing = None,
+            NetEvent::Reconnecting { .. }
             | NetEvent::LevelProgress { .. }
             | NetEvent::Level(..) => {}
         }
+    }
+
+    /// Makes the game for `welcome` at `now`: on the level downloaded (or
+    /// cached, or embedded), or else the level file or the embedded level,
+    /// each checked against the server's hash. `next`: the room's next
+    /// level, continuing the current game's clock
+    /// ([`ClientGame::next_level`]). A level that is not the server's is
+    /// an error shown ([`OnlineGame::error`]), with no game.
+    fn start_game(&mut self, welcome: &Welcome, now: Instant, next: bool) {
+        // The clock starts from QUIC's round-trip estimate of the
+        // handshake (or a guess).
+        let rtt = self
+            .net
+            .transport()
+            .map_or(Duration::from_millis(50), |t| t.rtt);
+        let level = match &self.bundle {
+            Some(bundle) => check_level(welcome, &bundle.level, "the downloaded level")
+                .map(|()| bundle.level.clone()),
+            None => level_for(welcome, self.level_file.as_deref()),
+        };
+        let made = level.and_then(|level| match (&self.game, next) {
+            (Some(old), true) => old.next_level(welcome, level, now),
+            _ => ClientGame::new(welcome, level, rtt, now),
+        });
+        match made {
+            Ok(mut game) => {
+                game.set_name(&self.name);
+                game.set_spectating(self.spectate);
+                game.set_player_names(&self.net.players());
+                self.game = Some(game);
+                self.fresh = true;
+                self.last_news = Some(now);
+            }
+            Err(e) => {
+                self.game = None;
+                self.error = Some(e.to_string());
+            }
+        }
+    }
+
+    /// The room moved to another level (its bundle came just before): a
+    /// new game on it, as on joining; the ghosts, the last run's standing
+    /// and the old level's state are forgotten, the chat stays.
+    fn level_changed(&mut self, welcome: &Welcome, now: Instant) {
+        self.changing = None;
+        self.level_changes += 1;
+        self.ghosts.clear();
+        self.ghost_error = None;
+        self.standing = None;
+        self.latest = None;
+        self.start_game(welcome, now, true);
     }
 
     /// Whether we watch rather than play: joined as a spectator, no
@@ -512,6 +558,53 @@ impl<N: Network> OnlineGame<N> {
         self.net.chat(text)
     }
 
+    /// The room's levels (rotation order), which is played and next, the
+    /// votes, the rule and when it moves on, as last heard.
+    pub fn levels(&self) -> Option<&LevelList> {
+        self.levels.as_ref()
+    }
+
+    /// Votes for `level` (an index into [`OnlineGame::levels`]) to be
+    /// played next; `false` when there is no such level in the list (or
+    /// no list yet) or the vote could not be queued.
+    pub fn vote(&mut self, level: u32) -> bool {
+        let known = self
+            .levels
+            .as_ref()
+            .is_some_and(|l| (level as usize) < l.levels.len());
+        known && self.net.vote(level)
+    }
+
+    /// While the room's next level downloads: bytes so far and its size
+    /// (for a progress bar); `None` otherwise (the first join's download
+    /// is [`NetStatus::Downloading`]).
+    pub fn changing_level(&self) -> Option<(u64, u64)> {
+        self.changing
+    }
+
+    /// How many times the room moved to another level since we joined: a
+    /// front end that remembers it knows when to forget what it drew of
+    /// the old level (its art, the splits).
+    pub fn level_changes(&self) -> u64 {
+        self.level_changes
+    }
+
+    /// How long until the room moves to its next level, when that is
+    /// decided ([`LevelList::change_at`]), from the newest server tick
+    /// known (the game's clock before any snapshot).
+    pub fn next_level_in(&self) -> Option<Duration> {
+        let at = self.levels.as_ref()?.change_at?;
+        let game = self.game.as_ref()?;
+        let rate = game.welcome()?.timing.tick_rate.max(1);
+        let now = self
+            .latest
+            .as_ref()
+            .map_or_else(|| game.clock().tick(), |s| s.tick);
+        Some(Duration::from_secs_f64(
+            at.saturating_sub(now) as f64 / f64::from(rate),
+        ))
+    }
+
     /// The network driver.
     pub fn network(&self) -> &N {
         &self.net
@@ -522,11 +615,15 @@ impl<N: Network> OnlineGame<N> {
 mod tests {
     use std::collections::{BTreeMap, VecDeque};
 
+    use std::time::Duration;
+
+    use ledge_levels::LevelBundle;
     use ledge_shared::input::Buttons;
-    use ledge_shared::protocol::{PlayerId, Standing};
+    use ledge_shared::protocol::{LevelChoice, LevelList, PlayerId, Standing, VoteRule, Welcome};
 
     use super::OnlineGame;
-    use crate::net::{NetEvent, Network};
+    use crate::net::download::Fetched;
+    use crate::net::{NetEvent, NetStatus, Network};
     use crate::netstats::TransportSample;
     use crate::time::Instant;
 
@@ -543,12 +640,125 @@ mod tests {
         fn chat(&mut self, _: &str) -> bool {
             true
         }
+        fn vote(&mut self, _: u32) -> bool {
+            true
+        }
         fn transport(&self) -> Option<TransportSample> {
             None
         }
         fn players(&self) -> BTreeMap<PlayerId, String> {
             BTreeMap::new()
         }
+    }
+
+    /// A welcome to `level`, at `tick`.
+    fn welcome_to(level: &ledge_shared::level::Level, tick: u64) -> Welcome {
+        Welcome {
+            player_id: PlayerId(2),
+            room: "room-1".into(),
+            level_id: level.name.clone(),
+            level_hash: level.content_hash(),
+            level: Default::default(),
+            session_token: Default::default(),
+            server_tick: tick,
+            timing: ledge_shared::protocol::NetTiming {
+                tick_rate: 60,
+                snapshot_interval: 2,
+                input_redundancy: 16,
+            },
+            sim_config: vec![],
+        }
+    }
+
+    fn bundle(name: &str) -> Box<LevelBundle> {
+        let mut bundle = LevelBundle::default_level();
+        bundle.level.name = name.into();
+        Box::new(bundle)
+    }
+
+    fn two_levels(change_at: Option<u64>) -> Box<LevelList> {
+        Box::new(LevelList {
+            levels: ["first", "second"]
+                .map(|n| LevelChoice {
+                    id: n.into(),
+                    name: n.into(),
+                })
+                .to_vec(),
+            current: 0,
+            next: 1,
+            votes: vec![0, 1],
+            rule: VoteRule::Majority,
+            change_at,
+        })
+    }
+
+    /// The room moves on: a new game on the new level, the old run's
+    /// standing and the ghosts forgotten, the chat kept; a level that is
+    /// not the server's is refused as on joining.
+    #[test]
+    fn a_level_change_makes_a_new_game_and_forgets_the_last_run() {
+        let now = Instant::now();
+        let first = bundle("first");
+        let w1 = welcome_to(&first.level, 10);
+        let mut game = OnlineGame::with_network(Queued(VecDeque::new()), "server", "ada");
+        game.net.0.extend([
+            NetEvent::Level(first.clone(), Fetched::default()),
+            NetEvent::Connected(w1.clone()),
+            NetEvent::Chat {
+                from: PlayerId(2),
+                text: "hi".into(),
+            },
+            NetEvent::RunRecorded(Err("records are off".into())),
+            NetEvent::Levels(two_levels(Some(10 + 120))),
+        ]);
+        game.update(now, Buttons::NONE);
+        assert_eq!(game.level().map(|l| l.name.as_str()), Some("first"));
+        assert!(game.standing().is_some());
+        assert_eq!(game.levels().map(|l| l.next), Some(1));
+        let left = game.next_level_in().expect("change_at is set");
+        assert!(left <= Duration::from_secs(2), "{left:?}");
+        assert!(game.vote(1));
+        assert!(!game.vote(2), "no such level");
+        assert_eq!(game.changing_level(), None);
+
+        // Downloading the next level: the old game plays on meanwhile.
+        game.net.0.push_back(NetEvent::LevelProgress {
+            got: 100,
+            total: 400,
+        });
+        game.update(now, Buttons::NONE);
+        assert_eq!(game.changing_level(), Some((100, 400)));
+        assert_eq!(game.level().map(|l| l.name.as_str()), Some("first"));
+
+        let second = bundle("second");
+        let w2 = welcome_to(&second.level, 200);
+        game.net.0.extend([
+            NetEvent::Level(second.clone(), Fetched::default()),
+            NetEvent::LevelChanged(Box::new(w2.clone())),
+        ]);
+        game.update(now, Buttons::NONE);
+        assert_eq!(game.error(), None);
+        assert_eq!(game.level().map(|l| l.name.as_str()), Some("second"));
+        assert_eq!(game.game().and_then(|g| g.welcome()), Some(&w2));
+        assert_eq!(game.changing_level(), None);
+        assert_eq!(game.level_changes(), 1);
+        assert_eq!(game.standing(), None, "the old level's run is gone");
+        assert!(game.ghosts().is_empty());
+        assert_eq!(game.chat_count(), 1, "the chat stays");
+        assert!(matches!(game.status(), NetStatus::Connected { welcome, .. } if *welcome == w2));
+
+        // A level change whose level is not the one the server names.
+        game.net.0.extend([
+            NetEvent::Level(first, Fetched::default()),
+            NetEvent::LevelChanged(Box::new(welcome_to(&second.level, 400))),
+        ]);
+        game.update(now, Buttons::NONE);
+        assert!(game.game().is_none());
+        assert!(
+            game.error().is_some_and(|e| e.contains("second")),
+            "{:?}",
+            game.error()
+        );
     }
 
     /// Two equal standings in a row are two: the count tells them apart.

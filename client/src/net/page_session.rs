@@ -13,7 +13,9 @@
 //! so both speak one protocol. It reports as the background thread does:
 //! the level ([`NetEvent::Level`], after its download if the server plays
 //! another than the embedded one), then [`NetEvent::Connected`], then the
-//! session's events.
+//! session's events; when the room moves to another level, that level
+//! (downloaded by its SHA-256 the same way, the session's events waiting
+//! meanwhile), then [`NetEvent::LevelChanged`].
 //!
 //! Everything queued here is bounded: at most [`MAX_EVENTS`] events and
 //! [`MAX_TRANSMITS`] messages waiting (beyond, the oldest input datagrams,
@@ -28,8 +30,8 @@ use ledge_shared::protocol::{
 };
 
 use crate::error::ClientError;
-use crate::net::download::{embedded, Download, Fetched};
-use crate::net::session::{Handshake, JoinOptions, SessionState};
+use crate::net::download::{embedded, level_change_failed, Download, Fetched};
+use crate::net::session::{Handshake, JoinOptions, SessionEvent, SessionState};
 use crate::net::{NetEvent, Network};
 use crate::netstats::TransportSample;
 use crate::time::Instant;
@@ -65,11 +67,13 @@ enum Phase {
     Opening,
     /// Hello sent, waiting for the answer (since `.1`).
     Hello(Handshake, Instant),
-    /// Welcomed; downloading the server's level first, if needed.
+    /// Welcomed; downloading the server's level first, if needed (and
+    /// again whenever the room moves to another level: the session's
+    /// events wait meanwhile).
     Joined {
         state: Box<SessionState>,
         download: Option<Download>,
-        /// `Connected` was reported (the level is there).
+        /// `Connected` was reported (the first level is there).
         connected: bool,
     },
     /// Over (the reason was reported).
@@ -90,6 +94,9 @@ pub struct PageSession {
     last_word: Option<(CloseCode, String)>,
     /// Messages or events dropped because a queue was full.
     dropped: u64,
+    /// The welcome last reported (on joining or by a level change): a
+    /// level change the join already had is not one.
+    reported: Option<Welcome>,
 }
 
 impl PageSession {
@@ -104,6 +111,7 @@ impl PageSession {
             last_ping: None,
             last_word: None,
             dropped: 0,
+            reported: None,
         }
     }
 
@@ -130,8 +138,28 @@ impl PageSession {
             Incoming::LevelEnd => 0,
         };
         self.sample.bytes_in += len as u64;
+        let level = matches!(message, Incoming::Level(_) | Incoming::LevelEnd);
+        let changing = self.changing_to().cloned();
         if let Err(e) = self.handle(message, now) {
-            self.fail(&e);
+            match changing {
+                // The next level's download failed: say which level.
+                Some(welcome) if level => {
+                    self.end(NetEvent::Failed(level_change_failed(&welcome, &e)));
+                }
+                _ => self.fail(&e),
+            }
+        }
+    }
+
+    /// The level change's welcome while its level downloads.
+    fn changing_to(&self) -> Option<&Welcome> {
+        match &self.phase {
+            Phase::Joined {
+                state,
+                download: Some(_),
+                connected: true,
+            } => Some(state.welcome()),
+            _ => None,
         }
     }
 
@@ -190,12 +218,8 @@ impl PageSession {
                 Err(e) => return self.fail(&e),
             }
         };
-        if download.is_some() {
-            let mut frame = Vec::new();
-            match write_frame(&ClientControl::GetLevel { offset: 0 }, &mut frame) {
-                Ok(()) => self.transmit(Transmit::Stream(frame)),
-                Err(e) => return self.fail(&e.into()),
-            }
+        if download.is_some() && !self.get_level(&offer) {
+            return;
         }
         self.phase = Phase::Joined {
             state: Box::new(state),
@@ -207,7 +231,28 @@ impl PageSession {
         }
     }
 
-    /// The level is here: report it, then the welcome.
+    /// Asks for the level `offer` names (by its SHA-256); `false` if the
+    /// request could not be written (the session ended).
+    fn get_level(&mut self, offer: &ledge_shared::protocol::LevelOffer) -> bool {
+        let get = ClientControl::GetLevel {
+            offset: 0,
+            sha256: offer.sha256,
+        };
+        let mut frame = Vec::new();
+        match write_frame(&get, &mut frame) {
+            Ok(()) => {
+                self.transmit(Transmit::Stream(frame));
+                true
+            }
+            Err(e) => {
+                self.fail(&e.into());
+                false
+            }
+        }
+    }
+
+    /// The level is here: report it, then the welcome (on joining) or the
+    /// level change.
     fn level_ready(&mut self, bundle: ledge_levels::LevelBundle, fetched: Fetched) {
         let Phase::Joined {
             state, connected, ..
@@ -215,40 +260,84 @@ impl PageSession {
         else {
             return;
         };
-        *connected = true;
+        let changed = std::mem::replace(connected, true);
         let welcome = state.welcome().clone();
+        self.reported = Some(welcome.clone());
         self.event(NetEvent::Level(Box::new(bundle), fetched));
-        self.event(NetEvent::Connected(welcome));
+        self.event(if changed {
+            NetEvent::LevelChanged(Box::new(welcome))
+        } else {
+            NetEvent::Connected(welcome)
+        });
     }
 
-    /// Moves the session's events (once connected) to ours.
-    fn drain_session(&mut self) {
+    /// The room moved to the session's latest welcome's level: the
+    /// embedded one, or download it (the session's events wait).
+    fn next_level(&mut self) {
         let Phase::Joined {
-            state,
-            connected: true,
-            ..
+            state, download, ..
         } = &mut self.phase
         else {
             return;
         };
-        let mut moved = Vec::new();
-        while let Some(event) = state.poll_event() {
-            if let crate::net::session::SessionEvent::Pong { rtt: Some(rtt), .. } = &event {
-                self.sample.rtt = *rtt;
+        let offer = state.welcome().level;
+        if offer == embedded().1 {
+            let fetched = Fetched {
+                embedded: true,
+                ..Fetched::default()
+            };
+            return self.level_ready(embedded().0.clone(), fetched);
+        }
+        match Download::new(offer, Vec::new()) {
+            Ok(d) => *download = Some(d),
+            Err(e) => {
+                let message = level_change_failed(state.welcome(), &e);
+                return self.end(NetEvent::Failed(message));
             }
+        }
+        if self.get_level(&offer) {
+            self.event(NetEvent::LevelProgress {
+                got: 0,
+                total: offer.size,
+            });
+        }
+    }
+
+    /// Moves the session's events (once connected, and not while the next
+    /// level downloads) to ours; a level change starts its level's
+    /// download.
+    fn drain_session(&mut self) {
+        loop {
+            let Phase::Joined {
+                state,
+                connected: true,
+                download: None,
+            } = &mut self.phase
+            else {
+                return;
+            };
+            let Some(event) = state.poll_event() else {
+                return;
+            };
             match &event {
-                crate::net::session::SessionEvent::Notice(NoticeKind::Kick { reason }) => {
+                // The latest change only (another may be queued after).
+                SessionEvent::LevelChange(w)
+                    if w == state.welcome() && self.reported.as_ref() != Some(w) =>
+                {
+                    self.next_level();
+                }
+                SessionEvent::Pong { rtt: Some(rtt), .. } => self.sample.rtt = *rtt,
+                SessionEvent::Notice(NoticeKind::Kick { reason }) => {
                     self.last_word = Some((CloseCode::Kicked, reason.clone()));
                 }
-                crate::net::session::SessionEvent::Notice(NoticeKind::Shutdown) => {
+                SessionEvent::Notice(NoticeKind::Shutdown) => {
                     self.last_word = Some((CloseCode::ServerShutdown, String::new()));
                 }
                 _ => {}
             }
-            moved.extend(NetEvent::from_session(event));
-        }
-        for event in moved {
-            self.event(event);
+            if let Some(event) = NetEvent::from_session(event) {
+                self.event(event);
+            }
         }
     }
 
@@ -283,17 +372,23 @@ impl PageSession {
     /// Ends the session with `error`: [`NetEvent::Disconnected`] once
     /// joined, [`NetEvent::Failed`] before. Only the first reason counts.
     fn fail(&mut self, error: &ClientError) {
-        let was = std::mem::replace(&mut self.phase, Phase::Ended);
-        let event = match was {
-            Phase::Ended => {
-                self.phase = Phase::Ended;
-                return;
-            }
+        let event = match self.phase {
             Phase::Joined {
                 connected: true, ..
             } => NetEvent::Disconnected(error.to_string()),
             _ => NetEvent::Failed(error.to_string()),
         };
+        self.end(event);
+    }
+
+    /// Ends the session, reporting `event` (unless it had ended already).
+    fn end(&mut self, event: NetEvent) {
+        if matches!(
+            std::mem::replace(&mut self.phase, Phase::Ended),
+            Phase::Ended
+        ) {
+            return;
+        }
         self.event(event);
     }
 
@@ -330,7 +425,8 @@ impl PageSession {
         matches!(self.phase, Phase::Ended)
     }
 
-    /// The welcome, once joined.
+    /// The welcome, once joined (the latest level change's, once the room
+    /// moved on).
     pub fn welcome(&self) -> Option<&Welcome> {
         match &self.phase {
             Phase::Joined { state, .. } => Some(state.welcome()),
@@ -396,6 +492,19 @@ impl Network for PageSession {
                 true
             }
             Ok(None) => true,
+            Err(_) => false,
+        }
+    }
+
+    fn vote(&mut self, level: u32) -> bool {
+        if !matches!(self.phase, Phase::Joined { .. }) {
+            return false;
+        }
+        match SessionState::vote_frame(level) {
+            Ok(frame) => {
+                self.transmit(Transmit::Stream(frame));
+                true
+            }
             Err(_) => false,
         }
     }
@@ -564,7 +673,7 @@ mod tests {
         );
         let (controls, _) = sent(&mut session);
         assert!(
-            matches!(controls[..], [ClientControl::GetLevel { offset: 0 }]),
+            matches!(controls[..], [ClientControl::GetLevel { offset: 0, sha256 }] if sha256 == offer.sha256),
             "{controls:?}"
         );
         // A roster while downloading waits for the welcome's report.
@@ -690,6 +799,117 @@ mod tests {
             &events(&mut session)[..],
             [NetEvent::Disconnected(_)]
         ));
+    }
+
+    /// Another level than the embedded one: its bundle's bytes and offer.
+    fn another_level(name: &str) -> (LevelBundle, Vec<u8>, ledge_shared::protocol::LevelOffer) {
+        let mut bundle = LevelBundle::default_level();
+        bundle.level.name = name.into();
+        let bytes = bundle.encode();
+        let offer = LevelBundle::offer(&bytes);
+        (bundle, bytes, offer)
+    }
+
+    /// An empty full snapshot of `tick`, as the control stream carries it.
+    fn full_state(tick: u64) -> ServerControl {
+        let state = ledge_shared::protocol::StateSnapshot {
+            tick,
+            ..Default::default()
+        };
+        let mut delta = Vec::new();
+        ledge_shared::protocol::encode_delta(None, &state, &mut delta).unwrap();
+        ServerControl::FullState(ledge_shared::protocol::Snapshot {
+            tick,
+            baseline_tick: None,
+            last_input_tick: None,
+            input_timing: 0,
+            since_previous: 0,
+            delta,
+        })
+    }
+
+    #[test]
+    fn a_level_change_downloads_the_new_level_by_its_hash_then_reports_it() {
+        let now = Instant::now();
+        let mut session = joined(now);
+        events(&mut session);
+        sent(&mut session);
+        let (_, bytes, offer) = another_level("second");
+        let mut next = welcome(offer);
+        next.level_id = "second".into();
+        next.server_tick = 500;
+        // The change and the new level's first snapshot in one read.
+        let mut read = frame(&ServerControl::LevelChange(next.clone()));
+        read.extend(frame(&full_state(500)));
+        session.on_message(Incoming::Stream(&read), now);
+        let (controls, _) = sent(&mut session);
+        assert!(
+            matches!(controls[..], [ClientControl::GetLevel { offset: 0, sha256 }] if sha256 == offer.sha256),
+            "{controls:?}"
+        );
+        assert_eq!(
+            events(&mut session),
+            [NetEvent::LevelProgress {
+                got: 0,
+                total: offer.size
+            }],
+            "the snapshot waits for the level"
+        );
+        assert_eq!(session.welcome().unwrap().level_id, "second");
+        for chunk in bytes.chunks(4096) {
+            session.on_message(Incoming::Level(chunk), now);
+        }
+        session.on_message(Incoming::LevelEnd, now);
+        let got: Vec<NetEvent> = events(&mut session)
+            .into_iter()
+            .filter(|e| !matches!(e, NetEvent::LevelProgress { .. }))
+            .collect();
+        assert!(
+            matches!(&got[..], [NetEvent::Level(b, _), NetEvent::LevelChanged(w), NetEvent::Snapshot(s)]
+                if b.level.name == "second" && w.server_tick == 500 && s.state.tick == 500),
+            "{got:?}"
+        );
+        // A vote goes on the control stream.
+        assert!(session.vote(1));
+        let (controls, _) = sent(&mut session);
+        assert_eq!(controls, [ClientControl::Vote { level: 1 }]);
+        // Back to the embedded level: nothing to download.
+        let mut back = welcome(embedded().1);
+        back.server_tick = 900;
+        session.on_message(
+            Incoming::Stream(&frame(&ServerControl::LevelChange(back))),
+            now,
+        );
+        let got = events(&mut session);
+        assert!(
+            matches!(&got[..], [NetEvent::Level(_, f), NetEvent::LevelChanged(w)]
+                if f.embedded && w.server_tick == 900),
+            "{got:?}"
+        );
+        assert!(sent(&mut session).0.is_empty());
+    }
+
+    #[test]
+    fn a_next_level_that_fails_to_download_ends_the_session_naming_it() {
+        let now = Instant::now();
+        let mut session = joined(now);
+        events(&mut session);
+        let (_, mut bytes, offer) = another_level("second");
+        let mut next = welcome(offer);
+        next.level_id = "second".into();
+        session.on_message(
+            Incoming::Stream(&frame(&ServerControl::LevelChange(next))),
+            now,
+        );
+        bytes[3] ^= 0xff;
+        session.on_message(Incoming::Level(&bytes), now);
+        session.on_message(Incoming::LevelEnd, now);
+        let got = events(&mut session);
+        assert!(
+            matches!(got.last(), Some(NetEvent::Failed(r)) if r.contains("\"second\"") && r.contains("does not match the hash")),
+            "{got:?}"
+        );
+        assert!(session.is_ended());
     }
 
     #[test]

@@ -163,6 +163,12 @@ impl Network for WebNet {
         sent
     }
 
+    fn vote(&mut self, level: u32) -> bool {
+        let sent = self.session.vote(level);
+        self.flush();
+        sent
+    }
+
     fn transport(&self) -> Option<TransportSample> {
         self.session.transport()
     }

@@ -22,8 +22,8 @@
 use std::time::Duration;
 
 use ledge_shared::protocol::{
-    ClientControl, GhostRun, NoticeKind, PlayerId, SessionToken, Standing, StateSnapshot,
-    PROTOCOL_VERSION,
+    ClientControl, GhostRun, LevelList, NoticeKind, PlayerId, SessionToken, Standing,
+    StateSnapshot, Welcome, PROTOCOL_VERSION,
 };
 
 use crate::time::Instant;
@@ -169,6 +169,14 @@ pub enum SessionEvent {
     /// A run to race against (the level's record or our best), as its
     /// replay ([`crate::ghost::Ghost::from_run`] plays it).
     Ghost(GhostRun),
+    /// The room's levels, votes and when it moves on (after the roster on
+    /// joining, then whenever any of it changes).
+    Levels(LevelList),
+    /// The room moved to another level: the session's welcome is now this
+    /// one (the first `session_token` kept), snapshots of earlier ticks are
+    /// dropped, and the new level must be had before predicting it
+    /// ([`crate::net::bundle::fetch_level`] gets the latest level).
+    LevelChange(Welcome),
 }
 
 /// Counters of what the session received and sent.
@@ -180,7 +188,8 @@ pub struct SessionStats {
     pub full_snapshots: u64,
     /// Snapshots on the control stream.
     pub stream_snapshots: u64,
-    /// Snapshots older than the newest decoded (reordered), ignored.
+    /// Snapshots older than the newest decoded (reordered), or of a level
+    /// the room has left, ignored.
     pub stale_snapshots: u64,
     /// Deltas against a snapshot we no longer have, dropped.
     pub missing_baselines: u64,

@@ -185,7 +185,8 @@ pub struct Session {
 
 impl Session {
     /// What the server said when we joined (player id, room, level, tick,
-    /// timing).
+    /// timing), or the latest level change's welcome
+    /// ([`SessionEvent::LevelChange`]).
     pub fn welcome(&self) -> &Welcome {
         self.state.welcome()
     }
@@ -269,6 +270,19 @@ impl Session {
             text: text.to_owned(),
         })
         .await
+    }
+
+    /// Votes for the level the room plays next: `level` is an index into
+    /// the [`SessionEvent::Levels`] list (a later vote replaces this one;
+    /// a spectator's is refused with a notice).
+    pub async fn vote(&mut self, level: u32) -> Result<(), ClientError> {
+        let frame = SessionState::vote_frame(level)?;
+        self.send_raw_control(&frame).await
+    }
+
+    /// The room's levels, votes and when it moves on, as last heard.
+    pub fn levels(&self) -> Option<&ledge_shared::protocol::LevelList> {
+        self.state.levels()
     }
 
     /// Sends a ping and returns its nonce; the [`SessionEvent::Pong`]

@@ -7,9 +7,9 @@ use std::collections::{BTreeMap, VecDeque};
 
 use ledge_shared::input::Buttons;
 use ledge_shared::protocol::{
-    write_frame, ClientControl, FrameDecoder, InputPacket, Message, PlayerId, RosterEntry,
-    ServerControl, Snapshot, SnapshotHistory, StateSnapshot, Welcome, MAX_FRAME, MAX_INPUT_HISTORY,
-    MAX_ROSTER,
+    write_frame, ClientControl, FrameDecoder, InputPacket, LevelList, Message, PlayerId,
+    RosterEntry, ServerControl, Snapshot, SnapshotHistory, StateSnapshot, Welcome, MAX_FRAME,
+    MAX_INPUT_HISTORY, MAX_ROSTER,
 };
 
 use super::{JoinOptions, SessionEvent, SessionStats, SnapshotUpdate, SNAPSHOT_HISTORY};
@@ -188,6 +188,11 @@ pub struct SessionState {
     /// The server's last `input_timing` (for a datagram's newest tick).
     server_timing: i16,
     history: SnapshotHistory,
+    /// Set by a level change: the tick the current level started at.
+    /// Snapshots of earlier ticks are of a level the room has left.
+    level_start: Option<u64>,
+    /// The room's levels and votes, as last heard.
+    levels: Option<LevelList>,
     pending: VecDeque<SessionEvent>,
     pings: VecDeque<(u64, Instant)>,
     players: BTreeMap<PlayerId, String>,
@@ -207,31 +212,59 @@ impl SessionState {
         let mut state = SessionState {
             decoder,
             inputs: InputHistory::default(),
-            redundancy: usize::from(welcome.timing.input_redundancy).clamp(1, MAX_INPUT_HISTORY),
-            input_every: input_interval(welcome.timing.tick_rate),
-            quiet_every: u64::from(welcome.timing.tick_rate.div_ceil(QUIET_SEND_HZ).max(1)),
-            quiet_after: ((QUIET_AFTER.as_secs_f64() * f64::from(welcome.timing.tick_rate))
-                as usize)
-                .clamp(1, MAX_INPUT_HISTORY),
+            redundancy: 1,
+            input_every: 1,
+            quiet_every: 1,
+            quiet_after: 1,
             quiet: false,
             world_still: false,
             input_sent: None,
             server_timing: 0,
             welcome,
             history: SnapshotHistory::new(SNAPSHOT_HISTORY),
+            level_start: None,
+            levels: None,
             pending: VecDeque::new(),
             pings: VecDeque::new(),
             players: BTreeMap::new(),
             next_nonce: 0,
             stats: SessionStats::default(),
         };
+        state.retime();
         state.drain_stream_at(now)?;
         Ok(state)
     }
 
-    /// What the server said when we joined.
+    /// Sets the input pacing from the welcome's timing.
+    fn retime(&mut self) {
+        let timing = &self.welcome.timing;
+        self.redundancy = usize::from(timing.input_redundancy).clamp(1, MAX_INPUT_HISTORY);
+        self.input_every = input_interval(timing.tick_rate);
+        self.quiet_every = u64::from(timing.tick_rate.div_ceil(QUIET_SEND_HZ).max(1));
+        self.quiet_after = ((QUIET_AFTER.as_secs_f64() * f64::from(timing.tick_rate)) as usize)
+            .clamp(1, MAX_INPUT_HISTORY);
+    }
+
+    /// What the server said when we joined, or the latest level change's
+    /// welcome (which keeps the first `session_token`, the one a resume
+    /// names).
     pub fn welcome(&self) -> &Welcome {
         &self.welcome
+    }
+
+    /// The room's levels, votes and when it moves on, as last heard.
+    pub fn levels(&self) -> Option<&LevelList> {
+        self.levels.as_ref()
+    }
+
+    /// The control frame of a vote for level `level` (an index into
+    /// [`SessionState::levels`]); an index no list can have is refused.
+    pub fn vote_frame(level: u32) -> Result<Vec<u8>, ClientError> {
+        let vote = ClientControl::Vote { level };
+        vote.validate()?;
+        let mut frame = Vec::new();
+        write_frame(&vote, &mut frame)?;
+        Ok(frame)
     }
 
     /// Who is in our room, by id (us included, once the roster arrived).
@@ -440,12 +473,38 @@ impl SessionState {
                 self.push(SessionEvent::RunRecorded(Err(reason)));
             }
             ServerControl::Ghost(ghost) => self.push(SessionEvent::Ghost(ghost)),
+            ServerControl::Levels(list) => {
+                self.levels = Some(list.clone());
+                self.push(SessionEvent::Levels(list));
+            }
+            ServerControl::LevelChange(welcome) => self.level_change(welcome),
             ServerControl::Welcome(_)
             | ServerControl::Reject { .. }
             | ServerControl::Rooms { .. } => {
                 tracing::warn!("ignoring a second welcome, a reject or a room list");
             }
         }
+    }
+
+    /// The room moved to another level: `welcome` replaces ours (keeping
+    /// the first session token: the server does not send it again), the
+    /// snapshots of the old level are forgotten, and those of ticks before
+    /// the new level's first are dropped from now on.
+    fn level_change(&mut self, mut welcome: Welcome) {
+        if welcome.player_id != self.welcome.player_id {
+            tracing::warn!(
+                "a level change for player {} (we are {})",
+                welcome.player_id,
+                self.welcome.player_id
+            );
+        }
+        welcome.session_token = self.welcome.session_token;
+        self.level_start = Some(welcome.server_tick);
+        self.history = SnapshotHistory::new(SNAPSHOT_HISTORY);
+        self.world_still = false;
+        self.welcome = welcome.clone();
+        self.retime();
+        self.push(SessionEvent::LevelChange(welcome));
     }
 
     /// Records a player in the roster (a new name for a known id replaces
@@ -472,6 +531,11 @@ impl SessionState {
 
     /// Decodes a snapshot against our history and queues it if it is new.
     fn snapshot(&mut self, snapshot: Snapshot, via_stream: bool, wire_bytes: usize, now: Instant) {
+        if self.level_start.is_some_and(|start| snapshot.tick < start) {
+            // Of the level the room left (sent before the change).
+            self.stats.stale_snapshots += 1;
+            return;
+        }
         let baseline = match snapshot.baseline_tick {
             None => None,
             Some(tick) => match self.history.get(tick) {
@@ -597,6 +661,113 @@ mod tests {
     }
 
     use super::*;
+
+    /// An empty full snapshot of `tick`, undecoded.
+    fn full_snapshot(tick: u64) -> Snapshot {
+        Snapshot::decode(&snapshot_datagram(tick, 0)).unwrap()
+    }
+
+    /// The events queued, oldest first.
+    fn drain(state: &mut SessionState) -> Vec<SessionEvent> {
+        std::iter::from_fn(|| state.poll_event()).collect()
+    }
+
+    #[test]
+    fn a_level_change_replaces_the_welcome_keeps_the_token_and_drops_the_old_level() {
+        use ledge_shared::protocol::{LevelOffer, SessionToken};
+        let now = Instant::now();
+        let mut first = welcome_at(60);
+        first.session_token = SessionToken([7; 16]);
+        let mut state = SessionState::new(first, FrameDecoder::new(MAX_FRAME), now).unwrap();
+        state.on_datagram(&snapshot_datagram(90, 0), now);
+        assert_eq!(state.ack(), Some(90));
+        // The room moves on at tick 100: the new welcome has no token.
+        let mut next = welcome_at(60);
+        next.level_id = "second".into();
+        next.level_hash = 0x5eed;
+        next.level = LevelOffer {
+            sha256: [9; 32],
+            size: 1234,
+        };
+        next.server_tick = 100;
+        let mut bytes = Vec::new();
+        write_frame(&ServerControl::LevelChange(next.clone()), &mut bytes).unwrap();
+        state.on_stream(&bytes, now).unwrap();
+        assert_eq!(state.welcome().level_id, "second");
+        assert_eq!(state.welcome().level, next.level);
+        assert_eq!(state.welcome().server_tick, 100);
+        assert_eq!(
+            state.welcome().session_token,
+            SessionToken([7; 16]),
+            "the first token still resumes"
+        );
+        assert_eq!(state.ack(), None, "the old level's snapshots are forgotten");
+        let events = drain(&mut state);
+        assert!(
+            matches!(&events[..], [SessionEvent::Snapshot(s), SessionEvent::LevelChange(w)]
+                if s.state.tick == 90 && w.level_id == "second"
+                    && w.session_token == SessionToken([7; 16])),
+            "{events:?}"
+        );
+        // A datagram of the old level, late: dropped as stale.
+        let stale = state.stats().stale_snapshots;
+        state.on_datagram(&snapshot_datagram(98, 0), now);
+        assert!(drain(&mut state).is_empty());
+        assert_eq!(state.stats().stale_snapshots, stale + 1);
+        assert_eq!(state.ack(), None);
+        // The new level's first snapshot, on the stream: taken.
+        let mut bytes = Vec::new();
+        write_frame(&ServerControl::FullState(full_snapshot(100)), &mut bytes).unwrap();
+        state.on_stream(&bytes, now).unwrap();
+        match &drain(&mut state)[..] {
+            [SessionEvent::Snapshot(update)] => {
+                assert_eq!(update.state.tick, 100);
+                assert!(update.via_stream);
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(state.ack(), Some(100));
+        assert_eq!(state.stats().stream_snapshots, 1);
+        // And the datagrams after it.
+        state.on_datagram(&snapshot_datagram(102, 0), now);
+        assert_eq!(state.ack(), Some(102));
+    }
+
+    #[test]
+    fn the_level_list_is_an_event_and_kept_and_votes_are_checked() {
+        use ledge_shared::protocol::{LevelChoice, VoteRule, MAX_LEVELS};
+        let now = Instant::now();
+        let mut state =
+            SessionState::new(welcome_at(60), FrameDecoder::new(MAX_FRAME), now).unwrap();
+        assert!(state.levels().is_none());
+        let list = LevelList {
+            levels: ["one", "two"]
+                .map(|n| LevelChoice {
+                    id: n.into(),
+                    name: n.to_uppercase(),
+                })
+                .to_vec(),
+            current: 0,
+            next: 1,
+            votes: vec![0, 2],
+            rule: VoteRule::Majority,
+            change_at: Some(900),
+        };
+        let mut bytes = Vec::new();
+        write_frame(&ServerControl::Levels(list.clone()), &mut bytes).unwrap();
+        state.on_stream(&bytes, now).unwrap();
+        assert_eq!(drain(&mut state), [SessionEvent::Levels(list.clone())]);
+        assert_eq!(state.levels(), Some(&list));
+
+        let frame = SessionState::vote_frame(1).unwrap();
+        let mut decoder = FrameDecoder::new(MAX_FRAME);
+        decoder.push(&frame).unwrap();
+        assert_eq!(
+            decoder.pop_message::<ClientControl>().unwrap().unwrap(),
+            ClientControl::Vote { level: 1 }
+        );
+        assert!(SessionState::vote_frame(MAX_LEVELS as u32).is_err());
+    }
 
     fn ticks(h: &InputHistory) -> Vec<(u64, u8)> {
         h.ticks.iter().map(|&(t, b)| (t, b.0)).collect()
