@@ -33,6 +33,7 @@ mod resume;
 mod robustness;
 mod rooms_by_name;
 mod roster;
+mod rotation;
 mod seats;
 mod spectators;
 mod stall;
