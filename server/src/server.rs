@@ -562,6 +562,17 @@ impl Server {
             snapshot_interval = config.snapshot_interval(),
             "listening"
         );
+        if levels.len() > 1 {
+            let names: Vec<&str> = levels.levels().iter().map(|l| l.id.as_str()).collect();
+            let r = &config.rotation;
+            info!(
+                vote = r.vote.name(),
+                level_time_s = r.level_time.map_or(0, |t| t.as_secs()),
+                results_time_s = r.results_time.as_secs_f32(),
+                "levels in rotation: {}",
+                names.join(", ")
+            );
+        }
         // Browsers: the web port's task hands admitted WebSockets to the
         // accept loop; WebTransport sessions are accepted there like QUIC
         // ones.
