@@ -36,6 +36,10 @@ use crate::metrics::{
 use crate::replays::ghosts;
 use crate::room_logic::{Action, Joined, RoomConfig, RoomLogic, RoomStatus};
 
+/// Longest a finished run waits for its replay file before it is stored
+/// (without the replay's id, should the file not be written by then).
+const REPLAY_SAVE_WAIT: std::time::Duration = std::time::Duration::from_secs(10);
+
 /// Something for a client's control-stream writer.
 #[derive(Debug)]
 pub enum Outbound {
@@ -528,6 +532,9 @@ impl Room {
     fn carry_out(&mut self, now: Instant) {
         self.logic.take_actions(&mut self.actions);
         let metrics = &*self.metrics;
+        // A run's replay is queued just before its run: the run is stored
+        // once the file is written, so no record names a missing replay.
+        let mut saving: BTreeMap<String, oneshot::Receiver<bool>> = BTreeMap::new();
         for action in self.actions.drain(..) {
             match action {
                 Action::Control { to, frame } => {
@@ -569,7 +576,11 @@ impl Room {
                 Action::Left(id) => {
                     self.peers.remove(&id);
                 }
-                Action::SaveReplay(replay) => self.logic.config().replays.save(*replay),
+                Action::SaveReplay(replay) => {
+                    let (tell, saved) = oneshot::channel();
+                    saving.insert(replay.id.clone(), saved);
+                    self.logic.config().replays.save_then(*replay, Some(tell));
+                }
                 Action::FindGhosts { to, name } => {
                     if let Some(peer) = self.peers.get(&to) {
                         Room::send_ghosts(self.logic.config(), &peer.link.control, name);
@@ -578,14 +589,24 @@ impl Room {
                 Action::RunFinished { to, mut run } => {
                     run.finished_at_ms = crate::records::unix_millis();
                     let control = self.peers.get(&to).map(|p| p.link.control.clone());
-                    self.logic.config().records.submit(
-                        run,
-                        Box::new(move |result| {
-                            if let Some(control) = control {
-                                tell_standing(&control, result);
+                    let saved = run.replay_id.as_ref().and_then(|id| saving.remove(id));
+                    let records = self.logic.config().records.clone();
+                    tokio::spawn(async move {
+                        if let Some(saved) = saved {
+                            let written = tokio::time::timeout(REPLAY_SAVE_WAIT, saved).await;
+                            if !matches!(written, Ok(Ok(true))) {
+                                run.replay_id = None;
                             }
-                        }),
-                    );
+                        }
+                        records.submit(
+                            run,
+                            Box::new(move |result| {
+                                if let Some(control) = control {
+                                    tell_standing(&control, result);
+                                }
+                            }),
+                        );
+                    });
                 }
             }
         }

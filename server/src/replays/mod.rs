@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 pub use dir::ReplayDir;
 pub use recording::MatchRecording;
-pub use writer::{ReplaysHandle, SAVE_QUEUE};
+pub use writer::{ReplaysHandle, SaveJob, SAVE_QUEUE};
 
 /// Where replays go (`--replays`).
 #[derive(Debug, Clone, PartialEq, Eq)]

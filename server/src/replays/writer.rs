@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use ledge_shared::protocol::MAX_TOP;
 use ledge_shared::replay;
 use prometheus_client::metrics::counter::Counter;
-use tokio::sync::mpsc;
+use tokio::sync::{mpsc, oneshot};
 use tokio::task::JoinHandle;
 use tracing::{error, info, warn};
 
@@ -33,10 +33,20 @@ pub struct ReplayMetrics {
     pub pruned: Counter,
 }
 
+/// A replay to save, and who to tell once its file is written (`true`)
+/// or not (`false`, or the sender dropped).
+#[derive(Debug)]
+pub struct SaveJob {
+    /// The replay.
+    pub replay: ToSave,
+    /// Told when the file is on disk (a record naming it waits for this).
+    pub saved: Option<oneshot::Sender<bool>>,
+}
+
 /// Where rooms send replays (cheap to clone); off: nothing is recorded.
 #[derive(Debug, Clone, Default)]
 pub struct ReplaysHandle {
-    queue: Option<mpsc::Sender<ToSave>>,
+    queue: Option<mpsc::Sender<SaveJob>>,
     dir: Option<PathBuf>,
     metrics: ReplayMetrics,
 }
@@ -49,7 +59,7 @@ impl ReplaysHandle {
 
     /// A handle whose replays go to the returned receiver, not to disk
     /// (tests, tools).
-    pub fn channel(capacity: usize) -> (ReplaysHandle, mpsc::Receiver<ToSave>) {
+    pub fn channel(capacity: usize) -> (ReplaysHandle, mpsc::Receiver<SaveJob>) {
         let (tx, rx) = mpsc::channel(capacity);
         let handle = ReplaysHandle {
             queue: Some(tx),
@@ -89,16 +99,31 @@ impl ReplaysHandle {
     /// Queues a replay for saving (dropped, counted and logged when the
     /// queue is full).
     pub fn save(&self, replay: ToSave) {
+        self.save_then(replay, None);
+    }
+
+    /// Queues a replay for saving; `saved` is told whether its file was
+    /// written (`false` at once when the queue is full or replays are off).
+    pub fn save_then(&self, replay: ToSave, saved: Option<oneshot::Sender<bool>>) {
         let Some(queue) = &self.queue else {
+            if let Some(tell) = saved {
+                let _ = tell.send(false);
+            }
             return;
         };
-        if let Err(e) = queue.try_send(replay) {
+        if let Err(e) = queue.try_send(SaveJob { replay, saved }) {
             self.metrics.failed.inc();
             let reason = match e {
                 mpsc::error::TrySendError::Full(_) => "too many replays waiting to be saved",
                 mpsc::error::TrySendError::Closed(_) => "the replays writer has stopped",
             };
             warn!("replay not saved: {reason}");
+            let job = match e {
+                mpsc::error::TrySendError::Full(j) | mpsc::error::TrySendError::Closed(j) => j,
+            };
+            if let Some(tell) = job.saved {
+                let _ = tell.send(false);
+            }
         }
     }
 }
@@ -107,11 +132,15 @@ impl ReplaysHandle {
 async fn write(
     dir: ReplayDir,
     records: RecordsHandle,
-    mut rx: mpsc::Receiver<ToSave>,
+    mut rx: mpsc::Receiver<SaveJob>,
     metrics: ReplayMetrics,
 ) {
     let mut dir = Some(dir);
-    while let Some(mut job) = rx.recv().await {
+    while let Some(SaveJob {
+        replay: mut job,
+        saved: tell,
+    }) = rx.recv().await
+    {
         let ticks = job.replay.ticks();
         let rate = u64::from(job.replay.header.tick_rate.max(1));
         job.replay.header.recorded_at_ms =
@@ -124,6 +153,9 @@ async fn write(
         .await
         .expect("saving does not panic");
         dir = Some(back);
+        if let Some(tell) = tell {
+            let _ = tell.send(saved.is_ok());
+        }
         match saved {
             Ok(bytes) => {
                 metrics.saved.inc();
@@ -181,4 +213,57 @@ async fn kept(records: Option<&RecordStore>) -> BTreeSet<String> {
         }
     }
     keep
+}
+
+#[cfg(test)]
+mod tests {
+    use ledge_levels::default_level;
+    use ledge_shared::game::{Game, GameConfig};
+    use ledge_shared::protocol::{LevelOffer, PlayerId};
+    use ledge_shared::replay::ReplayHeader;
+
+    use super::super::MatchRecording;
+    use super::*;
+
+    /// A short match's replay.
+    fn a_replay() -> ToSave {
+        let header = ReplayHeader::for_match(
+            "room-1",
+            ("default", "Default", LevelOffer::default()),
+            GameConfig::default(),
+            60,
+        );
+        let mut game = Game::from_level(&default_level()).unwrap();
+        let mut rec = MatchRecording::new(header, "inst".into());
+        rec.before_join(&game, std::iter::empty());
+        game.add_player(PlayerId(1)).unwrap();
+        rec.joined(PlayerId(1), "ann");
+        for _ in 0..10 {
+            game.step(&[]);
+            rec.stepped(&game, &[], std::iter::empty());
+        }
+        game.remove_player(PlayerId(1));
+        rec.left(&game, PlayerId(1), true).expect("the match")
+    }
+
+    #[tokio::test]
+    async fn the_saver_is_told_once_the_file_is_on_disk_or_that_it_is_not() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = ReplayDir::open(tmp.path(), 1 << 30).unwrap();
+        let (handle, task) =
+            ReplaysHandle::spawn(dir, RecordsHandle::default(), Default::default());
+        let job = a_replay();
+        let path = ReplayDir::path_of(tmp.path(), &job.id);
+        let (tell, saved) = oneshot::channel();
+        handle.save_then(job, Some(tell));
+        assert_eq!(saved.await, Ok(true));
+        assert!(path.is_file(), "the file exists when the saver is told");
+        drop(handle);
+        task.await.unwrap();
+
+        // Off: told at once that nothing was saved.
+        let (tell, saved) = oneshot::channel();
+        ReplaysHandle::off().save_then(a_replay(), Some(tell));
+        assert_eq!(saved.await, Ok(false));
+    }
 }
