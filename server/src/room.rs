@@ -107,6 +107,12 @@ enum Command {
         from: PlayerId,
         level: u32,
     },
+    /// A run set a new record (`everyone`: send the record's ghost to the
+    /// whole room) or its runner's best (send it to `finisher`).
+    RefreshGhosts {
+        finisher: PlayerId,
+        everyone: bool,
+    },
 }
 
 /// A cheap, cloneable way to talk to a running room. The room stops when
@@ -234,6 +240,7 @@ pub fn spawn(
         actions: Vec::new(),
         players: players.clone(),
         commands: command_rx,
+        myself: commands.downgrade(),
         status: status_tx,
         metrics,
     };
@@ -245,6 +252,21 @@ pub fn spawn(
         status,
     };
     (handle, tokio::spawn(room.run()))
+}
+
+/// Asks the room to send the ghosts a stored run changed: the new record
+/// to everyone in it, a new personal best to its runner (a ghost set while
+/// players race reaches them then, not at their next join).
+fn refresh_ghosts(room: &mpsc::WeakUnboundedSender<Command>, finisher: PlayerId, s: &Standing) {
+    if !(s.new_record || s.new_personal_best) {
+        return;
+    }
+    if let Some(room) = room.upgrade() {
+        let _ = room.send(Command::RefreshGhosts {
+            finisher,
+            everyone: s.new_record,
+        });
+    }
 }
 
 /// Queues where a player's run stands (or why it was not recorded) on its
@@ -364,6 +386,9 @@ struct Room {
     actions: Vec<Action>,
     players: Arc<AtomicUsize>,
     commands: mpsc::UnboundedReceiver<Command>,
+    /// Its own command queue, for the records' answers (weak: the room
+    /// still stops when the last handle goes).
+    myself: mpsc::WeakUnboundedSender<Command>,
     status: watch::Sender<RoomStatus>,
     metrics: Arc<Metrics>,
     tick_duration: Histogram,
@@ -478,6 +503,14 @@ impl Room {
                 self.logic.chat(from, text);
                 self.carry_out(Instant::now());
             }
+            Command::RefreshGhosts { finisher, everyone } => {
+                let config = self.logic.config();
+                for (id, name) in self.logic.player_names() {
+                    if let Some(peer) = self.peers.get(&id).filter(|_| everyone || id == finisher) {
+                        Room::send_ghosts(config, &peer.link.control, name);
+                    }
+                }
+            }
             Command::Vote { from, level } => {
                 self.logic.vote(from, level);
                 self.carry_out(Instant::now());
@@ -591,6 +624,7 @@ impl Room {
                     let control = self.peers.get(&to).map(|p| p.link.control.clone());
                     let saved = run.replay_id.as_ref().and_then(|id| saving.remove(id));
                     let records = self.logic.config().records.clone();
+                    let myself = self.myself.clone();
                     tokio::spawn(async move {
                         if let Some(saved) = saved {
                             let written = tokio::time::timeout(REPLAY_SAVE_WAIT, saved).await;
@@ -601,6 +635,9 @@ impl Room {
                         records.submit(
                             run,
                             Box::new(move |result| {
+                                if let Ok(s) = &result {
+                                    refresh_ghosts(&myself, to, s);
+                                }
                                 if let Some(control) = control {
                                     tell_standing(&control, result);
                                 }

@@ -612,6 +612,13 @@ impl RoomLogic {
         }
     }
 
+    /// The players (not spectators) by id, with their names.
+    pub fn player_names(&self) -> Vec<(PlayerId, String)> {
+        names(&self.members)
+            .map(|(id, name)| (id, name.to_owned()))
+            .collect()
+    }
+
     /// The level being played (an index into [`RoomConfig::levels`]).
     pub fn level_index(&self) -> usize {
         self.rotation.current()
@@ -671,9 +678,7 @@ impl RoomLogic {
                 self.config.instance.clone(),
             )
         });
-        let players: Vec<(PlayerId, String)> = names(&self.members)
-            .map(|(id, name)| (id, name.to_owned()))
-            .collect();
+        let players = self.player_names();
         for (id, name) in &players {
             if let Some(r) = &mut self.recording {
                 // The game is empty before the first: nobody to name.

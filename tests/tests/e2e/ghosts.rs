@@ -73,3 +73,23 @@ async fn a_joining_player_races_the_record_and_its_own_best() {
     again.close().await;
     server.stop().await.unwrap();
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_record_set_while_a_player_races_reaches_it_at_once() {
+    let root = page();
+    let server = web_server(root.path(), |_| {}).await;
+    // eve is in the room, with no ghost to race yet.
+    let mut eve = server.join("eve").await;
+    assert!(ghosts(&mut eve, Duration::from_millis(300))
+        .await
+        .is_empty());
+    let ann = race(&server, &["ann"]).await.remove(0);
+    // ann's record is stored: eve gets its ghost without joining again.
+    let sent = ghosts(&mut eve, Duration::from_secs(3)).await;
+    assert_eq!(sent.len(), 1, "{sent:?}");
+    assert!(sent[0].record);
+    assert_eq!(sent[0].player, "ann");
+    assert_eq!(sent[0].millis, millis(ann.finish_ticks.unwrap()));
+    eve.close().await;
+    server.stop().await.unwrap();
+}
