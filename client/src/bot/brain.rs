@@ -6,6 +6,7 @@
 
 use ledge_shared::game::Game;
 use ledge_shared::input::Buttons;
+use ledge_shared::level::Level;
 use ledge_shared::protocol::PlayerId;
 
 /// Decides a bot's buttons, tick by tick.
@@ -25,6 +26,11 @@ pub trait Brain: Send {
     /// A snapshot corrected the prediction: plans made on the old one are
     /// stale.
     fn on_correction(&mut self) {}
+
+    /// The room moved to another level, `level` (our player respawned at
+    /// its spawn, the run afresh): whatever was planned on the old one is
+    /// void.
+    fn on_level(&mut self, _level: &Level) {}
 
     /// A one-line progress note for reports (a runner's waypoint).
     fn progress(&self) -> String {

@@ -8,6 +8,6 @@ pub mod thin;
 
 pub use brain::{Brain, Idle, RandomWalker, SplitMix64};
 pub use misbehave::{misbehave, MisbehaveReport, Misbehavior, Outcome};
-pub use run::{connect_and_run, run_bot, BotOptions, BotReport};
+pub use run::{connect_and_run, run_bot, BotOptions, BotReport, LevelPlayed};
 pub use runner::{Runner, RunnerProgress};
 pub use thin::{run_thin, run_thin_with, THIN};

@@ -8,11 +8,13 @@ use std::time::{Duration, Instant};
 use ledge_shared::game::state::player_flags;
 use ledge_shared::game::RUN_ID_BASE;
 use ledge_shared::input::Buttons;
-use ledge_shared::protocol::{NoticeKind, PlayerId, Standing};
+use ledge_shared::protocol::{LevelList, NoticeKind, PlayerId, Standing, Welcome};
 
 use super::brain::Brain;
+use crate::error::ClientError;
 use crate::game::ClientGame;
 use crate::net::bundle::{fetch_level, FetchOptions, Fetched, LevelCache};
+use crate::net::download::level_change_failed;
 use crate::net::levels::level_for;
 use crate::net::session::{JoinOptions, Session, SessionEvent, SnapshotUpdate};
 use crate::net::trust::{connect_trusted, Trust};
@@ -47,6 +49,9 @@ pub struct BotOptions {
     pub level_cache: Option<PathBuf>,
     /// Smallest input margin the clock keeps, ticks (`None`: the default).
     pub min_margin: Option<f64>,
+    /// Vote for this level (an index into the server's level list) once
+    /// the list arrives (`None`: no vote).
+    pub vote: Option<u32>,
 }
 
 impl BotOptions {
@@ -60,8 +65,37 @@ impl BotOptions {
             level: None,
             level_cache: None,
             min_margin: None,
+            vote: None,
         }
     }
+}
+
+/// A level a bot played, in the order played (a level played again is
+/// listed again), and the runs it finished there.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct LevelPlayed {
+    /// The level's id (the welcome's `level_id`).
+    pub id: String,
+    /// Runs the server's snapshots showed finishing on it.
+    pub finishes: u32,
+}
+
+impl LevelPlayed {
+    /// Level `id`, no run finished yet.
+    pub fn new(id: &str) -> LevelPlayed {
+        LevelPlayed {
+            id: id.to_owned(),
+            finishes: 0,
+        }
+    }
+}
+
+/// Prediction counters of the games of levels played before the current
+/// one (each level's game counts afresh).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Earlier {
+    pub(crate) corrections: u64,
+    pub(crate) mispredictions: u64,
 }
 
 /// What a bot did.
@@ -119,17 +153,26 @@ pub struct BotReport {
     pub played: Duration,
     /// How the server's level was had (`None`: from `level`, a file).
     pub level: Option<Fetched>,
+    /// The levels played, in order, with the runs finished on each.
+    pub levels: Vec<LevelPlayed>,
+    /// What came of [`BotOptions::vote`], in words (`None`: no vote asked,
+    /// or no level list yet).
+    pub vote: Option<String>,
+    /// The prediction counters of the levels before the current one.
+    pub(crate) earlier: Earlier,
 }
 
 impl BotReport {
-    /// Counts a snapshot received ([`BotReport::snapshots`],
     /// Follows our player's run in a server snapshot: the goal flag turning
     /// on (a finish), the first finish's tick and time.
-    fn observe_run(&mut self, update: &SnapshotUpdate, me: PlayerId) {
+    pub(crate) fn observe_run(&mut self, update: &SnapshotUpdate, me: PlayerId) {
         if let Some(mine) = update.state.get(me.0) {
             let won = mine.flags & player_flags::WON != 0;
             if won && !self.was_won {
                 self.finishes += 1;
+                if let Some(level) = self.levels.last_mut() {
+                    level.finishes += 1;
+                }
             }
             self.was_won = won;
             if won && !self.won {
@@ -145,6 +188,24 @@ impl BotReport {
         }
     }
 
+    /// The room moved to level `id`: its runs are counted from now on (our
+    /// player starts there afresh).
+    pub(crate) fn next_level(&mut self, id: &str) {
+        self.levels.push(LevelPlayed::new(id));
+        self.was_won = false;
+    }
+
+    /// The levels played and the runs finished on each, as the report's
+    /// line says them: `"ID" finished N` for each, in order, comma
+    /// separated.
+    pub fn levels_line(&self) -> String {
+        self.levels
+            .iter()
+            .map(|l| format!("{:?} finished {}", l.id, l.finishes))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// Takes what the server said about our finished run's record.
     fn told(&mut self, standing: Result<Standing, String>) {
         match &standing {
@@ -154,6 +215,7 @@ impl BotReport {
         self.standing = Some(standing);
     }
 
+    /// Counts a snapshot received ([`BotReport::snapshots`],
     /// [`BotReport::covered_ticks`]).
     pub fn snapshot(&mut self, update: &SnapshotUpdate) {
         self.snapshots += 1;
@@ -194,6 +256,12 @@ impl fmt::Display for BotReport {
                 None => "no".to_owned(),
             }
         )?;
+        if !self.levels.is_empty() {
+            write!(f, "  levels: {}", self.levels_line())?;
+        }
+        if let Some(vote) = &self.vote {
+            write!(f, "  vote: {vote}")?;
+        }
         if !self.progress.is_empty() {
             write!(f, "  [{}]", self.progress)?;
         }
@@ -230,7 +298,10 @@ pub async fn connect_and_run(
 }
 
 /// Plays `brain` on a joined `session` for `options.duration` (or until the
-/// brain is done, with `stop_when_done`), then leaves.
+/// brain is done, with `stop_when_done`), then leaves. When the room moves
+/// to another level the bot gets that level, plays on there (its brain
+/// told: [`Brain::on_level`]), and the report counts the runs finished on
+/// each ([`BotReport::levels`]).
 pub async fn run_bot(
     mut session: Session,
     brain: &mut dyn Brain,
@@ -243,44 +314,17 @@ pub async fn run_bot(
         name: options.name.clone(),
         brain: brain.name(),
         player: Some(me),
+        levels: vec![LevelPlayed::new(&welcome.level_id)],
         ..BotReport::default()
     };
-    let level = match &options.level {
-        Some(file) => level_for(&welcome, Some(file)),
-        None => {
-            let fetch = FetchOptions {
-                cache: options.level_cache.clone().map(LevelCache::new),
-                cut_after: None,
-            };
-            fetch_level(&mut session, &fetch, |_, _| {})
-                .await
-                .map(|(bundle, fetched)| {
-                    report.level = Some(fetched);
-                    bundle.level
-                })
-        }
-    };
-    let level = match level {
-        Ok(level) => level,
+    let mut game = match first_game(&mut session, options, &mut report).await {
+        Ok(game) => game,
         Err(e) => {
             report.ended = Some(e.to_string());
             session.close().await;
             return report;
         }
     };
-    let rtt = session.connection().rtt();
-    let mut game = match ClientGame::new(&welcome, level, rtt, Instant::now()) {
-        Ok(g) => g,
-        Err(e) => {
-            report.ended = Some(e.to_string());
-            session.close().await;
-            return report;
-        }
-    };
-    game.set_name(&options.name);
-    if let Some(m) = options.min_margin {
-        game.set_base_margin(m);
-    }
     let mut deadline = started + options.duration;
     let mut next_transport = started;
     let mut lingering = false;
@@ -326,34 +370,22 @@ pub async fn run_bot(
             event = session.recv() => event,
             () = tokio::time::sleep(wait) => continue,
         };
-        match event {
-            Ok(SessionEvent::Snapshot(update)) => {
-                report.snapshot(&update);
-                report.observe_run(&update, me);
-                if let Some(r) = game.on_snapshot(&update) {
-                    if r.mispredicted || r.correction_px > 0.0 {
-                        brain.on_correction();
-                    }
-                    report.max_correction_px = report.max_correction_px.max(r.correction_px);
-                }
-            }
-            Ok(SessionEvent::Pong { rtt: Some(rtt), .. }) => game.on_rtt(rtt),
-            Ok(SessionEvent::RunRecorded(standing)) => report.told(standing),
-            Ok(SessionEvent::Notice(NoticeKind::Kick { reason })) => {
-                break Some(format!("kicked: {reason}"))
-            }
-            Ok(SessionEvent::Notice(NoticeKind::Shutdown)) => {
-                break Some("server shut down".into())
-            }
-            Ok(_) => {}
-            Err(e) => break Some(e.to_string()),
+        let mut bot = Playing {
+            session: &mut session,
+            game: &mut game,
+            brain: &mut *brain,
+            report: &mut report,
+            options,
+        };
+        if let Err(why) = bot.event(event).await {
+            break Some(why);
         }
     };
     let now = Instant::now();
     game.on_transport(TransportSample::of(session.connection()), now);
     report.net = game.net_stats(now);
-    report.corrections = report.net.corrections;
-    report.mispredictions = report.net.mispredictions;
+    report.corrections = report.net.corrections + report.earlier.corrections;
+    report.mispredictions = report.net.mispredictions + report.earlier.mispredictions;
     report.progress = brain.progress();
     report.played = started.elapsed();
     report.ended = ended;
@@ -361,4 +393,217 @@ pub async fn run_bot(
         session.close().await;
     }
     report
+}
+
+/// The game of the level we joined on: that of `options.level` (a file),
+/// or fetched (embedded, cached or downloaded; how, in `report.level`).
+async fn first_game(
+    session: &mut Session,
+    options: &BotOptions,
+    report: &mut BotReport,
+) -> Result<ClientGame, ClientError> {
+    let welcome = session.welcome().clone();
+    let level = match &options.level {
+        Some(file) => level_for(&welcome, Some(file))?,
+        None => {
+            let (bundle, fetched) =
+                fetch_level(session, &fetch_options(options), |_, _| {}).await?;
+            report.level = Some(fetched);
+            bundle.level
+        }
+    };
+    let rtt = session.connection().rtt();
+    let mut game = ClientGame::new(&welcome, level, rtt, Instant::now())?;
+    game.set_name(&options.name);
+    if let Some(m) = options.min_margin {
+        game.set_base_margin(m);
+    }
+    Ok(game)
+}
+
+/// How a bot fetches levels.
+fn fetch_options(options: &BotOptions) -> FetchOptions {
+    FetchOptions {
+        cache: options.level_cache.clone().map(LevelCache::new),
+        cut_after: None,
+    }
+}
+
+/// A playing bot, as one event from the server changes it.
+struct Playing<'a> {
+    session: &'a mut Session,
+    game: &'a mut ClientGame,
+    brain: &'a mut dyn Brain,
+    report: &'a mut BotReport,
+    options: &'a BotOptions,
+}
+
+impl Playing<'_> {
+    /// Takes one event (or the session's end); `Err`: why the bot stops.
+    async fn event(&mut self, event: Result<SessionEvent, ClientError>) -> Result<(), String> {
+        let me = self.report.player.unwrap_or(self.game.me());
+        match event.map_err(|e| e.to_string())? {
+            SessionEvent::Snapshot(update) => {
+                self.report.snapshot(&update);
+                self.report.observe_run(&update, me);
+                if let Some(r) = self.game.on_snapshot(&update) {
+                    if r.mispredicted || r.correction_px > 0.0 {
+                        self.brain.on_correction();
+                    }
+                    self.report.max_correction_px =
+                        self.report.max_correction_px.max(r.correction_px);
+                }
+            }
+            SessionEvent::Pong { rtt: Some(rtt), .. } => self.game.on_rtt(rtt),
+            SessionEvent::RunRecorded(standing) => self.report.told(standing),
+            SessionEvent::Notice(NoticeKind::Kick { reason }) => {
+                return Err(format!("kicked: {reason}"))
+            }
+            SessionEvent::Notice(NoticeKind::Shutdown) => return Err("server shut down".into()),
+            SessionEvent::Levels(list) => {
+                vote_once(self.session, self.options.vote, &list, self.report).await
+            }
+            SessionEvent::LevelChange(welcome) if welcome == *self.session.welcome() => {
+                self.next_level(&welcome).await?;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The room moved to the level of `welcome`: fetch it (or take the
+    /// level file, if it is that one), play on there with the clock going
+    /// on, the brain told.
+    async fn next_level(&mut self, welcome: &Welcome) -> Result<(), String> {
+        let file = self
+            .options
+            .level
+            .as_deref()
+            .and_then(|file| level_for(welcome, Some(file)).ok());
+        let level = match file {
+            Some(level) => level,
+            None => {
+                let fetch = fetch_options(self.options);
+                fetch_level(self.session, &fetch, |_, _| {})
+                    .await
+                    .map_err(|e| level_change_failed(welcome, &e))?
+                    .0
+                    .level
+            }
+        };
+        let next = self
+            .game
+            .next_level(welcome, level, Instant::now())
+            .map_err(|e| level_change_failed(welcome, &e))?;
+        let old = std::mem::replace(self.game, next);
+        let stats = old.predictor().stats();
+        self.report.earlier.corrections += stats.corrections;
+        self.report.earlier.mispredictions += stats.mispredictions;
+        self.report.next_level(&welcome.level_id);
+        self.brain.on_level(self.game.level());
+        Ok(())
+    }
+}
+
+/// Votes for level `vote` (an index into `list`) the first time a list
+/// comes, saying in `report.vote` what was done.
+pub(crate) async fn vote_once(
+    session: &mut Session,
+    vote: Option<u32>,
+    list: &LevelList,
+    report: &mut BotReport,
+) {
+    let Some(level) = vote.filter(|_| report.vote.is_none()) else {
+        return;
+    };
+    report.vote = Some(match list.levels.get(level as usize) {
+        None => format!(
+            "no level {level} to vote for (the server has {})",
+            list.levels.len()
+        ),
+        Some(choice) => match session.vote(level).await {
+            Ok(()) => format!("voted for level {level} ({:?})", choice.id),
+            Err(e) => format!("the vote for level {level} was not sent: {e}"),
+        },
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ledge_shared::protocol::{EntityState, StateSnapshot};
+
+    /// A snapshot of `tick` with player `me` at the goal or not.
+    fn update(tick: u64, me: PlayerId, won: bool) -> SnapshotUpdate {
+        let flags = if won { player_flags::WON } else { 0 };
+        SnapshotUpdate {
+            state: StateSnapshot {
+                tick,
+                entities: vec![EntityState {
+                    flags,
+                    ..EntityState::zero(me.0)
+                }],
+            },
+            baseline_tick: None,
+            previous_tick: None,
+            last_input_tick: None,
+            input_timing: 0,
+            via_stream: false,
+            wire_bytes: 0,
+            received: Instant::now(),
+        }
+    }
+
+    /// Runs finished are counted on the level they were run on, and the
+    /// report's line says so, in the documented format.
+    #[test]
+    fn the_report_counts_the_runs_finished_on_each_level() {
+        let me = PlayerId(4);
+        let mut report = BotReport {
+            name: "bot-1".into(),
+            brain: "runner",
+            player: Some(me),
+            levels: vec![LevelPlayed::new("default")],
+            ..BotReport::default()
+        };
+        report.observe_run(&update(10, me, false), me);
+        report.observe_run(&update(20, me, true), me);
+        report.observe_run(&update(30, me, true), me);
+        // The room moves on while our player stands at the goal: the new
+        // level's first finish counts there.
+        report.next_level("second");
+        report.observe_run(&update(40, me, false), me);
+        report.observe_run(&update(50, me, true), me);
+        report.next_level("third");
+        assert_eq!(report.finishes, 2);
+        assert_eq!(
+            report.levels,
+            [
+                LevelPlayed {
+                    id: "default".into(),
+                    finishes: 1
+                },
+                LevelPlayed {
+                    id: "second".into(),
+                    finishes: 1
+                },
+                LevelPlayed::new("third"),
+            ]
+        );
+        let line = report.to_string();
+        assert!(
+            line.contains(
+                r#"  levels: "default" finished 1, "second" finished 1, "third" finished 0"#
+            ),
+            "{line}"
+        );
+        assert!(!line.contains("vote:"), "{line}");
+        report.vote = Some("voted for level 1 (\"second\")".into());
+        assert!(
+            report
+                .to_string()
+                .contains(r#"vote: voted for level 1 ("second")"#),
+            "{line}"
+        );
+    }
 }

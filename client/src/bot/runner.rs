@@ -43,7 +43,7 @@ use std::collections::VecDeque;
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::game::{Game, GameEvent, PlayerView};
 use ledge_shared::input::Buttons;
-use ledge_shared::level::{RouteAction, Waypoint};
+use ledge_shared::level::{Level, RouteAction, Waypoint};
 use ledge_shared::protocol::PlayerId;
 use ledge_shared::world::Sides;
 
@@ -136,6 +136,9 @@ pub struct Runner {
     origin: usize,
     /// Recoveries in a row on the way to waypoint `origin`.
     retries: u32,
+    /// A new level began: take the route from where the player stands,
+    /// at its first sight.
+    restart: bool,
     progress: RunnerProgress,
 }
 
@@ -154,6 +157,7 @@ impl Runner {
             stall: 0,
             origin: usize::MAX,
             retries: 0,
+            restart: false,
             progress: RunnerProgress::default(),
         }
     }
@@ -440,6 +444,24 @@ impl Brain for Runner {
         self.cooldown = 0;
     }
 
+    /// The route starts over (the same route: a level bundle carries none,
+    /// so the rotation's levels share the runner's), from the player's
+    /// spawn; the counters go on.
+    fn on_level(&mut self, _level: &Level) {
+        self.next = 0;
+        self.plan.clear();
+        self.cooldown = 0;
+        self.blocked = 0;
+        self.recovering = false;
+        self.watched = usize::MAX;
+        self.closest = i32::MAX;
+        self.stall = 0;
+        self.origin = usize::MAX;
+        self.retries = 0;
+        self.restart = true;
+        self.progress.won = false;
+    }
+
     fn progress(&self) -> String {
         let p = self.progress();
         format!(
@@ -456,6 +478,9 @@ impl Brain for Runner {
         let Some(p) = game.player(me) else {
             return Buttons::NONE;
         };
+        if std::mem::take(&mut self.restart) {
+            self.resume_from(&p);
+        }
         if p.won {
             self.progress.won = true;
             return Buttons::NONE;
@@ -597,6 +622,40 @@ mod tests {
             runner.target()
         );
         assert_eq!(runner.progress().recoveries, 0, "it never left its route");
+    }
+
+    /// A runner that finished one level runs the next from its spawn
+    /// (here the same level again, a fresh game from a later tick, as a
+    /// room moving on starts it).
+    #[test]
+    fn a_runner_runs_the_next_level_after_finishing_one() {
+        let level = default_level();
+        let me = PlayerId(1);
+        let mut game = Game::from_level(&level).unwrap();
+        game.add_player(me).unwrap();
+        let mut runner = Runner::new(default_route());
+        let first = play(&mut game, me, &mut runner, 60 * 60).expect("the first level");
+        // Standing at the goal a while: done.
+        for _ in 0..30 {
+            let b = runner.buttons(&game, me);
+            game.step(&[(me, b)]);
+        }
+        assert!(runner.done());
+        let searched = runner.progress().searches;
+
+        let mut next = Game::from_level(&level).unwrap();
+        assert!(next.start_at(first + 600));
+        next.add_player(me).unwrap();
+        runner.on_level(&level);
+        assert!(!runner.done(), "a new run to make");
+        assert_eq!(runner.progress().waypoint, 0);
+        let second = play(&mut next, me, &mut runner, 60 * 60);
+        assert!(
+            second.is_some(),
+            "stuck before waypoint {:?}",
+            runner.target()
+        );
+        assert!(runner.progress().searches > searched, "the counters go on");
     }
 
     #[test]

@@ -14,7 +14,7 @@ use ledge_shared::input::Buttons;
 use ledge_shared::protocol::NoticeKind;
 
 use super::brain::RandomWalker;
-use super::run::{BotOptions, BotReport};
+use super::run::{vote_once, BotOptions, BotReport, LevelPlayed};
 use crate::game::clock::InputClock;
 use crate::net::session::{JoinOptions, SessionEvent};
 use crate::net::trust::{connect_trusted, Trust};
@@ -27,8 +27,9 @@ pub const THIN: &str = "thin";
 /// `walker`'s buttons once per server tick for `options.duration`, reads
 /// every snapshot, and leaves.
 ///
-/// Of `options`, the name, room and duration apply (no prediction: no level,
-/// margin or goal). In the report, `ticks` counts the inputs sent and `net`
+/// Of `options`, the name, room, duration and vote apply (no prediction: no
+/// level, margin or goal; a level change is only counted, the clock going
+/// on). In the report, `ticks` counts the inputs sent and `net`
 /// holds the round-trip time and QUIC's bytes per second; failures end up
 /// in [`BotReport::ended`].
 pub async fn run_thin(
@@ -67,6 +68,7 @@ pub async fn run_thin_with(
         }
     };
     report.player = Some(session.welcome().player_id);
+    report.levels = vec![LevelPlayed::new(&session.welcome().level_id)];
     let started = Instant::now();
     let deadline = started + options.duration;
     let mut clock = InputClock::new(session.welcome(), started);
@@ -95,7 +97,16 @@ pub async fn run_thin_with(
         match event {
             Ok(SessionEvent::Snapshot(update)) => {
                 report.snapshot(&update);
+                report.observe_run(&update, session.welcome().player_id);
                 clock.observe(update.input_timing);
+            }
+            // The room's tick goes on across a level change: so does our
+            // clock (no level to predict, none to fetch).
+            Ok(SessionEvent::LevelChange(welcome)) if welcome == *session.welcome() => {
+                report.next_level(&welcome.level_id);
+            }
+            Ok(SessionEvent::Levels(list)) => {
+                vote_once(&mut session, options.vote, &list, &mut report).await;
             }
             Ok(SessionEvent::Notice(NoticeKind::Kick { reason })) => {
                 break Some(format!("kicked: {reason}"))

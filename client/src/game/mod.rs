@@ -101,8 +101,10 @@ impl ClientGame {
     /// config) and `level` must be its level (its hash is checked). The
     /// room's tick goes on across a change, so the clock carries on where
     /// it is (when it is not behind the new welcome's tick, at the same
-    /// rate), as do the names known and whether we watch; the prediction,
-    /// the remote players and the figures start afresh.
+    /// rate) with the inputs sent for the ticks since the change (the
+    /// server ran them on the new level), as do the names known and
+    /// whether we watch; the prediction, the remote players and the
+    /// figures start afresh.
     pub fn next_level(
         &self,
         welcome: &Welcome,
@@ -117,12 +119,15 @@ impl ClientGame {
             .welcome
             .as_ref()
             .is_some_and(|w| w.timing.tick_rate == welcome.timing.tick_rate);
-        let clock = if same_rate && going.position() >= fresh.position() {
-            going
-        } else {
-            fresh
-        };
+        let carry = same_rate && going.position() >= fresh.position();
+        let clock = if carry { going } else { fresh };
         let mut game = ClientGame::with_clock(welcome, level, rtt, clock)?;
+        if carry {
+            // The ticks since the change ran on the server with the
+            // inputs we sent for them.
+            game.predictor
+                .carry_inputs(&self.predictor, welcome.server_tick);
+        }
         game.name = self.name.clone();
         game.names = self.names.clone();
         game.spectating = self.spectating;
@@ -521,6 +526,7 @@ mod tests {
     /// watching carry over, the prediction starts afresh.
     #[test]
     fn the_next_level_carries_the_clock_on() {
+        use crate::net::session::SnapshotUpdate;
         use ledge_shared::protocol::NetTiming;
         let level = ledge_levels::default_level();
         let welcome = |tick: u64, hash: u64| Welcome {
@@ -557,7 +563,7 @@ mod tests {
             "{} {was}",
             next.clock().position()
         );
-        assert_eq!(next.next_tick(), next.clock().tick());
+        assert_eq!(next.next_tick(), old.next_tick(), "the ticks go on");
         assert!(
             !next.synced(),
             "prediction waits for the new level's snapshot"
@@ -571,6 +577,42 @@ mod tests {
             None,
             "no body until synced"
         );
+        // The server runs the new level from tick 1060 with the inputs we
+        // sent for those ticks (predicted on the old level): after its
+        // first snapshot the new game replays them, and predicts the next
+        // snapshot exactly.
+        let mut old = old;
+        let right = Buttons(Buttons::RIGHT);
+        for _ in 0..old.advance(later) {
+            old.step(right);
+        }
+        let mut next = old
+            .next_level(&welcome(1060, hash), level.clone(), later)
+            .unwrap();
+        assert_eq!(next.next_tick(), old.next_tick());
+        let mut server = Game::from_level(&level).unwrap();
+        assert!(server.start_at(1060));
+        server.add_player(PlayerId(1)).unwrap();
+        let snapshot = |server: &Game| SnapshotUpdate {
+            state: server.snapshot(),
+            baseline_tick: None,
+            previous_tick: None,
+            last_input_tick: Some(server.tick() - 1),
+            input_timing: 0,
+            via_stream: true,
+            wire_bytes: 0,
+            received: later,
+        };
+        for _ in 0..20 {
+            server.step(&[(PlayerId(1), right)]);
+        }
+        assert!(next.on_snapshot(&snapshot(&server)).unwrap().first);
+        next.step(right);
+        while server.tick() < next.next_tick() {
+            server.step(&[(PlayerId(1), right)]);
+        }
+        let r = next.on_snapshot(&snapshot(&server)).unwrap();
+        assert!(r.compared && !r.mispredicted, "{r:?}");
         // A change ahead of our clock: the clock starts from it.
         let ahead = old
             .next_level(&welcome(50_000, hash), level.clone(), later)

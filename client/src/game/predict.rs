@@ -154,6 +154,25 @@ impl Predictor {
         })
     }
 
+    /// Takes over `other`'s inputs of ticks `since` and later, and its
+    /// next tick, before the first snapshot: the game of the room's next
+    /// level, whose first ticks (from `since`, the change's) the server
+    /// runs with the inputs already sent for them, predicted on the old
+    /// level. Without them the replay after the new level's first
+    /// snapshot would hold nothing for those ticks and mispredict.
+    pub fn carry_inputs(&mut self, other: &Predictor, since: u64) {
+        if self.synced {
+            return;
+        }
+        self.inputs = other
+            .inputs
+            .iter()
+            .filter(|&&(t, _)| t >= since)
+            .copied()
+            .collect();
+        self.next_tick = other.next_tick;
+    }
+
     /// A predictor running `game` locally with no server: `me` is added to
     /// it and prediction starts at once (offline play, tests).
     pub fn offline(mut game: Game, me: PlayerId) -> Result<Predictor, GameError> {

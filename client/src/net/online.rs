@@ -379,7 +379,9 @@ impl<N: Network> OnlineGame<N> {
                 game.set_spectating(self.spectate);
                 game.set_player_names(&self.net.players());
                 self.game = Some(game);
-                self.fresh = true;
+                // A next level's game goes on with the clock: its due
+                // ticks are play.
+                self.fresh = !next;
                 self.last_news = Some(now);
             }
             Err(e) => {

@@ -66,6 +66,22 @@ impl TestServer {
         }
     }
 
+    /// Starts a server rotating through [`two_levels`] (written into
+    /// `dir`) in one room, with votes by majority and a second between a
+    /// decision and the change.
+    pub fn rotating(dir: &std::path::Path) -> TestServer {
+        let levels = two_levels(dir);
+        TestServer::start_with(move |c| {
+            c.levels = levels;
+            c.rooms = 1;
+            c.rotation = ledge_server::config::RotationConfig {
+                level_time: None,
+                results_time: Duration::from_secs(1),
+                vote: ledge_shared::protocol::VoteRule::Majority,
+            };
+        })
+    }
+
     /// Runs `name`, a runner bot, along the default level's route to the
     /// goal (it leaves once its run is recorded, or after 40 s) and
     /// returns its report.
@@ -104,6 +120,18 @@ impl TestServer {
             let _ = tokio::time::timeout(Duration::from_secs(5), task).await;
         });
     }
+}
+
+/// The default level's files, and a copy of the level named `second`, in
+/// `dir`: a rotation of two levels (the same ground, another bundle to
+/// download).
+pub fn two_levels(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../levels/default");
+    for name in ["ledge.ogmo", "default.json"] {
+        std::fs::copy(src.join(name), dir.join(name)).unwrap();
+    }
+    std::fs::copy(src.join("default.json"), dir.join("second.json")).unwrap();
+    vec![dir.join("default.json"), dir.join("second.json")]
 }
 
 /// Runs `command` to its end with piped output; kills it and fails the test

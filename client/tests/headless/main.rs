@@ -5,5 +5,6 @@
 mod common;
 
 mod online_game;
+mod rotation;
 mod runner_race;
 mod thin_bot;

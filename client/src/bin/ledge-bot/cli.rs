@@ -79,13 +79,18 @@ struct Cli {
     /// Name prefix (bots are PREFIX-1, PREFIX-2, ...).
     #[arg(long, default_value = "bot")]
     name: String,
-    /// Runners leave when they reach the goal.
+    /// Runners leave when they reach the goal (the first: on a server
+    /// rotating levels they do not wait for the next).
     #[arg(long)]
     stop_at_goal: bool,
     /// Input margin kept with no jitter, ticks (more tolerates a loaded
     /// machine: many bots planning at once).
     #[arg(long, value_name = "TICKS")]
     margin: Option<f64>,
+    /// Vote for the level at index N of the server's level list (0 is the
+    /// first) once the list arrives; each bot's line says how it went.
+    #[arg(long, value_name = "N")]
+    vote: Option<u32>,
 }
 
 /// Runs the bots the command line asks for.
@@ -127,6 +132,7 @@ async fn run(cli: Cli) -> ExitCode {
             level: cli.level.clone(),
             level_cache: cli.level_cache.clone().or_else(LevelCache::default_dir),
             min_margin: cli.margin,
+            vote: cli.vote,
             ..BotOptions::new(&format!("{}-{}", cli.name, i + 1), duration)
         };
         let server = cli.connect.clone();

@@ -9,7 +9,11 @@
 //! Runs N bots in one process on one tokio runtime, each with its own QUIC
 //! connection, clock, prediction and brain, and prints one line per bot at
 //! the end: ticks, corrections, RTT, whether the server saw it reach the
-//! goal. Without `--cert-hash` the certificate is trusted on first use
+//! goal, and the levels it played with the runs it finished on each
+//! (`levels: "ID" finished N, "ID2" finished M`: a room rotating levels
+//! moves its bots on, and they play on there). `--vote N` votes for the
+//! level at index N of the server's list once it arrives (`vote: ...` on
+//! the line says how it went). Without `--cert-hash` the certificate is trusted on first use
 //! (`--known-hosts`, default in the user's configuration folder).
 //!
 //! `--brain thin` runs thin bots instead (`ledge_client::bot::thin`): the
