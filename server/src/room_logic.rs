@@ -302,7 +302,8 @@ impl Member {
         self.packets_seen = 0;
         self.packets_at_snapshot = 0;
         self.last_snapshot = None;
-        self.stream_until = None;
+        // A level change it has not acknowledged yet (made while it was
+        // lost, say) still holds: its snapshots stay on the stream.
     }
 
     /// The acknowledged baseline and the timing to report in a snapshot
@@ -1903,6 +1904,42 @@ mod level_change_tests {
         let acked = step(&mut room, 2, t0);
         assert!(acked.iter().any(|a| matches!(a, Action::Snapshot { to, outgoing: Outgoing::Datagram(_), .. } if *to == PlayerId(1))), "datagrams again once acknowledged");
         drop(watcher);
+    }
+
+    #[test]
+    fn a_player_lost_during_a_change_resumes_on_the_new_level() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut room = room(dir.path(), VoteRule::Off);
+        let t0 = Instant::now();
+        room.join(PlayerId(1), "ann".into()).unwrap();
+        step(&mut room, 10, t0);
+        room.detach(PlayerId(1), 0);
+        room.change_level(1);
+        let at = room.game().tick();
+        step(&mut room, 10, t0);
+        let resumed = room.rejoin(PlayerId(1)).expect("kept for a resume");
+        assert_eq!(resumed.joined.welcome.level_id, "second");
+        assert_eq!(
+            resumed.joined.welcome.level,
+            room.config().levels.get(1).offer
+        );
+        let after = step(&mut room, 4, t0);
+        let sent: Vec<bool> = after
+            .iter()
+            .filter_map(|a| match a {
+                Action::Snapshot {
+                    to, tick, outgoing, ..
+                } if *to == PlayerId(1) => {
+                    assert!(*tick > at);
+                    Some(matches!(outgoing, Outgoing::Datagram(_)))
+                }
+                _ => None,
+            })
+            .collect();
+        assert!(
+            !sent.is_empty() && sent.iter().all(|d| !d),
+            "on the stream: {sent:?}"
+        );
     }
 
     #[test]
