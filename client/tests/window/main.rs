@@ -9,6 +9,7 @@ mod art_screenshot;
 mod chat_screenshot;
 mod failure_screenshot;
 mod ghost_screenshot;
+mod levels_screenshot;
 mod replay_check;
 mod replay_files;
 mod replay_screenshot;

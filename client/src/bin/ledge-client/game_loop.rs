@@ -27,10 +27,10 @@ use crate::draw::art::ArtView;
 use crate::draw::camera::{self, Camera};
 use crate::draw::ghost::{self, GhostSprite};
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
-use crate::draw::{card, chat as chat_view, fx, hud, scene};
+use crate::draw::{card, chat as chat_view, fx, hud, levels, scene};
 use crate::frame::{sound_notice, FrameClock};
 use crate::input::keys::{Bindings, Gamepads};
-use crate::input::script::Script;
+use crate::input::script::{Press, Script};
 use crate::input::typing;
 use crate::outcome::{fail, EXIT_FAILED, EXIT_JOIN_TIMEOUT, EXIT_UNTRUSTED};
 use crate::spectate::{self, Spectate};
@@ -147,6 +147,12 @@ struct GameLoop {
     show_net: bool,
     /// The ghosts are drawn (their key toggles them).
     show_ghosts: bool,
+    /// The server's level list is open (its key toggles it; a vote
+    /// closes it).
+    show_levels: bool,
+    /// The room's level changes seen ([`play::Play::level_changes`]): when
+    /// it grows, what was drawn of the old level goes.
+    level_changes: u64,
     /// Our run's split times against the first ghost.
     splits: Splits,
     /// Spectating: whom the camera follows.
@@ -160,6 +166,8 @@ struct GameLoop {
     /// When the player first moved (the controls hint fades after it).
     first_move: Option<f64>,
     restart_key: String,
+    /// The level list key's name, for the HUD.
+    levels_key: String,
     /// Ticks of play so far: the script's clock and --exit-after-ticks'.
     played: u64,
     frame_clock: FrameClock,
@@ -211,6 +219,12 @@ struct Hud {
     split: Option<(Split, String)>,
     /// Spectating: the line saying whom we watch.
     spectate: Option<String>,
+    /// The level list, when open.
+    levels: Option<levels::LevelsView>,
+    /// "next: NAME in N s", once the room's move is decided.
+    next_level: Option<String>,
+    /// A level downloading: what, bytes so far, its size.
+    downloading: Option<(&'static str, u64, u64)>,
 }
 
 impl GameLoop {
@@ -233,6 +247,11 @@ impl GameLoop {
             .restart_keys()
             .first()
             .map_or_else(|| "-".to_owned(), |k| format!("{k:?}"));
+        let levels_key = setup
+            .bindings
+            .levels
+            .first()
+            .map_or_else(|| "-".to_owned(), |k| format!("{k:?}"));
         let art = ArtView::new(
             std::mem::take(&mut setup.level_art),
             &setup.play.level().tilemap,
@@ -247,6 +266,8 @@ impl GameLoop {
             show_hud: setup.hud,
             show_net: setup.net,
             show_ghosts: true,
+            show_levels: false,
+            level_changes: 0,
             splits: Splits::default(),
             spectate: setup.spectate.then(|| Spectate::new(setup.follow.clone())),
             audio,
@@ -255,6 +276,7 @@ impl GameLoop {
             effects: fx::Fx::default(),
             first_move: None,
             restart_key,
+            levels_key,
             played: 0,
             frame_clock: FrameClock::new(),
             art,
@@ -279,12 +301,15 @@ impl GameLoop {
         self.type_chat(now);
         if !chatting && !self.chat.is_open() {
             self.toggle_overlays();
+            let pressed = Bindings::pressed(&self.setup.bindings.levels);
+            self.level_keys(pressed, Bindings::number_pressed(), now);
         }
         let dt = self.frame_clock.lap();
         let before = self.played;
         self.simulate(now);
         self.race_ghosts(now);
         self.script_chat(before, now);
+        self.script_keys(before, now);
         self.receive_chat(now);
         let cued = self.play_sounds();
         let stats = self.watch_network(now);
@@ -366,13 +391,73 @@ impl GameLoop {
         }
     }
 
-    /// Swaps in the server's level art once joined (it comes with its level).
+    /// Swaps in the server's level art once joined (it comes with its
+    /// level), and again each time the room moves to another level (the
+    /// splits against the old level's ghost go too).
     fn adopt_server_art(&mut self) {
+        let changes = self.setup.play.level_changes();
+        let changed = changes != self.level_changes;
+        if changed {
+            self.level_changes = changes;
+            self.server_art = false;
+            self.splits = Splits::default();
+        }
         if !self.server_art && self.setup.play.joined() {
-            if let Some(level_art) = self.setup.play.level_art() {
-                self.art = ArtView::new(level_art.clone(), &self.setup.play.level().tilemap);
+            let art = self.setup.play.level_art().cloned();
+            if art.is_some() || changed {
+                let tiles = &self.setup.play.level().tilemap;
+                self.art = ArtView::new(art.unwrap_or_default(), tiles);
             }
             self.server_art = true;
+        }
+    }
+
+    /// The script's window keys of the ticks just played (from tick
+    /// `before`), pressed.
+    fn script_keys(&mut self, before: u64, now: f64) {
+        let Some(script) = &self.setup.script else {
+            return;
+        };
+        let presses: Vec<Press> = script.pressed(before..self.played).collect();
+        for press in presses {
+            match press {
+                Press::Levels => self.level_keys(true, None, now),
+                Press::Number(n) => self.level_keys(false, Some(n), now),
+            }
+        }
+    }
+
+    /// The level list's key (`toggle`) opens or closes it; while it is
+    /// open a number key (`number`) votes for that level and closes it
+    /// (the chat says what came of it).
+    fn level_keys(&mut self, toggle: bool, number: Option<u32>, now: f64) {
+        if toggle {
+            self.show_levels = !self.show_levels;
+            if self.show_levels && self.setup.play.levels().is_none() {
+                self.show_levels = false;
+                self.chat
+                    .tell("no level list: the server has not sent one", now);
+            }
+            return;
+        }
+        if !self.show_levels {
+            return;
+        }
+        let Some(number) = number else {
+            return;
+        };
+        match self.setup.play.vote(number - 1) {
+            Ok(()) => {
+                let name = self
+                    .setup
+                    .play
+                    .levels()
+                    .and_then(|l| l.levels.get(number as usize - 1))
+                    .map_or_else(String::new, |l| l.name.clone());
+                self.chat.tell(&format!("voted for {number}. {name}"), now);
+                self.show_levels = false;
+            }
+            Err(why) => self.chat.tell(&format!("no vote: {why}"), now),
         }
     }
 
@@ -657,7 +742,14 @@ impl GameLoop {
             let following = scene.followed.map(|_| name.as_str());
             spectate::line(room, following)
         });
+        let list = self.setup.play.levels();
+        let next_in = self.setup.play.next_level_in();
         Hud {
+            levels: list
+                .filter(|_| self.show_levels)
+                .map(|l| levels::view(l, next_in)),
+            next_level: list.and_then(|l| levels::next_line(l, next_in)),
+            downloading: self.setup.play.downloading(),
             failure,
             run,
             name,
@@ -722,6 +814,15 @@ impl GameLoop {
                 results: &hud.results,
                 split: hud.split.as_ref().map(|(s, t)| (t.as_str(), s.faster())),
                 spectate: hud.spectate.as_deref(),
+                next_level: hud.next_level.as_deref(),
+                // Only where there is a choice: a server of one level
+                // sends its list too.
+                levels_key: self
+                    .setup
+                    .play
+                    .levels()
+                    .filter(|l| l.levels.len() > 1)
+                    .map(|_| self.levels_key.as_str()),
             };
             hud::draw(&info, &self.graph, now);
             if let Some(card) = &hud.card {
@@ -729,6 +830,12 @@ impl GameLoop {
             }
         }
         if hud.failure.is_none() {
+            if let Some(view) = &hud.levels {
+                levels::draw(view);
+            }
+            if let Some((what, got, total)) = hud.downloading {
+                levels::progress(&levels::progress_text(what, got, total), got, total);
+            }
             chat_view::draw(&hud.chat);
         }
         if let (None, Some(text)) = (&hud.failure, self.setup.play.banner()) {
@@ -829,6 +936,13 @@ impl GameLoop {
             ghosts_shown: self.show_ghosts,
             split: hud.split.as_ref().map(|(s, t)| (s, t.clone())),
             spectate: self.spectate_shot(scene, hud),
+            levels: self.setup.play.levels().map(|list| shot::LevelsShot {
+                list,
+                panel: hud.levels.as_ref(),
+                next_line: hud.next_level.as_deref().filter(|_| self.show_hud),
+                level_changes: self.level_changes,
+            }),
+            downloading: hud.downloading.filter(|_| hud.failure.is_none()),
         };
         if let Err(e) = shot::save(path, &shot) {
             fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));

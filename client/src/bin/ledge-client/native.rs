@@ -44,7 +44,8 @@ Esc quits.";
 /// Keys (rebind with --keys FILE; --print-keys shows the defaults): arrows
 /// or WASD move, space, Z or K jump, down + jump drops through one-way
 /// ledges, R restarts the run, M mutes, F1 debug overlay, F2 HUD on/off,
-/// F3 network panel, G ghosts, T or Enter chat, Esc quits. Gamepads need
+/// F3 network panel, G ghosts, T or Enter chat, V the server's level list
+/// (1-9 vote for the next level), Esc quits. Gamepads need
 /// the `gamepad` build feature. Spectating (--spectate): Tab / Shift+Tab
 /// the next player, F free camera (WASD moves it).
 #[derive(Debug, Parser)]

@@ -269,6 +269,62 @@ impl Play {
         (count, lines)
     }
 
+    /// The server's levels, votes and when the room moves on (online,
+    /// once the server said).
+    pub fn levels(&self) -> Option<&ledge_shared::protocol::LevelList> {
+        self.connection()?.levels()
+    }
+
+    /// Votes for level `index` (0: the first of [`Play::levels`]) to be
+    /// played next; why not, in words, if it cannot be.
+    pub fn vote(&mut self, index: u32) -> Result<(), String> {
+        let spectating = self.spectating();
+        let Mode::Online(online) = &mut self.mode else {
+            return Err("offline: there are no levels to vote for".to_owned());
+        };
+        let Some(list) = online.levels() else {
+            return Err("the server has not sent its levels yet".to_owned());
+        };
+        if list.rule == ledge_shared::protocol::VoteRule::Off {
+            return Err("this server takes no votes: its levels come in turn".to_owned());
+        }
+        if index as usize >= list.levels.len() {
+            return Err(format!("there is no level {}", index + 1));
+        }
+        if spectating {
+            return Err("spectators cannot vote: join as a player to vote".to_owned());
+        }
+        if online.vote(index) {
+            Ok(())
+        } else {
+            Err("the connection is busy: try again".to_owned())
+        }
+    }
+
+    /// How long until the room moves to its next level, when decided.
+    pub fn next_level_in(&self) -> Option<Duration> {
+        self.connection()?.next_level_in()
+    }
+
+    /// A level downloading: what (the server's level on joining, or the
+    /// room's next one), and bytes so far of its size.
+    pub fn downloading(&self) -> Option<(&'static str, u64, u64)> {
+        let online = self.connection()?;
+        if let Some((got, total)) = online.changing_level() {
+            return Some(("the next level", got, total));
+        }
+        match online.status() {
+            NetStatus::Downloading { got, total } => Some(("the server's level", *got, *total)),
+            _ => None,
+        }
+    }
+
+    /// How many times the room moved to another level (0 offline): the
+    /// window forgets what it drew of the old one when this grows.
+    pub fn level_changes(&self) -> u64 {
+        self.connection().map_or(0, OnlineGame::level_changes)
+    }
+
     /// The runs to race against the server sent (the level's record,
     /// our best; none offline).
     pub fn ghosts(&self) -> &[ledge_client::ghost::Ghost] {

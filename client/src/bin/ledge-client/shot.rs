@@ -90,6 +90,21 @@
 //!               "follow": "following bob (Tab: next)   tick 1530", "failure": null},
 //!     "end_banner": null               // ["end of replay", "Space or Home: ..."] when drawn
 //!   },                                 // ("player" above is the followed player)
+//!   "levels": {                        // null offline, in a replay, or before the server's list
+//!     "rule": "majority",              // "off", "majority", "host"
+//!     "current": 0, "next": 1,         // indexes into "list"
+//!     "change_at": 5400,               // the room tick it moves on at; null: not decided
+//!     "list": [{"number": 1, "id": "default", "name": "default", "votes": 0,
+//!               "current": true, "next": false}, ...],
+//!     "panel": {                       // the list's panel (V); null when closed
+//!       "title": "levels - vote: ...", "lines": ["1. default   0 votes   < playing", ...],
+//!       "more": 0, "footer": ["next level in 4 s", "1-2: vote   V: close"]
+//!     },
+//!     "next_line": "next: second in 4 s",  // the HUD's line; null unless decided
+//!     "level_changes": 1               // the room's moves to another level seen
+//!   },
+//!   "downloading": {"what": "the next level", "got": 1024, "total": 4096},
+//!                                      // the progress bar; null unless a level downloads
 //!   "failure": {                       // null unless the session failed
 //!     "message": "cannot join ...",    // as printed on stderr
 //!     "font_size": 20.0,
@@ -149,6 +164,24 @@ pub struct Shot<'a> {
     pub split: Option<(&'a Split, String)>,
     /// What a spectator watched (`--spectate`).
     pub spectate: Option<SpectateShot<'a>>,
+    /// The server's levels as shown (`None`: offline, a replay, or no
+    /// list from the server yet).
+    pub levels: Option<LevelsShot<'a>>,
+    /// A level downloading, as its progress bar showed it: what, bytes so
+    /// far, its size.
+    pub downloading: Option<(&'a str, u64, u64)>,
+}
+
+/// The server's levels as the window showed them.
+pub struct LevelsShot<'a> {
+    /// The list as the server last sent it.
+    pub list: &'a ledge_shared::protocol::LevelList,
+    /// The list's panel as drawn (`None`: closed).
+    pub panel: Option<&'a crate::draw::levels::LevelsView>,
+    /// The HUD's "next: NAME in N s", when drawn.
+    pub next_line: Option<&'a str>,
+    /// The room's level changes seen so far.
+    pub level_changes: u64,
 }
 
 /// A spectator's frame.
@@ -376,9 +409,82 @@ pub fn describe(shot: &Shot, png: &Path, width: u16, height: u16) -> String {
     );
     describe_chat(&mut s, shot.chat.as_ref());
     describe_replay(&mut s, shot.replay.as_ref());
+    describe_levels(&mut s, shot.levels.as_ref());
+    match shot.downloading {
+        Some((what, got, total)) => {
+            let _ = writeln!(
+                s,
+                "  \"downloading\": {{\"what\": {}, \"got\": {got}, \"total\": {total}}},",
+                json_string(what)
+            );
+        }
+        None => {
+            let _ = writeln!(s, "  \"downloading\": null,");
+        }
+    }
     describe_failure(&mut s, shot.failure);
     s.push_str("}\n");
     s
+}
+
+/// `value` as JSON, `null` when absent.
+fn json_or_null<T: std::fmt::Display>(value: Option<T>) -> String {
+    value.map_or_else(|| "null".to_owned(), |v| v.to_string())
+}
+
+/// The server's levels (`null` without a list): the list, the panel if
+/// open, the HUD's line.
+fn describe_levels(s: &mut String, levels: Option<&LevelsShot>) {
+    let Some(l) = levels else {
+        let _ = writeln!(s, "  \"levels\": null,");
+        return;
+    };
+    let list = l.list;
+    let rows: Vec<String> = list
+        .levels
+        .iter()
+        .enumerate()
+        .map(|(i, level)| {
+            format!(
+                "{{\"number\": {}, \"id\": {}, \"name\": {}, \"votes\": {}, \"current\": {}, \"next\": {}}}",
+                i + 1,
+                json_string(&level.id),
+                json_string(&level.name),
+                list.votes.get(i).copied().unwrap_or(0),
+                i == list.current as usize,
+                i == list.next as usize
+            )
+        })
+        .collect();
+    let panel = l.panel.map_or_else(
+        || "null".to_owned(),
+        |p| {
+            let strings = |v: &mut dyn Iterator<Item = &str>| {
+                v.map(json_string).collect::<Vec<_>>().join(", ")
+            };
+            format!(
+                "{{\"title\": {}, \"lines\": [{}], \"more\": {}, \"footer\": [{}]}}",
+                json_string(&p.title),
+                strings(&mut p.rows.iter().map(|r| r.text.as_str())),
+                p.more,
+                strings(&mut p.footer.iter().map(String::as_str))
+            )
+        },
+    );
+    let _ = writeln!(s, "  \"levels\": {{");
+    let _ = writeln!(s, "    \"rule\": {},", json_string(list.rule.name()));
+    let _ = writeln!(
+        s,
+        "    \"current\": {}, \"next\": {},",
+        list.current, list.next
+    );
+    let _ = writeln!(s, "    \"change_at\": {},", json_or_null(list.change_at));
+    let _ = writeln!(s, "    \"list\": [{}],", rows.join(", "));
+    let _ = writeln!(s, "    \"panel\": {panel},");
+    let next = l.next_line.map_or("null".to_owned(), json_string);
+    let _ = writeln!(s, "    \"next_line\": {next},");
+    let _ = writeln!(s, "    \"level_changes\": {}", l.level_changes);
+    let _ = writeln!(s, "  }},");
 }
 
 /// What a spectator watched (`null` unless spectating).
@@ -730,6 +836,8 @@ mod tests {
             ghosts_shown: true,
             split: None,
             spectate: None,
+            levels: None,
+            downloading: None,
         }
     }
 
@@ -915,6 +1023,79 @@ mod tests {
         let json: serde_json::Value =
             serde_json::from_str(&describe(&none, Path::new("f.png"), 480, 270)).expect("JSON");
         assert!(json["failure"].is_null());
+    }
+
+    /// The level list: each level with its votes and marks, the panel's
+    /// lines when open, the HUD's line, a download's progress.
+    #[test]
+    fn json_tells_the_levels_the_panel_and_a_download() {
+        use ledge_shared::protocol::{LevelChoice, LevelList, VoteRule};
+        let view = View {
+            zoom: 1.0,
+            offset: Vec2::ZERO,
+            screen: Vec2::new(480.0, 270.0),
+        };
+        let list = LevelList {
+            levels: ["default", "se\"cond"]
+                .map(|n| LevelChoice {
+                    id: n.into(),
+                    name: n.into(),
+                })
+                .to_vec(),
+            current: 0,
+            next: 1,
+            votes: vec![0, 2],
+            rule: VoteRule::Majority,
+            change_at: Some(900),
+        };
+        let panel = crate::draw::levels::view(&list, Some(std::time::Duration::from_secs(4)));
+        let shot = Shot {
+            levels: Some(LevelsShot {
+                list: &list,
+                panel: Some(&panel),
+                next_line: Some("next: second in 4 s"),
+                level_changes: 2,
+            }),
+            downloading: Some(("the next level", 1024, 4096)),
+            ..blank(&view)
+        };
+        let json: serde_json::Value =
+            serde_json::from_str(&describe(&shot, Path::new("l.png"), 480, 270)).expect("JSON");
+        let levels = &json["levels"];
+        assert_eq!(levels["rule"], "majority");
+        assert_eq!(levels["change_at"], 900);
+        assert_eq!(levels["list"][1]["name"], "se\"cond");
+        assert_eq!(levels["list"][1]["votes"], 2);
+        assert_eq!(levels["list"][1]["next"], true);
+        assert_eq!(levels["list"][0]["current"], true);
+        assert_eq!(
+            levels["panel"]["lines"][0],
+            "1. default   0 votes   < playing"
+        );
+        assert_eq!(levels["panel"]["footer"][0], "next level in 4 s");
+        assert_eq!(levels["next_line"], "next: second in 4 s");
+        assert_eq!(levels["level_changes"], 2);
+        assert_eq!(json["downloading"]["got"], 1024);
+        assert_eq!(json["downloading"]["what"], "the next level");
+        let closed = Shot {
+            levels: Some(LevelsShot {
+                list: &list,
+                panel: None,
+                next_line: None,
+                level_changes: 0,
+            }),
+            downloading: None,
+            ..blank(&view)
+        };
+        let json: serde_json::Value =
+            serde_json::from_str(&describe(&closed, Path::new("l.png"), 480, 270)).expect("JSON");
+        assert!(json["levels"]["panel"].is_null());
+        assert!(json["levels"]["next_line"].is_null());
+        assert!(json["downloading"].is_null());
+        let json: serde_json::Value =
+            serde_json::from_str(&describe(&blank(&view), Path::new("l.png"), 480, 270))
+                .expect("JSON");
+        assert!(json["levels"].is_null());
     }
 
     /// The card's lines as laid out: kinds, texts, the top runs' names and

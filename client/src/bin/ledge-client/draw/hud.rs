@@ -134,6 +134,11 @@ pub struct HudInfo<'a> {
     /// Spectating: the line saying whom we watch (in place of our name;
     /// the run shown is theirs).
     pub spectate: Option<&'a str>,
+    /// "next: NAME in N s", once the room's move to its next level is
+    /// decided.
+    pub next_level: Option<&'a str>,
+    /// The level list key's name, when the server sent its levels.
+    pub levels_key: Option<&'a str>,
 }
 
 /// A split we were faster in.
@@ -254,10 +259,16 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
     if let Some(run) = &info.run {
         lines.push((run_line(run), GOLD, FONT));
     }
-    let keys = match info.spectate {
+    if let Some(next) = info.next_level {
+        lines.push((next.to_owned(), WHITE, FONT));
+    }
+    let mut keys = match info.spectate {
         Some(_) => "Tab/Shift+Tab: next player   F: free camera (WASD)".to_owned(),
         None => format!("restart: {}", info.restart_key),
     };
+    if let Some(key) = info.levels_key {
+        keys.push_str(&format!("   levels: {key}"));
+    }
     lines.push((keys, DIM, 14.0));
     let mut y = 8.0 + panel(&lines, 8.0, 8.0) + 6.0;
     if let Some((text, faster)) = info.split {

@@ -2,7 +2,8 @@
 //! ([`camera`]), the world and the players ([`render`], the level's own art
 //! in [`art`]), how the players move between ticks ([`anim`]), particles,
 //! shake and flashes ([`fx`]), the ghosts to race ([`ghost`]), the heads-up display ([`hud`]), the results
-//! card once our run is finished ([`card`]), the chat ([`chat`]) and the
+//! card once our run is finished ([`card`]), the chat ([`chat`]), the
+//! server's level list and a level's download ([`levels`]) and the
 //! debug overlay ([`debug`]); the world's layers in their order
 //! ([`scene`]), and a replay's HUD ([`replay_hud`]).
 //!
@@ -18,6 +19,7 @@ pub mod debug;
 pub mod fx;
 pub mod ghost;
 pub mod hud;
+pub mod levels;
 pub mod render;
 pub mod replay_hud;
 pub mod scene;

@@ -33,6 +33,8 @@ net = ["F3"]
 ghosts = ["G"]
 # Opens the chat line (then Enter sends it, Escape closes it).
 chat = ["T", "Enter"]
+# The server's level list opens/closes (then 1-9 vote for a level).
+levels = ["V"]
 quit = ["Escape"]
 "#;
 
@@ -52,6 +54,7 @@ struct KeyFile {
     net: Option<Vec<String>>,
     ghosts: Option<Vec<String>>,
     chat: Option<Vec<String>>,
+    levels: Option<Vec<String>>,
     quit: Option<Vec<String>>,
 }
 
@@ -72,6 +75,8 @@ pub struct Bindings {
     pub ghosts: Vec<KeyCode>,
     /// Opens the chat line.
     pub chat: Vec<KeyCode>,
+    /// Opens and closes the server's level list (votes).
+    pub levels: Vec<KeyCode>,
     /// Quits.
     pub quit: Vec<KeyCode>,
 }
@@ -93,6 +98,7 @@ impl Default for Bindings {
             net: Vec::new(),
             ghosts: Vec::new(),
             chat: Vec::new(),
+            levels: Vec::new(),
             quit: Vec::new(),
         };
         empty
@@ -136,6 +142,7 @@ impl Bindings {
         keys(file.net, &mut self.net)?;
         keys(file.ghosts, &mut self.ghosts)?;
         keys(file.chat, &mut self.chat)?;
+        keys(file.levels, &mut self.levels)?;
         keys(file.quit, &mut self.quit)?;
         Ok(self)
     }
@@ -155,6 +162,18 @@ impl Bindings {
     /// The keys that restart the run.
     pub fn restart_keys(&self) -> &[KeyCode] {
         &self.buttons[5].1
+    }
+
+    /// The level number key (1 to 9, on the row above the letters or
+    /// the keypad) pressed this frame, if any: a vote while the level list
+    /// is open. No default binding uses them.
+    pub fn number_pressed() -> Option<u32> {
+        use KeyCode::*;
+        const ROW: [KeyCode; 9] = [Key1, Key2, Key3, Key4, Key5, Key6, Key7, Key8, Key9];
+        const PAD: [KeyCode; 9] = [Kp1, Kp2, Kp3, Kp4, Kp5, Kp6, Kp7, Kp8, Kp9];
+        (0..9u32)
+            .find(|&i| is_key_pressed(ROW[i as usize]) || is_key_pressed(PAD[i as usize]))
+            .map(|i| i + 1)
     }
 
     /// Whether one of `keys` was pressed this frame.
@@ -388,6 +407,7 @@ mod tests {
         assert_eq!(b.mute, [KeyCode::M]);
         assert_eq!(b.ghosts, [KeyCode::G]);
         assert_eq!(b.chat, [KeyCode::T, KeyCode::Enter]);
+        assert_eq!(b.levels, [KeyCode::V]);
         assert_eq!(b.buttons[5], (Buttons::RESTART, vec![KeyCode::R]));
         assert_eq!(b.quit, [KeyCode::Escape]);
     }
@@ -411,7 +431,7 @@ mod tests {
         );
         let mut all: Vec<KeyCode> = b.buttons.iter().flat_map(|(_, k)| k.clone()).collect();
         for keys in [
-            &b.mute, &b.debug, &b.hud, &b.net, &b.ghosts, &b.chat, &b.quit,
+            &b.mute, &b.debug, &b.hud, &b.net, &b.ghosts, &b.chat, &b.levels, &b.quit,
         ] {
             all.extend(keys.iter().copied());
         }

@@ -18,6 +18,8 @@
 //! 30..34 -> jump         # jumping on the way
 //! 120 -> down+jump       # drop through a one-way ledge
 //! 130 -> say made it     # a chat line
+//! 140 -> levels          # the level list's key (V): opens or closes it
+//! 150 -> vote 2          # the number key 2 (votes for level 2 while the list is open)
 //! ```
 
 use ledge_shared::input::Buttons;
@@ -30,12 +32,29 @@ struct Entry {
     buttons: u8,
 }
 
+/// A key the script presses (not a button: a window's own key).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Press {
+    /// The level list's key.
+    Levels,
+    /// A number key, 1 to 9.
+    Number(u32),
+}
+
 /// A parsed script.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct Script {
     entries: Vec<Entry>,
     /// `(tick, text)`: chat lines typed.
     says: Vec<(u64, String)>,
+    /// `(tick, key)`: the window's keys pressed.
+    presses: Vec<(u64, Press)>,
+}
+
+/// An entry that is not buttons held.
+enum Action {
+    Say(String),
+    Press(Press),
 }
 
 impl Script {
@@ -56,6 +75,7 @@ impl Script {
     pub fn parse(text: &str) -> Result<Script, String> {
         let mut entries = Vec::new();
         let mut says = Vec::new();
+        let mut presses = Vec::new();
         for (n, line) in text.lines().enumerate() {
             let line = line.split('#').next().unwrap_or("");
             for part in line.split(';') {
@@ -64,13 +84,26 @@ impl Script {
                     continue;
                 }
                 let at = |e| format!("line {}: {e}", n + 1);
-                match parse_say(part).map_err(at)? {
-                    Some(say) => says.push(say),
+                match parse_action(part).map_err(at)? {
+                    Some((tick, Action::Say(text))) => says.push((tick, text)),
+                    Some((tick, Action::Press(key))) => presses.push((tick, key)),
                     None => entries.push(parse_entry(part).map_err(at)?),
                 }
             }
         }
-        Ok(Script { entries, says })
+        Ok(Script {
+            entries,
+            says,
+            presses,
+        })
+    }
+
+    /// The window's keys pressed at ticks `ticks`, in order.
+    pub fn pressed(&self, ticks: std::ops::Range<u64>) -> impl Iterator<Item = Press> + '_ {
+        self.presses
+            .iter()
+            .filter(move |(t, _)| ticks.contains(t))
+            .map(|&(_, key)| key)
     }
 
     /// The chat lines typed at ticks `ticks`, in order.
@@ -106,18 +139,27 @@ fn parse_entry(part: &str) -> Result<Entry, String> {
     })
 }
 
-/// A `TICKS -> say TEXT` entry as `(first tick, TEXT)`; `None` if the
-/// entry is not a `say`.
-fn parse_say(part: &str) -> Result<Option<(u64, String)>, String> {
+/// A `TICKS -> say TEXT`, `TICKS -> levels` or `TICKS -> vote N` entry
+/// as its first tick and what it does; `None` if the entry is buttons.
+fn parse_action(part: &str) -> Result<Option<(u64, Action)>, String> {
     let Some((ticks, rest)) = part.split_once("->").or_else(|| part.split_once(':')) else {
         return Ok(None);
     };
-    let rest = rest.trim_start();
-    let Some(text) = rest.strip_prefix("say ") else {
+    let rest = rest.trim();
+    let action = if let Some(text) = rest.strip_prefix("say ") {
+        Action::Say(text.trim().to_owned())
+    } else if rest == "levels" {
+        Action::Press(Press::Levels)
+    } else if let Some(n) = rest.strip_prefix("vote ") {
+        match n.trim().parse::<u32>() {
+            Ok(n @ 1..=9) => Action::Press(Press::Number(n)),
+            _ => return Err(format!("vote {n:?}: a level number from 1 to 9")),
+        }
+    } else {
         return Ok(None);
     };
     let (start, _) = parse_ticks(ticks.trim())?;
-    Ok(Some((start, text.trim().to_owned())))
+    Ok(Some((start, action)))
 }
 
 fn parse_ticks(s: &str) -> Result<(u64, u64), String> {
@@ -198,6 +240,19 @@ mod tests {
         assert_eq!(s.said(0..31).collect::<Vec<_>>(), ["hello bob: gg!"]);
         assert_eq!(s.said(31..60).collect::<Vec<_>>(), ["two"]);
         assert_eq!(s.said(41..60).count(), 0, "once, at the first tick");
+    }
+
+    #[test]
+    fn levels_and_vote_entries_press_the_window_keys() {
+        let s = Script::parse("10 -> levels; 20 -> vote 2\n30..40 -> levels").unwrap();
+        assert_eq!(s.at(10), Buttons::NONE, "pressing holds no button");
+        assert_eq!(s.pressed(0..11).collect::<Vec<_>>(), [Press::Levels]);
+        assert_eq!(
+            s.pressed(11..100).collect::<Vec<_>>(),
+            [Press::Number(2), Press::Levels]
+        );
+        assert!(Script::parse("5 -> vote 0").is_err());
+        assert!(Script::parse("5 -> vote ten").is_err());
     }
 
     #[test]

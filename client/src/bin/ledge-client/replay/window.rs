@@ -504,6 +504,8 @@ impl ReplayLoop {
             ghosts_shown: false,
             split: None,
             spectate: None,
+            levels: None,
+            downloading: None,
         };
         if let Err(e) = shot::save(path, &shot) {
             fail(EXIT_FAILED, &format!("cannot save the screenshot: {e}"));
