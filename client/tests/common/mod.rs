@@ -70,6 +70,14 @@ impl TestServer {
     /// `dir`) in one room, with votes by majority and a second between a
     /// decision and the change.
     pub fn rotating(dir: &std::path::Path) -> TestServer {
+        TestServer::rotating_with(dir, ledge_shared::protocol::VoteRule::Majority)
+    }
+
+    /// [`TestServer::rotating`] with votes counted by `vote`.
+    pub fn rotating_with(
+        dir: &std::path::Path,
+        vote: ledge_shared::protocol::VoteRule,
+    ) -> TestServer {
         let levels = two_levels(dir);
         TestServer::start_with(move |c| {
             c.levels = levels;
@@ -77,7 +85,7 @@ impl TestServer {
             c.rotation = ledge_server::config::RotationConfig {
                 level_time: None,
                 results_time: Duration::from_secs(1),
-                vote: ledge_shared::protocol::VoteRule::Majority,
+                vote,
             };
         })
     }
