@@ -463,7 +463,12 @@ impl Playing<'_> {
             SessionEvent::Levels(list) => {
                 vote_once(self.session, self.options.vote, &list, self.report).await
             }
-            SessionEvent::LevelChange(welcome) if welcome == *self.session.welcome() => {
+            // The latest change only (another may be queued after it), and
+            // not the one our game already plays (a change read with the
+            // welcome).
+            SessionEvent::LevelChange(welcome)
+                if welcome == *self.session.welcome() && self.game.welcome() != Some(&welcome) =>
+            {
                 self.next_level(&welcome).await?;
             }
             _ => {}

@@ -69,6 +69,9 @@ pub async fn run_thin_with(
     };
     report.player = Some(session.welcome().player_id);
     report.levels = vec![LevelPlayed::new(&session.welcome().level_id)];
+    // The welcome of the level played (a change read with the welcome is
+    // that level already).
+    let mut playing = session.welcome().clone();
     let started = Instant::now();
     let deadline = started + options.duration;
     let mut clock = InputClock::new(session.welcome(), started);
@@ -102,8 +105,11 @@ pub async fn run_thin_with(
             }
             // The room's tick goes on across a level change: so does our
             // clock (no level to predict, none to fetch).
-            Ok(SessionEvent::LevelChange(welcome)) if welcome == *session.welcome() => {
+            Ok(SessionEvent::LevelChange(welcome))
+                if welcome == *session.welcome() && welcome != playing =>
+            {
                 report.next_level(&welcome.level_id);
+                playing = welcome;
             }
             Ok(SessionEvent::Levels(list)) => {
                 vote_once(&mut session, options.vote, &list, &mut report).await;

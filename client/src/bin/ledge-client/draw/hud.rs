@@ -248,10 +248,9 @@ pub fn panel(lines: &[(String, Color, f32)], x: f32, y: f32) -> f32 {
     height
 }
 
-/// Draws the HUD: our name, coins, deaths and run timer; the network
-/// panel and graph when `show_net`; the room's results table; the
-/// controls hint; sound notices.
-pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
+/// The top-left panel's lines: our name (or whom we watch), our run,
+/// when the room moves on, the keys.
+fn corner_lines(info: &HudInfo) -> Vec<(String, Color, f32)> {
     let mut lines: Vec<(String, Color, f32)> = match info.spectate {
         Some(line) => vec![(line.to_owned(), WHITE, FONT)],
         None => vec![(info.name.to_owned(), WHITE, 22.0)],
@@ -270,7 +269,14 @@ pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
         keys.push_str(&format!("   levels: {key}"));
     }
     lines.push((keys, DIM, 14.0));
-    let mut y = 8.0 + panel(&lines, 8.0, 8.0) + 6.0;
+    lines
+}
+
+/// Draws the HUD: our name, coins, deaths and run timer; the network
+/// panel and graph when `show_net`; the room's results table; the
+/// controls hint; sound notices.
+pub fn draw(info: &HudInfo, graph: &NetGraph, now: f64) {
+    let mut y = 8.0 + panel(&corner_lines(info), 8.0, 8.0) + 6.0;
     if let Some((text, faster)) = info.split {
         let colour = if faster { FASTER } else { SLOWER };
         y += panel(&[(text.to_owned(), colour, 28.0)], 8.0, y) + 6.0;
