@@ -602,9 +602,10 @@ impl<N: Network> OnlineGame<N> {
             .latest
             .as_ref()
             .map_or_else(|| game.clock().tick(), |s| s.tick);
-        Some(Duration::from_secs_f64(
-            at.saturating_sub(now) as f64 / f64::from(rate),
-        ))
+        // A tick far away (whatever the server says) is a long time, not
+        // a panic.
+        let secs = at.saturating_sub(now) as f64 / f64::from(rate);
+        Some(Duration::try_from_secs_f64(secs).unwrap_or(Duration::MAX))
     }
 
     /// The network driver.
@@ -719,6 +720,14 @@ mod tests {
         assert_eq!(game.levels().map(|l| l.next), Some(1));
         let left = game.next_level_in().expect("change_at is set");
         assert!(left <= Duration::from_secs(2), "{left:?}");
+        game.net
+            .0
+            .push_back(NetEvent::Levels(two_levels(Some(u64::MAX))));
+        game.update(now, Buttons::NONE);
+        assert!(game.next_level_in().unwrap() > Duration::from_secs(1 << 40));
+        game.net
+            .0
+            .push_back(NetEvent::Levels(two_levels(Some(10 + 120))));
         assert!(game.vote(1));
         assert!(!game.vote(2), "no such level");
         assert_eq!(game.changing_level(), None);
