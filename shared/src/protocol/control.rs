@@ -42,6 +42,8 @@ const _: () = assert!(1 + 52 + 1 + MAX_TOP * (1 + MAX_NAME_LEN + 10) <= MAX_FRAM
 // Worst-case room list: variant (1) + count (3) + per room two strings
 // (1 + MAX_ID_LEN each) and two counts (5 each).
 const _: () = assert!(1 + 3 + MAX_ROOMS * (2 * (1 + MAX_ID_LEN) + 10) <= MAX_FRAME);
+// A full `LevelList` fits a frame.
+const _: () = assert!(16 + MAX_LEVELS * (2 * (1 + MAX_ID_LEN) + 5) <= MAX_FRAME);
 
 /// `text` made fit for a text field of at most `max` bytes: control
 /// characters become spaces and it is cut at a character boundary (for
@@ -355,6 +357,38 @@ pub fn check_standing(standing: &Standing) -> Result<(), ProtocolError> {
         });
     }
     standing.top.iter().try_for_each(|t| check_name(&t.name))
+}
+
+/// Checks a [`LevelList`]: 1..=[`MAX_LEVELS`] levels with valid ids and names,
+/// one vote count per level (each at most [`MAX_ROSTER`]), `current`
+/// and `next` in range.
+pub fn check_level_list(list: &LevelList) -> Result<(), ProtocolError> {
+    let bad = |detail| ProtocolError::malformed("level list", detail);
+    if list.levels.is_empty() {
+        return Err(bad("no levels"));
+    }
+    if list.levels.len() > MAX_LEVELS {
+        return Err(ProtocolError::too_large(
+            "level list",
+            list.levels.len(),
+            MAX_LEVELS,
+        ));
+    }
+    for level in &list.levels {
+        check_text("level id", &level.id, 1, MAX_ID_LEN)?;
+        check_text("level name", &level.name, 1, MAX_ID_LEN)?;
+    }
+    if list.votes.len() != list.levels.len() {
+        return Err(bad("not one vote count per level"));
+    }
+    if list.votes.iter().any(|&v| v as usize > MAX_ROSTER) {
+        return Err(bad("more votes than players"));
+    }
+    let n = list.levels.len();
+    if list.current as usize >= n || list.next as usize >= n {
+        return Err(bad("current or next level out of range"));
+    }
+    Ok(())
 }
 
 /// Messages a client sends on the control stream.
@@ -830,7 +864,7 @@ impl Message for ServerControl {
     fn validate(&self) -> Result<(), ProtocolError> {
         match self {
             ServerControl::Welcome(w) | ServerControl::LevelChange(w) => w.validate(),
-            ServerControl::Levels(list) => list.validate(),
+            ServerControl::Levels(list) => check_level_list(list),
             ServerControl::Reject { reason } => match reason {
                 RejectReason::Other { reason } => {
                     check_text("reject reason", reason, 0, MAX_REASON_LEN)

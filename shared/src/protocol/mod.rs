@@ -33,12 +33,12 @@ pub mod web;
 
 pub use codec::Message;
 pub use control::{
-    check_name, check_rooms, check_roster, check_standing, check_text, check_version, clip_text,
-    decode_sim_config, encode_sim_config, is_hidden, name_key, ClientControl, CloseCode, GhostRun,
-    LevelOffer, NetTiming, NoticeKind, PlayerId, RejectReason, RoomInfo, RosterEntry,
-    ServerControl, SessionToken, Standing, TopRun, Welcome, MAX_CHAT_LEN, MAX_GHOST_REPLAY,
-    MAX_ID_LEN, MAX_LEVEL_BUNDLE, MAX_NAME_LEN, MAX_REASON_LEN, MAX_ROOMS, MAX_ROSTER,
-    MAX_SIM_CONFIG_LEN, MAX_TOP,
+    check_level_list, check_name, check_rooms, check_roster, check_standing, check_text,
+    check_version, clip_text, decode_sim_config, encode_sim_config, is_hidden, name_key,
+    ClientControl, CloseCode, GhostRun, LevelOffer, NetTiming, NoticeKind, PlayerId, RejectReason,
+    RoomInfo, RosterEntry, ServerControl, SessionToken, Standing, TopRun, Welcome, MAX_CHAT_LEN,
+    MAX_GHOST_REPLAY, MAX_ID_LEN, MAX_LEVEL_BUNDLE, MAX_NAME_LEN, MAX_REASON_LEN, MAX_ROOMS,
+    MAX_ROSTER, MAX_SIM_CONFIG_LEN, MAX_TOP,
 };
 pub use datagram::{input_timing, InputPacket, Snapshot};
 pub use error::ProtocolError;

@@ -7,21 +7,17 @@
 use serde::{Deserialize, Serialize};
 
 use super::bounded;
-use super::control::{check_text, MAX_ID_LEN, MAX_ROSTER};
-use super::ProtocolError;
 
 /// Most levels a server rotates through (and one [`LevelList`] names).
-/// A full list is under 9 KiB (checked at compile time).
+/// A full list is under 9 KiB (checked at compile time, in `control`).
 pub const MAX_LEVELS: usize = 64;
-
-const _: () = assert!(16 + MAX_LEVELS * (2 * (1 + MAX_ID_LEN) + 5) <= super::MAX_FRAME);
 
 /// One level of the rotation, as players choose it.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct LevelChoice {
     /// The level's id (as in [`super::Welcome::level_id`]).
     pub id: String,
-    /// Its name for people (1..=[`MAX_ID_LEN`] bytes, no control
+    /// Its name for people (1..=[`super::MAX_ID_LEN`] bytes, no control
     /// characters; the id when the level has no usable name).
     pub name: String,
 }
@@ -79,43 +75,9 @@ fn votes_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<u32>, D::Err
     bounded::seq(d, MAX_LEVELS, "vote counts")
 }
 
-impl LevelList {
-    /// Checks the list: 1..=[`MAX_LEVELS`] levels with valid ids and names,
-    /// one vote count per level (each at most [`MAX_ROSTER`]), `current`
-    /// and `next` in range.
-    pub fn validate(&self) -> Result<(), ProtocolError> {
-        let bad = |detail| ProtocolError::malformed("level list", detail);
-        if self.levels.is_empty() {
-            return Err(bad("no levels"));
-        }
-        if self.levels.len() > MAX_LEVELS {
-            return Err(ProtocolError::too_large(
-                "level list",
-                self.levels.len(),
-                MAX_LEVELS,
-            ));
-        }
-        for level in &self.levels {
-            check_text("level id", &level.id, 1, MAX_ID_LEN)?;
-            check_text("level name", &level.name, 1, MAX_ID_LEN)?;
-        }
-        if self.votes.len() != self.levels.len() {
-            return Err(bad("not one vote count per level"));
-        }
-        if self.votes.iter().any(|&v| v as usize > MAX_ROSTER) {
-            return Err(bad("more votes than players"));
-        }
-        let n = self.levels.len();
-        if self.current as usize >= n || self.next as usize >= n {
-            return Err(bad("current or next level out of range"));
-        }
-        Ok(())
-    }
-}
-
 #[cfg(test)]
 mod tests {
-    use super::super::{ClientControl, Message, ServerControl};
+    use super::super::{ClientControl, Message, ServerControl, MAX_ID_LEN, MAX_ROSTER};
     use super::*;
 
     fn list(n: usize) -> LevelList {

@@ -9,11 +9,14 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use ledge_client::bot::{BotOptions, Runner};
 use ledge_client::net::bundle::{fetch_level, FetchOptions};
 use ledge_client::net::session::{connect_with, JoinOptions, Session, SessionEvent};
+use ledge_levels::default_route;
 use ledge_server::config::RotationConfig;
 use ledge_shared::protocol::{LevelList, VoteRule, Welcome};
-use ledge_tests::TestServer;
+use ledge_tests::e2e::{bot_options, spawn_bot};
+use ledge_tests::{metric, TestServer};
 
 /// The default level's files, and a copy of the level named `second`, in
 /// `dir`: the rotation `[default, second]`.
@@ -170,5 +173,47 @@ async fn a_majority_vote_moves_the_room_and_every_member_follows() {
     for s in [ann, bob, eve] {
         s.close().await;
     }
+    server.stop().await.unwrap();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn runners_that_finish_the_first_level_are_moved_on_and_finish_the_second() {
+    let dir = tempfile::tempdir().unwrap();
+    let server = rotating_server(dir.path(), VoteRule::Majority).await;
+    let caches = [tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap()];
+    let mut bots = Vec::new();
+    for (name, cache) in ["ann", "bob"].into_iter().zip(&caches) {
+        let session = server.join(name).await;
+        let options = BotOptions {
+            level_cache: Some(cache.path().to_owned()),
+            ..bot_options(name, Duration::from_secs(34))
+        };
+        bots.push(spawn_bot(session, Runner::new(default_route()), options));
+    }
+    for bot in bots {
+        let (report, _) = bot.await.expect("the bot task did not panic");
+        let played: Vec<(&str, u32)> = report
+            .levels
+            .iter()
+            .map(|l| (l.id.as_str(), l.finishes))
+            .collect();
+        assert!(
+            played.len() >= 2 && played[0].0 == "default" && played[1].0 == "second",
+            "{}: played {played:?}",
+            report.name
+        );
+        assert!(
+            played[0].1 >= 1 && played[1].1 >= 1,
+            "{} finished each level: {played:?} ({})",
+            report.name,
+            report.progress
+        );
+        assert_eq!(report.mispredictions, 0, "{}: {report}", report.name);
+    }
+    let m = server.metrics();
+    assert!(
+        metric(&m, "ledge_level_downloads_completed_total") >= 2.0,
+        "each bot downloaded the second level"
+    );
     server.stop().await.unwrap();
 }
