@@ -111,12 +111,36 @@ impl LevelCache {
             ))
         };
         std::fs::create_dir_all(&self.dir).map_err(fail)?;
-        let part = self.part_path(offer);
+        // A name of this writer's own, not the shared part file.
+        static WRITES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let n = WRITES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let part = (self.dir).join(format!("{}.{}-{n}.tmp", offer.hex(), std::process::id()));
         std::fs::write(&part, bytes).map_err(fail)?;
         let done = self.bundle_path(offer);
         std::fs::rename(&part, &done).map_err(fail)?;
         self.trim(&done);
         Ok(done)
+    }
+
+    /// Makes the part file of a download that checked out the cached
+    /// bundle, if the file holds exactly that bundle: another client
+    /// sharing the cache may have written into it meanwhile (every client
+    /// of a room fetches a new level at the same moment), and then it is
+    /// deleted instead (the level in memory is the checked one).
+    fn keep_part(&self, offer: &LevelOffer) {
+        let part = self.part_path(offer);
+        let intact = std::fs::metadata(&part).is_ok_and(|m| m.len() == offer.size)
+            && std::fs::read(&part).is_ok_and(|bytes| sha256(&bytes) == offer.sha256);
+        let done = self.bundle_path(offer);
+        if intact && std::fs::rename(&part, &done).is_ok() {
+            self.trim(&done);
+        } else {
+            tracing::debug!(
+                "{} was written by another client too; not cached",
+                part.display()
+            );
+            let _ = std::fs::remove_file(&part);
+        }
     }
 
     /// What a cut download left (at most the offered size; more is
@@ -175,8 +199,30 @@ pub struct FetchOptions {
 /// cached copy, or downloaded (resuming a cut download; the request names
 /// the bundle by its SHA-256, so a server rotating levels sends this one),
 /// checked by hash and decoded with every bound checked.
-/// `progress(got, total)` is called as bytes arrive.
+/// `progress(got, total)` is called as bytes arrive. A download resumed
+/// from a part file that does not check out (another client sharing the
+/// cache wrote into it) is made once more from the start.
 pub async fn fetch_level(
+    session: &mut Session,
+    options: &FetchOptions,
+    mut progress: impl FnMut(u64, u64),
+) -> Result<(LevelBundle, Fetched), ClientError> {
+    let offer = session.welcome().level;
+    let resumed = options
+        .cache
+        .as_ref()
+        .is_some_and(|c| c.part_path(&offer).is_file());
+    match fetch_once(session, options, &mut progress).await {
+        Err(ClientError::LevelHashMismatch { .. }) if resumed => {
+            tracing::info!("the partial level download did not check out; downloading it again");
+            fetch_once(session, options, &mut progress).await
+        }
+        result => result,
+    }
+}
+
+/// One try of [`fetch_level`].
+async fn fetch_once(
     session: &mut Session,
     options: &FetchOptions,
     mut progress: impl FnMut(u64, u64),
@@ -200,9 +246,10 @@ pub async fn fetch_level(
     let mut download = Download::new(offer, cache.map(|c| c.partial(&offer)).unwrap_or_default())?;
     let resumed_from = download.resumed_from();
     let mut part = match cache {
-        Some(c) => Some(open_part(c, &offer, resumed_from)?),
+        Some(c) => open_part(c, &offer, resumed_from)?,
         None => None,
     };
+    let caching = part.is_some();
     if !download.is_complete() {
         session
             .send_control(&ClientControl::GetLevel {
@@ -255,21 +302,20 @@ pub async fn fetch_level(
         let _ = std::fs::remove_file(c.part_path(&offer));
     }
     let (level, fetched) = finished?;
-    if let Some(c) = cache {
-        let done = c.bundle_path(&offer);
-        if std::fs::rename(c.part_path(&offer), &done).is_ok() {
-            c.trim(&done);
-        }
+    if let (Some(c), true) = (cache, caching) {
+        c.keep_part(&offer);
     }
     Ok((level, fetched))
 }
 
-/// Opens (creating the folder) the part file for appending at `len`.
+/// Opens (creating the folder) the part file for appending at `len`;
+/// `None` when another client sharing the cache is writing it (the
+/// download then goes to memory only).
 fn open_part(
     cache: &LevelCache,
     offer: &LevelOffer,
     len: u64,
-) -> Result<std::fs::File, ClientError> {
+) -> Result<Option<std::fs::File>, ClientError> {
     let fail = |e: std::io::Error| {
         ClientError::LevelDownload(format!(
             "cannot write the level cache {}: {e} (choose another folder with --level-cache)",
@@ -282,12 +328,10 @@ fn open_part(
         .append(true)
         .open(cache.part_path(offer))
         .map_err(fail)?;
-    // A part longer than what was read (a concurrent writer): start over.
+    // Not what was read a moment ago: another client is downloading it.
     if file.metadata().map_err(fail)?.len() != len {
-        file.set_len(0).map_err(fail)?;
-        return Err(ClientError::LevelDownload(
-            "the partial download changed while reading it; try again".into(),
-        ));
+        tracing::debug!("another client is downloading this level into the cache too");
+        return Ok(None);
     }
-    Ok(file)
+    Ok(Some(file))
 }

@@ -243,3 +243,39 @@ async fn a_level_bigger_than_the_cap_stops_the_server_at_start() {
     let server = Server::bind(config(2)).expect("fits 2 MiB");
     assert!(server.level_offer().size > 1 << 20);
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn clients_sharing_a_cache_download_one_level_at_once_and_the_cache_stays_sound() {
+    // Every client of a room fetches a new level at the same moment: on
+    // one machine (bots, two windows) they share the level cache.
+    let dir = tempfile::tempdir().unwrap();
+    let map = noisy_map(dir.path(), 400);
+    let server = level_server(&map).await;
+    let cache_dir = tempfile::tempdir().unwrap();
+    let mut sessions = Vec::new();
+    for name in ["c1", "c2", "c3"] {
+        sessions.push(server.join(name).await);
+    }
+    let offer = sessions[0].welcome().level;
+    let fetches = sessions.iter_mut().map(|s| {
+        let options = cache_options(cache_dir.path());
+        async move { fetch_level(s, &options, |_, _| {}).await }
+    });
+    for result in futures_util::future::join_all(fetches).await {
+        let (bundle, _) = result.expect("each client gets the level");
+        assert_eq!(bundle.level.name, "big");
+    }
+    // Whatever was cached is the level itself, never the downloads mixed.
+    let cache = LevelCache::new(cache_dir.path());
+    let cached = cache.bundle_path(&offer);
+    if cached.exists() {
+        assert_eq!(sha256(&std::fs::read(&cached).unwrap()), offer.sha256);
+    }
+    assert!(!cache.part_path(&offer).exists(), "no part file left");
+    let mut later = server.join("c4").await;
+    let (bundle, _) = fetch_level(&mut later, &cache_options(cache_dir.path()), |_, _| {})
+        .await
+        .expect("and a later client too");
+    assert_eq!(bundle.level.name, "big");
+    server.stop().await.unwrap();
+}
