@@ -50,6 +50,13 @@ use crate::rotation::Rotation;
 use crate::snapshots::RoomSnapshots;
 use crate::tls::DATAGRAM_SEND_BUFFER;
 
+/// The slowest download a level change allows for before a silent
+/// client counts as idle, bytes a second.
+pub const LEVEL_DOWNLOAD_FLOOR: u64 = 256 * 1024;
+
+/// Longest extra silence a level change allows for its download.
+pub const MAX_DOWNLOAD_GRACE: Duration = Duration::from_secs(120);
+
 /// How long the room waits for a client to acknowledge a snapshot sent on
 /// the control stream before it sends another one there.
 pub const STREAM_SNAPSHOT_RESEND: Duration = Duration::from_millis(1000);
@@ -693,6 +700,7 @@ impl RoomLogic {
         }
         self.snapshots = RoomSnapshots::new(self.config.history);
         self.rotation.changed_to(index, tick);
+        let grace = self.download_grace(level.offer.size);
         let ids: Vec<PlayerId> = self.members.keys().copied().collect();
         for id in ids {
             let welcome = self.welcome(id, tick);
@@ -700,6 +708,8 @@ impl RoomLogic {
                 m.last_snapshot = None;
                 m.stream_pending = None;
                 m.stream_until = Some(tick);
+                // Downloading the level, a client sends no input.
+                m.heard_at = m.heard_at.max(tick + grace);
                 lock(&m.inbox).ack = None;
                 if !m.spectator {
                     let name = m.name.clone();
@@ -710,6 +720,15 @@ impl RoomLogic {
         }
         self.broadcast_levels();
         info!(room = %self.config.name, level = %self.config.level_id, tick, "moved to the next level");
+    }
+
+    /// Ticks a member may stay silent after a level change on top of the
+    /// idle kick's, while it downloads a level of `size` bytes at
+    /// [`LEVEL_DOWNLOAD_FLOOR`] (at most [`MAX_DOWNLOAD_GRACE`]).
+    fn download_grace(&self, size: u64) -> u64 {
+        let secs =
+            (size as f64 / LEVEL_DOWNLOAD_FLOOR as f64).min(MAX_DOWNLOAD_GRACE.as_secs_f64());
+        (secs * f64::from(self.config.tick_rate)) as u64
     }
 
     /// Queues the rotation's list for member `id` (none when the room
@@ -1940,6 +1959,30 @@ mod level_change_tests {
             !sent.is_empty() && sent.iter().all(|d| !d),
             "on the stream: {sent:?}"
         );
+    }
+
+    #[test]
+    fn a_level_change_gives_silent_downloaders_time_by_the_levels_size() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut room = room(dir.path(), VoteRule::Off);
+        assert_eq!(room.download_grace(1 << 20), 4 * 60, "1 MiB at 256 KiB/s");
+        assert_eq!(
+            room.download_grace(96 << 20),
+            120 * 60,
+            "capped at 2 minutes"
+        );
+        room.config.idle_kick = Duration::from_millis(500);
+        let t0 = Instant::now();
+        room.join(PlayerId(1), "ann".into()).unwrap();
+        step(&mut room, 10, t0);
+        room.change_level(1);
+        let grace = room.download_grace(room.config().level.size);
+        let kicked = |actions: &[Action]| actions.iter().any(|a| matches!(a, Action::Kick { .. }));
+        assert!(
+            !kicked(&step(&mut room, 30 + grace, t0)),
+            "silent within the idle time and the grace"
+        );
+        assert!(kicked(&step(&mut room, 10, t0)), "then idle");
     }
 
     #[test]
