@@ -1,7 +1,9 @@
 // ledge's glue between the browser and the client's wasm build: a
 // miniquad plugin (miniquad's gl.js loads the wasm and calls
 // `register_plugin` with its imports) giving the game the page's clock,
-// the address's parameters, and a place to publish its state.
+// the address's parameters, its connection to the server, files fetched
+// from that server (a replay and its level), and a place to publish its
+// state.
 //
 // The wasm checks the glue's version through `ledge_crate_version`
 // (miniquad's loader logs a mismatch): keep GLUE_VERSION equal to
@@ -9,7 +11,7 @@
 "use strict";
 
 (function () {
-    const GLUE_VERSION = 1;
+    const GLUE_VERSION = 2;
     const decoder = new TextDecoder("utf-8");
     const encoder = new TextEncoder();
 
@@ -158,6 +160,76 @@
         });
     }
 
+    // ---- Files from the server that served this page ------------------
+    //
+    // `ledge_fetch_start` starts one (a replay, a level bundle) with a
+    // bound on its body: a larger Content-Length is refused before the
+    // body is read, and the body is never read past the bound. The game
+    // polls it (`ledge_fetch_poll`), then takes its bytes
+    // (`ledge_fetch_take`), which forgets it. An HTTP error keeps the
+    // server's text (at most MAX_FETCH_TEXT bytes); no answer at all
+    // (status 0) keeps why, as text.
+    const MAX_FETCH_TEXT = 4096;
+    const fetches = new Map();
+    let nextFetch = 1;
+
+    async function readBounded(response, limit) {
+        const chunks = [];
+        let total = 0;
+        let over = false;
+        if (response.body) {
+            const reader = response.body.getReader();
+            for (;;) {
+                const { value, done } = await reader.read();
+                if (done) {
+                    break;
+                }
+                if (total + value.length > limit) {
+                    chunks.push(value.subarray(0, limit - total));
+                    total = limit;
+                    over = true;
+                    reader.cancel().catch(() => { });
+                    break;
+                }
+                chunks.push(value);
+                total += value.length;
+            }
+        }
+        const body = new Uint8Array(total);
+        let at = 0;
+        for (const c of chunks) {
+            body.set(c, at);
+            at += c.length;
+        }
+        return { body, over };
+    }
+
+    async function fetchBounded(path, max) {
+        const failed = why => ({ status: 0, body: encoder.encode(why), retryAfter: 0xFFFFFFFF });
+        let response;
+        try {
+            response = await fetch(path, { cache: "no-cache" });
+        } catch (e) {
+            return failed("the server cannot be reached (" + e.message + "): is it running? reload the page to try again");
+        }
+        const retry = parseInt(response.headers.get("Retry-After") || "", 10);
+        const retryAfter = Number.isFinite(retry) && retry >= 0 ? Math.min(retry, 0xFFFFFFFE) : 0xFFFFFFFF;
+        if (!response.ok) {
+            const { body } = await readBounded(response, MAX_FETCH_TEXT);
+            return { status: response.status, body, retryAfter };
+        }
+        const length = Number(response.headers.get("Content-Length"));
+        if (Number.isFinite(length) && length > max) {
+            try { response.body && response.body.cancel(); } catch (e) { }
+            return failed("the server offers " + length + " bytes, more than it can be (" + max + " bytes): refused without reading it");
+        }
+        const { body, over } = await readBounded(response, max);
+        if (over) {
+            return failed("the server sent more than it can be (" + max + " bytes): refused; is this a ledge server?");
+        }
+        return { status: response.status, body, retryAfter };
+    }
+
     async function connect() {
         let config;
         try {
@@ -301,6 +373,52 @@
                     return 1;
                 }
                 return 0;
+            };
+            // Starts fetching `path` (UTF-8 at pathPtr) from this page's
+            // server, a body of at most `max` bytes; returns its handle.
+            env.ledge_fetch_start = function (pathPtr, pathLen, max) {
+                const path = decoder.decode(bytes(pathPtr, pathLen));
+                const handle = nextFetch++;
+                const entry = { done: null };
+                fetches.set(handle, entry);
+                fetchBounded(path, max >>> 0)
+                    .catch(e => ({ status: 0, body: encoder.encode("the download broke off (" + e + "): reload the page to try again"), retryAfter: 0xFFFFFFFF }))
+                    .then(done => { entry.done = done; });
+                return handle;
+            };
+            // -1 while fetch `handle` runs; else 0, with its status, body
+            // length and Retry-After (u32 LE each) at `info`.
+            env.ledge_fetch_poll = function (handle, info) {
+                const entry = fetches.get(handle);
+                if (!entry) {
+                    const view = new DataView(wasm_memory.buffer);
+                    view.setUint32(info, 0, true);
+                    view.setUint32(info + 4, 0, true);
+                    view.setUint32(info + 8, 0xFFFFFFFF, true);
+                    return 0;
+                }
+                if (!entry.done) {
+                    return -1;
+                }
+                const view = new DataView(wasm_memory.buffer);
+                view.setUint32(info, entry.done.status >>> 0, true);
+                view.setUint32(info + 4, entry.done.body.length >>> 0, true);
+                view.setUint32(info + 8, entry.done.retryAfter >>> 0, true);
+                return 0;
+            };
+            // Copies fetch `handle`'s body into `out` (at most `cap` bytes)
+            // and forgets it; the bytes copied.
+            env.ledge_fetch_take = function (handle, out, cap) {
+                const entry = fetches.get(handle);
+                fetches.delete(handle);
+                if (!entry || !entry.done) {
+                    return 0;
+                }
+                const n = Math.min(entry.done.body.length, cap >>> 0);
+                if (n > 0) {
+                    bytes(out, n).set(entry.done.body.subarray(0, n));
+                }
+                return n;
             };
             // The game's state (JSON) as `window.ledgeState`.
             env.ledge_report = function (ptr, len) {

@@ -194,17 +194,20 @@ fn page(levels: &[LevelSummary], tops: &[Vec<TopEntry>]) -> String {
         );
     }
     html.push_str(
-        "<p>A replay plays in the game: <code>ledge-client --replay</code> and the replay \
-         link's address.</p></body></html>",
+        "<p>\"watch\" plays a replay in this browser; the file's link plays in the game: \
+         <code>ledge-client --replay</code> and the link's address.</p></body></html>",
     );
     html
 }
 
-/// The cell linking a run's replay (only ids that are replay ids: the
-/// records may hold anything).
+/// The cell linking a run's replay: the file, and "watch", the page
+/// playing it (`/?replay=ID`); only ids that are replay ids (the records
+/// may hold anything).
 fn replay_link(id: Option<&str>) -> String {
     match id.filter(|id| crate::replays::is_replay_id(id)) {
-        Some(id) => format!("<a href=\"/replays/{id}\">{id}</a>"),
+        Some(id) => {
+            format!("<a href=\"/replays/{id}\">{id}</a> (<a href=\"/?replay={id}\">watch</a>)")
+        }
         None => String::new(),
     }
 }
@@ -243,6 +246,7 @@ mod tests {
         assert!(html.contains("&lt;b&gt;x&lt;/b&gt;") && html.contains("a&amp;b"));
         assert!(html.contains("0:09.000") && !html.contains("<b>x"));
         assert!(html.contains("<a href=\"/replays/0123456789abcdef\">"));
+        assert!(html.contains("<a href=\"/?replay=0123456789abcdef\">watch</a>"));
         assert_eq!(replay_link(Some("<script>")), "");
     }
 }

@@ -10,6 +10,7 @@ mod background;
 mod bots;
 mod browser_client;
 mod browser_harness;
+mod browser_replay;
 mod churn;
 mod conditioned;
 mod deploy_manifests;

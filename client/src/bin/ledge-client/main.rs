@@ -11,7 +11,7 @@
 //! * `--local`: starts the real server in-process on `127.0.0.1:0` and
 //!   joins it: one command, a playable game;
 //! * `--replay FILE|URL`: plays a replay in the window ([`replay`]), or
-//!   checks it without one (`--check`).
+//!   checks it without one (`--check`); in the browser `?replay=ID`.
 //!
 //! The simulation runs at a fixed 60 Hz (accumulator); frames are drawn
 //! interpolated between the last two ticks. `--script`, `--screenshot` and
@@ -62,7 +62,6 @@ mod outcome;
 #[cfg(target_arch = "wasm32")]
 mod page;
 mod play;
-#[cfg(not(target_arch = "wasm32"))]
 mod replay;
 mod shot;
 mod sound;

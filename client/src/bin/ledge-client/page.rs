@@ -2,7 +2,8 @@
 //! `web/ledge.js` (a miniquad plugin) and what the game makes of them: the
 //! address's parameters, the page's host, its gamepads, its connection to
 //! the server ([`WebNet`]: WebTransport, or a WebSocket where the browser
-//! has no WebTransport), and the game's state reported to the page.
+//! has no WebTransport), files fetched from that server ([`Fetch`]: a
+//! replay and its level), and the game's state reported to the page.
 //!
 //! Below the game: [`crate::web`], the browser's entry point, and the
 //! game loop call it; it calls nothing of theirs.
@@ -23,7 +24,7 @@ use crate::outcome::tell;
 
 /// The glue's version: `web/ledge.js` says the same, and miniquad's loader
 /// compares them (`ledge_crate_version`) so a stale page says so.
-const GLUE_VERSION: u32 = 1;
+const GLUE_VERSION: u32 = 2;
 
 /// Longest address parameter read (a player name is at most 32 bytes).
 const MAX_PARAM: usize = 256;
@@ -51,6 +52,100 @@ extern "C" {
     /// Sends on the control stream (`kind` 0) or as a datagram (1);
     /// 0 if dropped.
     fn ledge_net_send(kind: u32, bytes: *const u8, len: u32) -> u32;
+    /// Starts fetching `path` from the server that served the page, a
+    /// body of at most `max` bytes (more is refused, unread); returns the
+    /// fetch's handle.
+    fn ledge_fetch_start(path: *const u8, path_len: u32, max: u32) -> u32;
+    /// Fetch `handle`'s outcome: -1 while it runs; else 0, with three
+    /// u32 LE written to `info`: the HTTP status (0: no answer, and the
+    /// body says why), the body's length (an error's text: at most
+    /// [`MAX_FETCH_TEXT`]), the answer's `Retry-After` seconds
+    /// (`u32::MAX` if none).
+    fn ledge_fetch_poll(handle: u32, info: *mut u8) -> i32;
+    /// Copies the finished fetch's body into `out` (at most `cap` bytes)
+    /// and forgets the fetch; returns the bytes copied.
+    fn ledge_fetch_take(handle: u32, out: *mut u8, cap: u32) -> u32;
+}
+
+/// Longest error text (an HTTP error's body, or why there was no answer)
+/// a fetch keeps (`web/ledge.js` cuts longer ones).
+pub const MAX_FETCH_TEXT: u32 = 4096;
+
+/// A file being fetched from the server that served the page, its body
+/// bounded (the glue refuses a larger one before or while reading it, and
+/// the bound is checked again here before anything is allocated).
+#[derive(Debug)]
+pub struct Fetch {
+    handle: u32,
+    max: u32,
+}
+
+/// How a fetch ended.
+#[derive(Debug)]
+pub enum Fetched {
+    /// 200 OK: the body.
+    Body(Vec<u8>),
+    /// Another HTTP status, with the server's text (cut to
+    /// [`MAX_FETCH_TEXT`] bytes) and its `Retry-After` seconds.
+    Status {
+        /// The HTTP status.
+        status: u16,
+        /// The server's text, trimmed.
+        text: String,
+        /// `Retry-After`, seconds.
+        retry_after: Option<u32>,
+    },
+    /// No answer, or one refused: why.
+    Failed(String),
+}
+
+impl Fetch {
+    /// Starts fetching `path` (absolute, on the page's server): a body of
+    /// at most `max` bytes.
+    pub fn start(path: &str, max: u32) -> Fetch {
+        let len = u32::try_from(path.len()).unwrap_or(0);
+        // SAFETY: a valid buffer and its length.
+        let handle = unsafe { ledge_fetch_start(path.as_ptr(), len, max) };
+        Fetch { handle, max }
+    }
+
+    /// How it ended, once it has (then the fetch is forgotten).
+    pub fn poll(&mut self) -> Option<Fetched> {
+        let mut info = [0u8; 12];
+        // SAFETY: `info` is valid for the 12 bytes the glue writes.
+        if unsafe { ledge_fetch_poll(self.handle, info.as_mut_ptr()) } < 0 {
+            return None;
+        }
+        let word =
+            |at: usize| u32::from_le_bytes([info[at], info[at + 1], info[at + 2], info[at + 3]]);
+        let (status, len, retry) = (word(0), word(4), word(8));
+        let cap = if status == 200 {
+            self.max
+        } else {
+            MAX_FETCH_TEXT
+        };
+        if len > cap {
+            // SAFETY: nothing is written with a capacity of 0.
+            unsafe { ledge_fetch_take(self.handle, std::ptr::null_mut(), 0) };
+            return Some(Fetched::Failed(format!(
+                "the answer is {len} bytes, more than it can be ({cap} bytes): refused"
+            )));
+        }
+        let mut body = vec![0u8; len as usize];
+        // SAFETY: `body` is valid for its length; the glue writes at most that.
+        let n = unsafe { ledge_fetch_take(self.handle, body.as_mut_ptr(), len) };
+        body.truncate(n.min(len) as usize);
+        let text = || String::from_utf8_lossy(&body).trim().to_owned();
+        Some(match status {
+            200 => Fetched::Body(body),
+            0 => Fetched::Failed(text()),
+            _ => Fetched::Status {
+                status: u16::try_from(status).unwrap_or(u16::MAX),
+                text: text(),
+                retry_after: (retry != u32::MAX).then_some(retry),
+            },
+        })
+    }
 }
 
 /// Message tags from the glue (`web/ledge.js`) besides the WebSocket
@@ -273,10 +368,99 @@ pub struct DrawnPlayer {
     pub rgb: [u8; 3],
 }
 
+/// A replay's state on the page (`window.ledgeState.replay`).
+pub struct ReplayState<'a> {
+    /// The replay's id.
+    pub id: &'a str,
+    /// Its level's name.
+    pub level: &'a str,
+    /// Where the level came from: "embedded", or the URL it was
+    /// downloaded from.
+    pub level_from: &'a str,
+    /// The game's tick shown.
+    pub tick: u64,
+    /// The replay's first and last game ticks.
+    pub start_tick: u64,
+    /// Its last.
+    pub end_tick: u64,
+    /// Where it opened (a run's start, or the replay's).
+    pub home: u64,
+    /// The speed (1: as played).
+    pub speed: f32,
+    /// Paused by the viewer.
+    pub paused: bool,
+    /// At its end (or where it failed).
+    pub at_end: bool,
+    /// The followed player's name.
+    pub following: Option<&'a str>,
+    /// The followed player's centre at `tick`, units (the replay's game).
+    pub follow_pos: Option<glam::IVec2>,
+    /// The camera is free.
+    pub free_camera: bool,
+    /// The HUD's clock line.
+    pub clock: &'a str,
+    /// Why it stopped playing, if it did.
+    pub error: Option<&'a str>,
+}
+
+/// World pixels of `units`.
+fn px(units: i32) -> f64 {
+    f64::from(units) / f64::from(UNITS_PER_PX)
+}
+
 /// Publishes `report` as `window.ledgeState` (a few times a second is
 /// plenty; every frame is cheap too).
 pub fn report(r: &Report<'_>) {
-    let px = |v: i32| f64::from(v) / f64::from(UNITS_PER_PX);
+    publish(&state(r));
+}
+
+/// Publishes a replay's frame: `report`, and `replay` as its `replay`.
+pub fn report_replay(r: &Report<'_>, replay: &ReplayState<'_>) {
+    let mut json = state(r);
+    json["replay"] = serde_json::json!({
+        "id": replay.id,
+        "level": { "name": replay.level, "from": replay.level_from },
+        "tick": replay.tick,
+        "start_tick": replay.start_tick,
+        "end_tick": replay.end_tick,
+        "ticks": replay.end_tick.saturating_sub(replay.start_tick),
+        "home": replay.home,
+        "speed": replay.speed,
+        "paused": replay.paused,
+        "at_end": replay.at_end,
+        "following": replay.following,
+        "follow_pos": replay.follow_pos.map(|p| [px(p.x), px(p.y)]),
+        "free_camera": replay.free_camera,
+        "clock": replay.clock,
+        "error": replay.error,
+    });
+    publish(&json);
+}
+
+/// Publishes a replay not playing yet: what is `loading` ("replay",
+/// "level"), or the `error` that stopped it opening.
+pub fn report_replay_opening(id: &str, loading: Option<&str>, error: Option<&str>) {
+    publish(&serde_json::json!({
+        "played": 0,
+        "status": loading.map_or("", |_| "loading the replay"),
+        "failure": error,
+        "joined": false,
+        "spectating": false,
+        "me": null,
+        "players": [],
+        "replay": { "id": id, "loading": loading, "error": error },
+    }));
+}
+
+/// `json` as `window.ledgeState`.
+fn publish(json: &serde_json::Value) {
+    let json = json.to_string();
+    // SAFETY: a valid buffer and its length.
+    unsafe { ledge_report(json.as_ptr(), json.len() as u32) };
+}
+
+/// The page's state of a frame.
+fn state(r: &Report<'_>) -> serde_json::Value {
     let players: Vec<serde_json::Value> = r
         .players
         .iter()
@@ -287,7 +471,7 @@ pub fn report(r: &Report<'_>) {
             })
         })
         .collect();
-    let json = serde_json::json!({
+    serde_json::json!({
         "played": r.played,
         "status": r.status,
         "failure": r.failure,
@@ -302,7 +486,4 @@ pub fn report(r: &Report<'_>) {
             "grass": crate::draw::render::palette::bytes(crate::draw::render::palette::GRASS),
         },
     })
-    .to_string();
-    // SAFETY: a valid buffer and its length.
-    unsafe { ledge_report(json.as_ptr(), json.len() as u32) };
 }

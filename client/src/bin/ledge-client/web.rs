@@ -7,7 +7,8 @@
 //! or a WebSocket where the browser has no WebTransport), in the room the
 //! address names (`?room=friends`); `?offline` plays the embedded level
 //! without a server; `?spectate` watches (`&follow=NAME`) rather than
-//! plays.
+//! plays; `?replay=ID` plays the server's replay ID
+//! ([`crate::replay::browser`]).
 //!
 //! On top, beside [`crate::native`]: it builds the game's [`Setup`] and
 //! runs the game loop; nothing calls into it but `main`.
@@ -39,6 +40,10 @@ fn name() -> String {
 
 /// Starts the game in the page's canvas.
 pub fn main() {
+    if let Some(id) = param("replay") {
+        crate::replay::browser::main(id);
+        return;
+    }
     let name = name();
     let level = ledge_levels::default_level();
     let spectate = param("spectate").is_some();

@@ -14,13 +14,26 @@ use macroquad::prelude::*;
 use crate::draw::hud::{self, ResultRow, RunInfo, DIM, GOLD};
 
 /// The keys, as the hint at the bottom right says them.
+#[cfg(not(target_arch = "wasm32"))]
 pub const KEYS_HINT: &str = "Space pause   -/+ speed   Left/Right 5 s   Home/End   Tab follow   F free camera   F2 HUD   Esc quit";
+/// The keys, as the hint at the bottom right says them (a page is left by
+/// closing it: no Esc).
+#[cfg(target_arch = "wasm32")]
+pub const KEYS_HINT: &str =
+    "Space pause   -/+ speed   Left/Right 5 s   Home/End   Tab follow   F free camera   F2 HUD";
 
 /// What the middle of the screen says at the end: that it ended, and the
 /// keys that go on.
+#[cfg(not(target_arch = "wasm32"))]
 pub const END_TEXT: [&str; 2] = [
     "end of replay",
     "Space or Home: watch again · Left: 5 s back · Esc: quit",
+];
+/// What the middle of the screen says at the end (in a page: no Esc).
+#[cfg(target_arch = "wasm32")]
+pub const END_TEXT: [&str; 2] = [
+    "end of replay",
+    "Space or Home: watch again · Left: 5 s back",
 ];
 
 /// Failure lines are red.

@@ -8,15 +8,9 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context};
 use ledge_shared::protocol::LevelOffer;
-use ledge_shared::replay::{file::HEADER_LEN, MAX_REPLAY_BYTES};
 
 use crate::replay::http;
-
-/// The largest replay file: its header and the largest body.
-pub const MAX_FILE_BYTES: u64 = (MAX_REPLAY_BYTES + HEADER_LEN) as u64;
-
-/// Digits of a replay's id in its URL.
-pub const ID_DIGITS: usize = 16;
+use crate::replay::open::{is_id, MAX_FILE_BYTES};
 
 /// How a replay's URL looks, for messages.
 pub const URL_FORM: &str = "http://HOST:PORT/replays/ID (ID: 16 hex digits)";
@@ -50,8 +44,7 @@ impl ReplayUrl {
             bail!("{url}: no server in it: give the replay as {URL_FORM}");
         }
         let id = path.strip_prefix("replays/").unwrap_or_default();
-        let hex = id.len() == ID_DIGITS && id.bytes().all(|b| b.is_ascii_hexdigit());
-        if !hex {
+        if !is_id(id) {
             bail!(
                 "{url}: not a replay's address on a ledge server: give it as {URL_FORM}, as the \
                  server's records page links it"

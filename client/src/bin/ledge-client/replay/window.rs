@@ -3,7 +3,10 @@
 //! drawn as the game draws a match (the same camera, scene, animation and
 //! effects; the followed player as ours, the others with their names), the
 //! replay's HUD, and `--screenshot`'s picture and description; until Esc
-//! or the window is closed (or `--exit-after-ticks`).
+//! or the window is closed (or `--exit-after-ticks`). In the browser (the
+//! page's `?replay=ID`) the same, but no screenshot, no Esc (a page is
+//! left by closing it), and each frame's state reported to the page
+//! (`window.ledgeState`).
 //!
 //! Keys (fixed; Esc, F1, F2 and M as `--keys` binds them): Space pauses
 //! (at the end it plays again), `-`/`+` (or `[`/`]`) slower and faster,
@@ -11,6 +14,7 @@
 //! the end, Tab follows the next player (Shift+Tab the one before), F a
 //! free camera (WASD moves it).
 
+#[cfg(not(target_arch = "wasm32"))]
 use std::path::PathBuf;
 
 use ledge_client::replay::{Follow, ReplayViewer};
@@ -18,7 +22,7 @@ use ledge_client::time::Instant;
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::game::PlayerView;
 use ledge_shared::level::{EntityKind, Level};
-use ledge_shared::replay::{ReplayError, ReplayKind};
+use ledge_shared::replay::ReplayError;
 use macroquad::prelude::*;
 
 use crate::draw::anim::Animator;
@@ -34,6 +38,7 @@ use crate::input::keys::Bindings;
 use crate::outcome::{fail, EXIT_FAILED};
 use crate::play;
 use crate::replay::advice::advice;
+#[cfg(not(target_arch = "wasm32"))]
 use crate::shot;
 use crate::sound::audio::{Audio, AudioStatus, Effect};
 use crate::sound::cues::Cues;
@@ -61,7 +66,11 @@ pub struct Watch {
     /// Quit after this many ticks played (`--exit-after-ticks`).
     pub exit_after: Option<u64>,
     /// Save the last frame there (`--screenshot`).
+    #[cfg(not(target_arch = "wasm32"))]
     pub screenshot: Option<PathBuf>,
+    /// What the page's state says of the replay beside the viewer's.
+    #[cfg(target_arch = "wasm32")]
+    pub page: PageReplay,
     /// Start with the debug overlay.
     pub debug: bool,
     /// Start with the HUD.
@@ -70,6 +79,17 @@ pub struct Watch {
     pub volume: f32,
     /// Start muted.
     pub mute: bool,
+}
+
+/// What the page's state (`window.ledgeState.replay`) says of a replay
+/// beside what the viewer knows.
+#[cfg(target_arch = "wasm32")]
+pub struct PageReplay {
+    /// The replay's id.
+    pub id: String,
+    /// Where its level came from: "embedded", or the URL it was
+    /// downloaded from.
+    pub level_from: String,
 }
 
 /// Shows the replay in the window until it is closed.
@@ -159,7 +179,8 @@ impl ReplayLoop {
 
     /// One frame; false once the window is to close.
     fn frame(&mut self) -> bool {
-        if Bindings::pressed(&self.watch.bindings.quit) || is_quit_requested() {
+        let esc = cfg!(not(target_arch = "wasm32")) && Bindings::pressed(&self.watch.bindings.quit);
+        if esc || is_quit_requested() {
             return false;
         }
         let now = self.started.elapsed().as_secs_f64();
@@ -180,7 +201,16 @@ impl ReplayLoop {
         self.animate_effects(&cued, &mut scene, pace);
         self.draw_world(&scene, now);
         let shown = self.draw_hud(&scene, now);
-        !self.finished(&scene, &shown, now)
+        #[cfg(target_arch = "wasm32")]
+        self.report_to_page(&scene, &shown);
+        let done = self.finished();
+        #[cfg(not(target_arch = "wasm32"))]
+        if done {
+            if let Some(path) = &self.watch.screenshot {
+                self.save_screenshot(path, &scene, &shown, now);
+            }
+        }
+        !done
     }
 
     /// F1, F2 and M as bound.
@@ -439,21 +469,78 @@ impl ReplayLoop {
         sound_notice(self.sound_off.as_deref(), now)
     }
 
-    /// Whether `--exit-after-ticks` is reached (or the replay's end); the
-    /// screenshot then.
-    fn finished(&self, scene: &Scene, shown: &Shown, now: f64) -> bool {
-        let done = self.watch.exit_after.is_some_and(|n| {
+    /// Whether `--exit-after-ticks` is reached (or the replay's end).
+    fn finished(&self) -> bool {
+        self.watch.exit_after.is_some_and(|n| {
             (self.played >= n || self.watch.viewer.at_end()) && self.frames >= MIN_FRAMES
-        });
-        if done {
-            if let Some(path) = &self.watch.screenshot {
-                self.save_screenshot(path, scene, shown, now);
-            }
-        }
-        done
+        })
+    }
+
+    /// Publishes what the frame showed to the page (`window.ledgeState`):
+    /// the replay's state, the players drawn (the followed one as ours).
+    #[cfg(target_arch = "wasm32")]
+    fn report_to_page(&self, scene: &Scene, shown: &Shown) {
+        use crate::page;
+        let viewer = &self.watch.viewer;
+        let view = &scene.view;
+        let local = scene
+            .local
+            .iter()
+            .map(|p| (p, true, p.name.as_deref().unwrap_or_default()));
+        let remotes = scene
+            .remotes
+            .iter()
+            .zip(&scene.labels)
+            .map(|(p, label)| (p, false, label.as_str()));
+        let players = local
+            .chain(remotes)
+            .map(|(p, ours, label)| {
+                let top_left = view.to_screen(p.pos - p.size / 2.0);
+                let size = p.size * view.zoom;
+                page::DrawnPlayer {
+                    id: p.id,
+                    name: label.to_owned(),
+                    local: ours,
+                    screen: [top_left.x, top_left.y, size.x, size.y],
+                    world: [p.pos.x, p.pos.y],
+                    rgb: render::palette::bytes(render::player_color(p.id, ours)),
+                }
+            })
+            .collect();
+        let me = scene.me.as_ref();
+        let report = page::Report {
+            played: self.played,
+            status: &shown.lines.clock,
+            failure: self.failed.as_deref(),
+            joined: true,
+            me: me.map(|m| m.pos),
+            players,
+            spectating: false,
+        };
+        page::report_replay(
+            &report,
+            &page::ReplayState {
+                id: &self.watch.page.id,
+                level: &viewer.replay().header.level_name,
+                level_from: &self.watch.page.level_from,
+                tick: viewer.tick(),
+                start_tick: viewer.start_tick(),
+                end_tick: viewer.end_tick(),
+                home: viewer.home(),
+                speed: viewer.speed(),
+                paused: viewer.paused(),
+                at_end: viewer.at_end(),
+                following: me.map(|_| shown.name.as_str()),
+                follow_pos: me.map(|m| m.pos),
+                free_camera: viewer.follow() == Follow::Free,
+                clock: &shown.lines.clock,
+                error: self.failed.as_deref(),
+            },
+        );
     }
 
     /// Saves the frame as `path` and its description beside it.
+    #[cfg(not(target_arch = "wasm32"))]
     fn save_screenshot(&self, path: &std::path::Path, scene: &Scene, shown: &Shown, now: f64) {
         let viewer = &self.watch.viewer;
         let level = &self.watch.level;
@@ -466,7 +553,10 @@ impl ReplayLoop {
             speed: viewer.speed(),
             paused: viewer.paused(),
             at_end: viewer.at_end(),
-            run: matches!(viewer.replay().header.kind, ReplayKind::Run { .. }),
+            run: matches!(
+                viewer.replay().header.kind,
+                ledge_shared::replay::ReplayKind::Run { .. }
+            ),
             following,
             free_camera: viewer.follow() == Follow::Free,
             lines: &shown.lines,
