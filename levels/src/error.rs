@@ -21,7 +21,7 @@ pub enum LevelError {
     },
     /// An extension no loader handles.
     #[error(
-        "{file}: unsupported level format (expected .json from OGMO Editor 3 or .tmx from Tiled)"
+        "{file}: unsupported level format (expected .json from OGMO Editor 3, .tmx from Tiled or .ldtk from LDtk)"
     )]
     UnsupportedFormat {
         /// The file.
@@ -161,6 +161,19 @@ pub enum LevelError {
         /// The constant of the bound, e.g. `MAX_TILESET_TILES`.
         bound: &'static str,
     },
+    /// A level name (`PROJECT.ldtk#NAME`) that is not one of the project's
+    /// levels, or an empty one.
+    #[error("{file}: {field}: {problem} (the project's levels: {known})")]
+    UnknownLevel {
+        /// The project file.
+        file: String,
+        /// Where the levels are listed (`levels`).
+        field: String,
+        /// What is wrong, naming the level asked for.
+        problem: String,
+        /// The project's level identifiers, in order, comma-separated.
+        known: String,
+    },
     /// No entity is a player spawn.
     #[error("{file}: {field}: no player spawn, and nothing in the level to place one on: nothing in it collides (add an entity named \"player\" or \"spawn\", and make something collide: see docs/LEVELS.md, \"What collides\", and the level's settings file)")]
     MissingSpawn {
@@ -188,6 +201,7 @@ impl LevelError {
             | LevelError::DegeneratePath { file, .. }
             | LevelError::BadPolygon { file, .. }
             | LevelError::MissingSpawn { file, .. }
+            | LevelError::UnknownLevel { file, .. }
             | LevelError::Limit { file, .. } => file,
         }
     }
@@ -207,6 +221,7 @@ impl LevelError {
             | LevelError::DegeneratePath { field, .. }
             | LevelError::BadPolygon { field, .. }
             | LevelError::MissingSpawn { field, .. }
+            | LevelError::UnknownLevel { field, .. }
             | LevelError::Limit { field, .. } => Some(field),
         }
     }

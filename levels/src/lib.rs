@@ -1,4 +1,4 @@
-//! ledge's level importers: OGMO Editor 3 and Tiled files into the
+//! ledge's level importers: OGMO Editor 3, Tiled and LDtk files into the
 //! simulation's [`Level`] model (`ledge_shared::level`), and the embedded
 //! default level.
 //!
@@ -9,8 +9,11 @@
 //!
 //! * [`load_file`] / [`load_file_with`]: `.json` (OGMO Editor 3 level; the
 //!   nearest `.ogmo` project in its folder or up to five folders above is
-//!   used) or `.tmx` (Tiled, through the `tiled` crate);
-//! * [`ogmo::load_str`], [`tmx::load_str`]: the same from text;
+//!   used), `.tmx` (Tiled, through the `tiled` crate) or `.ldtk` (an LDtk
+//!   project: `PATH.ldtk#LEVEL` one of its levels, `PATH.ldtk` the first;
+//!   [`ldtk::level_names`] lists them);
+//! * [`ogmo::load_str`], [`tmx::load_str`], [`ldtk::load_str`]: the same
+//!   from text;
 //! * [`default_level`], [`default_route`]: the embedded default level and the
 //!   route a runner bot can follow through it;
 //! * [`TileMapping`]: editor tile ids and grid values to [`Tile`](ledge_shared::tilemap::Tile)s;
@@ -32,6 +35,7 @@ mod collision;
 mod default;
 mod entities;
 mod error;
+pub mod ldtk;
 pub mod limits;
 mod load;
 mod loaded;

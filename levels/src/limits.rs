@@ -14,8 +14,10 @@
 //!   `tiled` crate cannot read as built here (zstd-compressed base64, and the
 //!   oldest format, one `<tile gid=".."/>` element per cell) is decoded here,
 //!   under the same bounds, and handed to it rewritten as CSV.
-//! * OGMO: the JSON text is scanned (`check_json`) for its nesting depth
-//!   and its number of values before `serde_json` builds a tree of it.
+//! * OGMO and LDtk: the JSON text is scanned (`check_json`) for its
+//!   nesting depth and its number of values before `serde_json` builds a
+//!   tree of it; the LDtk importer then checks its counts (`check_count`,
+//!   the `MAX_LDTK_*` bounds) before building anything from them.
 //!
 //! Every refusal is a [`LevelError`] naming the file, the element path (like
 //! `map.layers[3].data`) and the bound; see `docs/LEVELS.md` ("Limits").
@@ -79,12 +81,41 @@ pub const MAX_CHUNK_COORD: i64 = 1 << 24;
 /// Most bytes the objects made from templates may copy: a template's size
 /// times the number of objects using it, added up.
 pub const MAX_TEMPLATE_BYTES: u64 = 64 << 20;
-/// Deepest nesting of arrays and objects in an OGMO JSON document (the same
+/// Deepest nesting of arrays and objects in an OGMO or LDtk JSON document (the same
 /// as `serde_json`'s own recursion limit).
 pub const MAX_JSON_DEPTH: usize = 128;
 /// Most values (numbers, strings, arrays, objects, keys included) in one
-/// OGMO JSON document.
+/// OGMO or LDtk JSON document.
 pub const MAX_JSON_VALUES: u64 = 1 << 22;
+
+/// Most levels in one LDtk project (all its worlds together).
+pub const MAX_LDTK_LEVELS: u64 = 4096;
+/// Most layer instances in one LDtk level.
+pub const MAX_LDTK_LAYERS: u64 = 1024;
+/// Most entity instances in one LDtk level (all its entity layers).
+pub const MAX_LDTK_ENTITIES: u64 = 65_536;
+/// Most placed tiles (`gridTiles` and `autoLayerTiles`) in all the layers
+/// of one LDtk level.
+pub const MAX_LDTK_TILES: u64 = 1 << 22;
+/// Most definitions (layers, entities, tilesets, IntGrid values of each
+/// layer) in one LDtk project's `defs`.
+pub const MAX_LDTK_DEFS: u64 = 65_536;
+
+/// Refuses a count `found` of `what` above `max` (named `bound`), before
+/// anything is allocated for it: the LDtk importer's counts.
+pub(crate) fn check_count(
+    file: &str,
+    field: impl Into<String>,
+    what: &str,
+    found: u64,
+    max: u64,
+    bound: &'static str,
+) -> Result<(), LevelError> {
+    if found > max {
+        return Err(limit(file, field, what, max, found, bound));
+    }
+    Ok(())
+}
 
 /// Totals over the documents of one Tiled load.
 #[derive(Debug, Default)]
@@ -1446,7 +1477,7 @@ fn png_size(path: &Path) -> Option<(u32, u32)> {
     Some((w, h))
 }
 
-/// Checks an OGMO JSON document before `serde_json` parses it: its size,
+/// Checks an OGMO or LDtk JSON document before `serde_json` parses it: its size,
 /// nesting depth ([`MAX_JSON_DEPTH`]) and number of values
 /// ([`MAX_JSON_VALUES`]), in one pass without allocating.
 pub(crate) fn check_json(file: &str, text: &str) -> Result<(), LevelError> {

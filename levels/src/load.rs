@@ -1,5 +1,6 @@
 //! Loading a level file by its extension (OGMO `.json` with its project,
-//! Tiled `.tmx`), with its settings file: the importers' entry points.
+//! Tiled `.tmx`, LDtk `.ldtk` with an optional `#LEVEL`), with its settings
+//! file: the importers' entry points.
 
 use std::path::Path;
 
@@ -10,7 +11,7 @@ use crate::loaded::LoadedLevel;
 use crate::options::LoadOptions;
 use crate::read::read_text;
 use crate::settings::{settings_path_for, LevelSettings};
-use crate::{ogmo, tmx};
+use crate::{ldtk, ogmo, tmx};
 
 /// Loads a level the way the server, the client and `ledge-level` do: with
 /// the settings file `settings` when given, else the one beside the level
@@ -39,12 +40,18 @@ pub fn load_file(path: impl AsRef<Path>) -> Result<Level, LevelError> {
 /// Loads a level file by extension: `.json` is an OGMO Editor 3 level (its
 /// project is the first `.ogmo` file, by name, in the level's folder or the
 /// nearest of up to five folders above it; without one, layer kinds are told
-/// from their fields and entities need explicit sizes), `.tmx` a Tiled map.
+/// from their fields and entities need explicit sizes), `.tmx` a Tiled map,
+/// `.ldtk` an LDtk project: `PATH.ldtk#LEVEL` loads the level of that
+/// identifier, `PATH.ldtk` its first level (see [`ldtk::level_names`]). An
+/// `.ldtkl` file (one level of a project) is refused: load its project.
 pub fn load_file_with(
     path: impl AsRef<Path>,
     options: &LoadOptions,
 ) -> Result<LoadedLevel, LevelError> {
     let path = path.as_ref();
+    if let Some((project, level)) = ldtk::split_level_path(path) {
+        return ldtk::load_path(&project, level.as_deref(), options);
+    }
     let file = path.display().to_string();
     let ext = path
         .extension()
@@ -64,6 +71,11 @@ pub fn load_file_with(
             )
         }
         Some("tmx") => tmx::load_path(path, options),
+        Some("ldtkl") => Err(LevelError::BadValue {
+            file,
+            field: "(document)".into(),
+            message: "an .ldtkl file is one level of an LDtk project, without the project's definitions: load the project instead (PROJECT.ldtk#LEVEL_IDENTIFIER)".into(),
+        }),
         _ => Err(LevelError::UnsupportedFormat { file }),
     }
 }

@@ -1,7 +1,9 @@
 //! `ledge-level`: the level author's tool. `ledge-level check FILE` loads a
 //! level the way the server does and prints what it became (size, tiles by
-//! kind, entities by kind, spawn, warnings); it exits non-zero when the file
-//! is refused, so it can run before hosting or in a level's own CI.
+//! kind, entities by kind, spawn, warnings, art warnings); it exits non-zero
+//! when the file is refused, so it can run before hosting or in a level's
+//! own CI. An LDtk project is checked level by level: `FILE.ldtk#LEVEL` one
+//! of them, `FILE.ldtk` every one.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -17,7 +19,7 @@ use ledge_shared::tilemap::Tile;
 #[command(
     name = "ledge-level",
     version,
-    about = "Check ledge level files (OGMO Editor 3 .json, Tiled .tmx)"
+    about = "Check ledge level files (OGMO Editor 3 .json, Tiled .tmx, LDtk .ldtk)"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -29,7 +31,9 @@ enum Command {
     /// Load each file as the server would and print what it became; exits
     /// 1 if any file is refused.
     Check {
-        /// Level files (.json from OGMO Editor 3, .tmx from Tiled).
+        /// Level files (.json from OGMO Editor 3, .tmx from Tiled, .ldtk from
+        /// LDtk: PROJECT.ldtk#LEVEL for one level, PROJECT.ldtk for every
+        /// level of the project).
         #[arg(required = true)]
         files: Vec<PathBuf>,
         /// A settings file for every level (default: each level's own
@@ -41,6 +45,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let Command::Check { files, settings } = Cli::parse().command;
+    let files = expand(files);
     let mut failed = 0;
     for (i, file) in files.iter().enumerate() {
         if i > 0 {
@@ -75,6 +80,23 @@ fn main() -> ExitCode {
     } else {
         ExitCode::SUCCESS
     }
+}
+
+/// The files to check: an LDtk project without `#LEVEL` stands for every
+/// one of its levels (a project that cannot be listed stays as it is, to
+/// be refused with its reason).
+fn expand(files: Vec<PathBuf>) -> Vec<PathBuf> {
+    let mut out = Vec::with_capacity(files.len());
+    for f in files {
+        match ledge_levels::ldtk::split_level_path(&f) {
+            Some((_, None)) => match ledge_levels::ldtk::level_paths(&f) {
+                Ok(paths) if !paths.is_empty() => out.extend(paths),
+                _ => out.push(f),
+            },
+            _ => out.push(f),
+        }
+    }
+    out
 }
 
 /// The report for one loaded level.
@@ -158,6 +180,12 @@ fn describe(file: &str, loaded: &LoadedLevel) -> String {
     } else {
         let _ = writeln!(out, "  warnings: {}", loaded.warnings.len());
         for w in &loaded.warnings {
+            let _ = writeln!(out, "    warning: {w}");
+        }
+    }
+    if !loaded.art.warnings.is_empty() {
+        let _ = writeln!(out, "  art warnings: {}", loaded.art.warnings.len());
+        for w in &loaded.art.warnings {
             let _ = writeln!(out, "    warning: {w}");
         }
     }

@@ -9,4 +9,5 @@ static ALLOC: peak::Counting = peak::Counting;
 mod peak;
 
 mod fuzz_levels;
+mod ldtk;
 mod limits;

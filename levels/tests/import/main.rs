@@ -8,6 +8,8 @@ mod platformer_kit;
 mod art;
 mod check_cli;
 mod corpus;
+mod ldtk;
+mod ldtk_edge;
 mod level_errors;
 mod level_ogmo;
 mod level_polygon;
