@@ -34,7 +34,8 @@ pub enum LevelError {
         file: String,
         /// Where: a line and column when known, else the part of the document.
         field: String,
-        /// "JSON", "OGMO project JSON" or "TMX".
+        /// "JSON", "OGMO project JSON", "TMX", "LDtk project JSON" or "LDtk
+        /// level JSON".
         format: &'static str,
         /// What the parser said.
         message: String,

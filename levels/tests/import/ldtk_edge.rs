@@ -725,3 +725,66 @@ proptest::proptest! {
         }
     }
 }
+
+#[test]
+fn settings_choose_the_collision_layers_and_hidden_layers_do_not_collide() {
+    let dir = tempfile::tempdir().unwrap();
+    let atlas = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/testdata/levels/ldtk-samples/atlas/Cavernas_by_Adam_Saltsman.png"
+    );
+    std::fs::copy(atlas, dir.path().join("atlas.png")).unwrap();
+    let p = write(dir.path(), "s.ldtk", &everything());
+    // A tile layer listed in collision_layers collides, every placed tile
+    // solid, on its own grid and offset; the IntGrid layer, not listed,
+    // does not.
+    std::fs::write(
+        dir.path().join("s.ledge.toml"),
+        "collision_layers = [\"Tiles\"]\n",
+    )
+    .unwrap();
+    let l = load_at(&p, None).unwrap();
+    let map = &l.level.tilemap;
+    assert_eq!(
+        (map.width(), map.height(), map.tile_size()),
+        (16, 12, 8 * UNITS_PER_PX)
+    );
+    assert_eq!(map.origin(), IVec2::new(4, -4) * UNITS_PER_PX);
+    let solid: Vec<IVec2> = (0..12)
+        .flat_map(|r| (0..16).map(move |c| IVec2::new(c, r)))
+        .filter(|&c| map.tile(c) == Tile::Solid)
+        .collect();
+    assert_eq!(solid, vec![IVec2::new(1, 1), IVec2::new(15, 11)]);
+    // Decoration: the IntGrid layer does not collide.
+    std::fs::write(
+        dir.path().join("s.ledge.toml"),
+        "decoration_layers = [\"Collisions\"]\n",
+    )
+    .unwrap();
+    let l = load_at(&p, None).unwrap();
+    assert!(l.level.tilemap.tiles().iter().all(|t| *t == Tile::Empty));
+    std::fs::remove_file(dir.path().join("s.ledge.toml")).unwrap();
+    // Hidden layers neither collide nor draw, said.
+    let hide = |k: usize| {
+        let mut v = everything();
+        v["levels"][0]["layerInstances"][k]["visible"] = json!(false);
+        load_at(&write(dir.path(), "h.ldtk", &v), None).unwrap()
+    };
+    let l = hide(2);
+    assert!(l.level.tilemap.tiles().iter().all(|t| *t == Tile::Empty));
+    assert!(
+        warned(
+            &l,
+            "layerInstances[2]: layer \"Collisions\" is hidden: it neither collides nor is drawn"
+        ),
+        "{:?}",
+        l.warnings
+    );
+    assert!(l.art.layers.iter().all(|a| a.name == "Tiles"));
+    let l = hide(0);
+    assert!(warned(
+        &l,
+        "layerInstances[0]: entity layer \"Entities\" is hidden: its 3 entities are ignored"
+    ));
+    assert!(warned(&l, "no player spawn"));
+}
