@@ -43,6 +43,7 @@ mod mapping;
 pub mod ogmo;
 mod options;
 mod read;
+pub mod report;
 mod settings;
 mod spawn;
 pub mod tmx;

@@ -6,10 +6,11 @@
 //! of them, `FILE.ldtk` every one.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use ledge_levels::report::LevelReport;
 use ledge_levels::{entity_kind_name, load_level, settings_path_for, LoadedLevel};
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::level::EntityKind;
@@ -40,20 +41,96 @@ enum Command {
         /// LEVEL.ledge.toml beside it, when there is one).
         #[arg(long, value_name = "FILE")]
         settings: Option<PathBuf>,
+        /// Print the findings as one JSON document on stdout (`levels`: one
+        /// object per level; `refused`: file and error of each refused
+        /// one), for scripts.
+        #[arg(long)]
+        json: bool,
     },
 }
 
 fn main() -> ExitCode {
-    let Command::Check { files, settings } = Cli::parse().command;
-    let files = expand(files);
+    match Cli::parse().command {
+        Command::Check {
+            files,
+            settings,
+            json: false,
+        } => check(expand(files), settings),
+        Command::Check {
+            files,
+            settings,
+            json: true,
+        } => check_json(expand(files), settings),
+    }
+}
+
+/// The settings file a level is loaded with: the one given, else its own
+/// beside it when there is one.
+fn settings_for(file: &Path, given: &Option<PathBuf>) -> Option<PathBuf> {
+    given
+        .clone()
+        .or_else(|| Some(settings_path_for(file)).filter(|p| p.is_file()))
+}
+
+/// `check --json`: one document, `{"levels": [...], "refused": [...]}`.
+fn check_json(files: Vec<PathBuf>, settings: Option<PathBuf>) -> ExitCode {
+    let mut levels = Vec::new();
+    let mut refused = Vec::new();
+    for file in &files {
+        let used = settings_for(file, &settings);
+        let name = file.display().to_string();
+        match load_level(file, used.as_deref()) {
+            Ok(loaded) => {
+                let s = used.as_ref().map(|p| p.display().to_string());
+                levels.push(LevelReport::new(&name, &loaded, s.as_deref()));
+            }
+            Err(e) => refused.push(Refused {
+                file: name,
+                error: e.to_string(),
+            }),
+        }
+    }
+    let failed = !refused.is_empty();
+    match serde_json::to_string_pretty(&CheckJson { levels, refused }) {
+        Ok(text) => println!("{text}"),
+        Err(e) => {
+            eprintln!("error: cannot write the report as JSON: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// What `check --json` prints.
+#[derive(serde::Serialize)]
+struct CheckJson {
+    /// The levels that loaded.
+    levels: Vec<LevelReport>,
+    /// The files refused.
+    refused: Vec<Refused>,
+}
+
+/// A refused file.
+#[derive(serde::Serialize)]
+struct Refused {
+    /// The file as given.
+    file: String,
+    /// Why, as `check` prints it.
+    error: String,
+}
+
+/// `check`: the report in words.
+fn check(files: Vec<PathBuf>, settings: Option<PathBuf>) -> ExitCode {
     let mut failed = 0;
     for (i, file) in files.iter().enumerate() {
         if i > 0 {
             println!();
         }
-        let used = settings
-            .clone()
-            .or_else(|| Some(settings_path_for(file)).filter(|p| p.is_file()));
+        let used = settings_for(file, &settings);
         match load_level(file, used.as_deref()) {
             Ok(loaded) => {
                 print!("{}", describe(&file.display().to_string(), &loaded));
@@ -107,6 +184,12 @@ fn describe(file: &str, loaded: &LoadedLevel) -> String {
     let px = |u: i32| u as f64 / UNITS_PER_PX as f64;
     let mut out = String::new();
     let _ = writeln!(out, "{file}: ok, level {:?}", level.name);
+    if ledge_levels::report::guessed_collision(loaded) {
+        let _ = writeln!(
+            out,
+            "  collision: GUESSED (the file says nothing about what collides; see the warning)"
+        );
+    }
     if map.width() == 0 || map.height() == 0 {
         let _ = writeln!(out, "  grid: none (no tile or grid layer collides)");
     } else {

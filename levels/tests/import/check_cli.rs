@@ -60,3 +60,127 @@ fn a_refused_level_names_the_problem_and_exits_one() {
     assert!(!ok);
     assert!(err.contains("unknown field `colision_layers`"), "{err}");
 }
+
+/// A level of Tiled's own examples (tiled-rs's test assets, in
+/// `shared/testdata`) with no collision data: its collision is guessed.
+const GUESSED: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../shared/testdata/levels/tiled-rs-tiled/assets/tiled_csv.tmx"
+);
+
+/// `check --json`: one document whose fields say what the level became,
+/// checked against the same level loaded here.
+#[test]
+fn check_json_reports_the_level_as_loaded() {
+    use ledge_levels::report::WarningKind;
+    use ledge_shared::fixed::UNITS_PER_PX;
+    use ledge_shared::tilemap::Tile;
+
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, "{\"layers\": [}").unwrap();
+    let mut files = vec![FIXTURE, bad.to_str().unwrap()];
+    let guessed = std::path::Path::new(GUESSED).is_file();
+    if guessed {
+        files.push(GUESSED);
+    }
+    let mut args = vec!["--json"];
+    args.extend(&files);
+    let (ok, out, err) = check(&args);
+    assert!(!ok, "a refused file exits 1 with --json too");
+    let doc: serde_json::Value = serde_json::from_str(&out).expect("stdout is one JSON document");
+    assert!(err.is_empty(), "nothing on stderr: {err}");
+    let refused = doc["refused"].as_array().unwrap();
+    assert_eq!(refused.len(), 1);
+    assert_eq!(refused[0]["file"], bad.to_str().unwrap());
+    assert!(refused[0]["error"]
+        .as_str()
+        .unwrap()
+        .contains("malformed JSON"));
+    let levels = doc["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), files.len() - 1);
+
+    for (report, file) in levels.iter().zip([FIXTURE, GUESSED]) {
+        let loaded = ledge_levels::load_level(std::path::Path::new(file), None).unwrap();
+        let level = &loaded.level;
+        let map = &level.tilemap;
+        let px = |u: i32| u as f64 / UNITS_PER_PX as f64;
+        assert_eq!(report["file"], file);
+        assert_eq!(report["level"], level.name.as_str());
+        let grid = &report["grid"];
+        assert_eq!(grid["width"], map.width());
+        assert_eq!(grid["height"], map.height());
+        assert_eq!(grid["tile"], px(map.tile_size()));
+        assert_eq!(
+            grid["origin"],
+            serde_json::json!([px(map.origin().x), px(map.origin().y)])
+        );
+        let (lo, hi) = level.bounds().unwrap();
+        assert_eq!(
+            report["bounds"],
+            serde_json::json!([px(lo.x), px(lo.y), px(hi.x), px(hi.y)])
+        );
+        assert_eq!(
+            report["size"],
+            serde_json::json!([px(hi.x - lo.x), px(hi.y - lo.y)])
+        );
+        // Tiles and entities by kind add up to the level's.
+        let count = |t: fn(&Tile) -> bool| map.tiles().iter().filter(|x| t(x)).count() as u64;
+        let tiles = &report["tiles"];
+        let n = |k: &str| tiles[k].as_u64().unwrap_or(0);
+        assert_eq!(n("solid"), count(|t| *t == Tile::Solid));
+        assert_eq!(n("one_way"), count(|t| *t == Tile::OneWay));
+        assert_eq!(n("hazard"), count(|t| *t == Tile::Hazard));
+        assert_eq!(n("slope"), count(|t| matches!(t, Tile::Slope(_))));
+        let ents: u64 = report["entities"]
+            .as_object()
+            .unwrap()
+            .values()
+            .map(|v| v.as_u64().unwrap())
+            .sum();
+        assert_eq!(ents, level.entities.len() as u64);
+        // Layers in file order, each saying what it became.
+        let layers = report["layers"].as_array().unwrap();
+        assert_eq!(layers.len(), loaded.layers.len());
+        for (j, l) in layers.iter().zip(&loaded.layers) {
+            assert_eq!(j["name"], l.name.as_str());
+            let became = j["became"].as_str().unwrap();
+            assert!(
+                ["collision", "off_grid", "entities"].contains(&became),
+                "{became}"
+            );
+            assert_eq!(became == "collision", !l.field.is_empty() && l.on_grid);
+        }
+        // Spawns: the spawn entities' boxes.
+        let spawns: Vec<_> = level
+            .entities
+            .iter()
+            .filter(|e| e.kind == ledge_levels::EntityKind::PlayerSpawn)
+            .map(|e| serde_json::json!({"x": px(e.pos.x), "y": px(e.pos.y), "width": px(e.size.x), "height": px(e.size.y)}))
+            .collect();
+        assert_eq!(report["spawns"], serde_json::json!(spawns));
+        // Every warning, with its kind.
+        let warnings = report["warnings"].as_array().unwrap();
+        assert_eq!(
+            warnings.len(),
+            loaded.warnings.len() + loaded.art.warnings.len()
+        );
+        for (w, text) in warnings.iter().zip(loaded.warnings.iter()) {
+            assert_eq!(w["text"], text.as_str());
+            assert_eq!(w["kind"], WarningKind::of(text).name());
+        }
+        let kinds: Vec<&str> = warnings
+            .iter()
+            .map(|w| w["kind"].as_str().unwrap())
+            .collect();
+        if file == GUESSED {
+            assert_eq!(
+                kinds[..2],
+                ["guessed_collision", "spawn_placed"],
+                "{report}"
+            );
+        } else {
+            assert!(!kinds.contains(&"guessed_collision"), "{report}");
+        }
+    }
+}
