@@ -8,12 +8,28 @@ use super::{EntityDef, EntityKind, LevelError, PlatformMotion, RouteAction, Spee
 use ledge_shared::fixed::{MAX_COORD, MAX_EXTENT, MAX_SPEED, UNITS_PER_PX};
 use ledge_shared::shape::{ConvexPolygon, ShapeError, MAX_POLYGON_VERTICES};
 
+/// The player spawn names every loader (Tiled, OGMO, LDtk) reads, before
+/// the number a name may end with (`Start1`, `player_2`, `Player-3`); also
+/// written without the `_` (`PlayerStart`, `SpawnPoint`). Matching is
+/// ASCII case-insensitive, `-` and spaces read as `_`.
+pub const SPAWN_NAMES: &[&str] = &[
+    "player",
+    "spawn",
+    "player_spawn",
+    "player_start",
+    "start",
+    "start_point",
+    "spawn_point",
+    "hero",
+    "entrance",
+];
+
 /// Every entity name the loaders know, for messages (matching is ASCII
 /// case-insensitive, with `-` and spaces read as `_`):
 ///
 /// | names | becomes | parameters (OGMO `values`, Tiled `properties`) |
 /// |---|---|---|
-/// | `player`, `spawn`, `player_spawn`, `player_start`, `start` | [`EntityKind::PlayerSpawn`] | |
+/// | [`SPAWN_NAMES`]: `player`, `spawn`, `player_spawn`, `player_start`, `start`, `start_point`, `spawn_point`, `hero`, `entrance`, also with a number (`Start1`, `Player_2`) | [`EntityKind::PlayerSpawn`] | |
 /// | `block`, `solid`, `crate` | [`EntityKind::Block`]; a Tiled polygon object of these names: [`EntityKind::PolygonBlock`] | |
 /// | `polygon`, `polygon_block`, `ramp` | [`EntityKind::PolygonBlock`]: a static convex polygon of 3 to 8 vertices. OGMO: the vertices are the entity's position followed by its `nodes` (raw positions of the entity's origin, as the editor draws them); Tiled: a polygon object's points (an unnamed polygon object is one too) | |
 /// | `platform`, `moving_platform`, `mover`, `elevator` | [`EntityKind::MovingPlatform`] | `speed` (px/tick, default 1), `one_way` (bool, default false), `loop` (bool, default false); path: OGMO `nodes`, Tiled `path` (object property naming a polyline or polygon) |
@@ -30,6 +46,10 @@ pub const ENTITY_NAMES: &[&str] = &[
     "player_spawn",
     "player_start",
     "start",
+    "start_point",
+    "spawn_point",
+    "hero",
+    "entrance",
     "block",
     "solid",
     "crate",
@@ -234,10 +254,23 @@ enum Class {
     Waypoint,
 }
 
+/// Whether `n` (normalised) is a spawn name: one of [`SPAWN_NAMES`] (its
+/// `_`s optional), optionally followed by a number (`start1`, `player_2`).
+fn is_spawn_name(n: &str) -> bool {
+    let base = n.trim_end_matches(|c: char| c.is_ascii_digit());
+    let base = if base.len() < n.len() {
+        base.strip_suffix('_').unwrap_or(base)
+    } else {
+        base
+    };
+    let squash = |s: &str| s.replace('_', "");
+    let base = squash(base);
+    SPAWN_NAMES.iter().any(|s| squash(s) == base)
+}
+
 fn class_of(name: &str) -> Option<Class> {
     Some(match normalize(name).as_str() {
-        "player" | "spawn" | "player_spawn" | "playerspawn" | "player_start" | "playerstart"
-        | "start" => Class::Spawn,
+        n if is_spawn_name(n) => Class::Spawn,
         "block" | "solid" | "crate" => Class::Block,
         "polygon" | "polygon_block" | "polygonblock" | "ramp" => Class::Polygon,
         "platform" | "moving_platform" | "movingplatform" | "mover" | "elevator" => Class::Platform,

@@ -54,7 +54,7 @@ pub use default::{
 };
 pub use entities::{
     PlacedEntity, PlacedPolygon, PropValue, DEFAULT_PLATFORM_SPEED, DEFAULT_SPRING_STRENGTH,
-    DEFAULT_WALKER_SPEED, ENTITY_NAMES, MAX_PATH_NODES,
+    DEFAULT_WALKER_SPEED, ENTITY_NAMES, MAX_PATH_NODES, SPAWN_NAMES,
 };
 pub use error::LevelError;
 pub use ledge_shared::level::{

@@ -5,8 +5,7 @@
 //!
 //! | identifier (any case, `-` and spaces as `_`) | ledge entity |
 //! |---|---|
-//! | the entity table's names (`player`, `player_start`, `coin`, `goal`, `exit`, `flag`, `checkpoint`, `spike`, `hazard`, `walker`, `enemy`, ...) | as the table says |
-//! | `hero` | player spawn |
+//! | the entity table's names (the spawn names of [`crate::SPAWN_NAMES`]: `player`, `player_start`, `hero`, `Start1`, ...; `coin`, `goal`, `exit`, `flag`, `checkpoint`, `spike`, `hazard`, `walker`, `enemy`, ...) | as the table says |
 //! | `gem`, `gems`, `coins`, `collectible`, `collectibles`, `collectable` | coin |
 //! | `mob`, `mobs`, `monster` | walker (a patrol is not used: ledge walkers turn at walls and ledges) |
 //! | `door`, `finish` | goal |
@@ -36,7 +35,6 @@ const PATH_FIELDS: &[&str] = &["path", "points", "nodes", "waypoints", "route", 
 /// names, `None` when the entity table reads it as it is.
 fn ldtk_name(n: &str) -> Option<&'static str> {
     Some(match n {
-        "hero" => "player",
         "gem" | "gems" | "coins" | "collectible" | "collectibles" | "collectable" => "coin",
         "mob" | "mobs" | "monster" => "walker",
         "door" | "finish" => "goal",

@@ -14,5 +14,6 @@ mod level_errors;
 mod level_ogmo;
 mod level_polygon;
 mod level_tiled;
+mod real_levels;
 mod settings;
 mod tiled_collision;
