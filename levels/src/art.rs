@@ -20,6 +20,7 @@
 //!   OGMO writes it), the project's background colour; OGMO draws its first
 //!   layer on top, so the layers are listed last to first.
 
+pub mod covered;
 pub(crate) mod ogmo;
 pub(crate) mod tiled;
 

@@ -41,8 +41,12 @@ mod load;
 mod loaded;
 mod mapping;
 pub mod ogmo;
+pub mod overlay;
 mod options;
+pub mod palette;
 mod read;
+#[cfg(feature = "render")]
+pub mod render;
 pub mod report;
 mod settings;
 mod spawn;

@@ -1,4 +1,5 @@
-//! `ledge-level`: the level author's tool. `ledge-level check FILE` loads a
+//! `ledge-level`: the level author's tool. `ledge-level render FILE -o
+//! OUT.png` draws it with what collides on top; `ledge-level check FILE` loads a
 //! level the way the server does and prints what it became (size, tiles by
 //! kind, entities by kind, spawn, warnings, art warnings); it exits non-zero
 //! when the file is refused, so it can run before hosting or in a level's
@@ -10,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use ledge_levels::render::RenderOptions;
 use ledge_levels::report::LevelReport;
 use ledge_levels::{entity_kind_name, load_level, settings_path_for, LoadedLevel};
 use ledge_shared::fixed::UNITS_PER_PX;
@@ -20,7 +22,7 @@ use ledge_shared::tilemap::Tile;
 #[command(
     name = "ledge-level",
     version,
-    about = "Check ledge level files (OGMO Editor 3 .json, Tiled .tmx, LDtk .ldtk)"
+    about = "Check and draw ledge level files (OGMO Editor 3 .json, Tiled .tmx, LDtk .ldtk)"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -47,6 +49,30 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Draw a level as the game does (its art, or the game's plain
+    /// colours) with what collides on top (solid, one-way, slopes,
+    /// hazards, entities, spawns and a player's box at each) into a PNG.
+    Render {
+        /// The level file (PROJECT.ldtk#LEVEL for one level of an LDtk
+        /// project; PROJECT.ldtk: its first).
+        file: PathBuf,
+        /// The picture to write [default: the level's name with .png, in
+        /// the current folder].
+        #[arg(short, long, value_name = "OUT.png")]
+        output: Option<PathBuf>,
+        /// Picture pixels per world pixel (above 0, at most 16) [default:
+        /// 1, or the largest scale at which a large level fits the
+        /// picture's bounds].
+        #[arg(long, value_name = "S")]
+        scale: Option<f32>,
+        /// Leave the collision overlay out (the level as the game draws it).
+        #[arg(long)]
+        no_overlay: bool,
+        /// The level's settings file (default: LEVEL.ledge.toml beside it,
+        /// when there is one).
+        #[arg(long, value_name = "FILE")]
+        settings: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -61,6 +87,90 @@ fn main() -> ExitCode {
             settings,
             json: true,
         } => check_json(expand(files), settings),
+        Command::Render {
+            file,
+            output,
+            scale,
+            no_overlay,
+            settings,
+        } => {
+            let options = RenderOptions {
+                scale,
+                overlay: !no_overlay,
+            };
+            render(&file, output, &options, settings)
+        }
+    }
+}
+
+/// `render`: loads the level, draws it and writes the PNG; says where, at
+/// what scale and which world box it shows.
+fn render(
+    file: &Path,
+    output: Option<PathBuf>,
+    options: &RenderOptions,
+    settings: Option<PathBuf>,
+) -> ExitCode {
+    let used = settings_for(file, &settings);
+    let loaded = match load_level(file, used.as_deref()) {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let picture = match ledge_levels::render::render(&loaded, options) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {}: {e}", file.display());
+            return ExitCode::FAILURE;
+        }
+    };
+    let out = output.unwrap_or_else(|| PathBuf::from(format!("{}.png", picture_name(&loaded))));
+    let written = picture
+        .encode_png()
+        .map_err(|e| e.to_string())
+        .and_then(|bytes| std::fs::write(&out, bytes).map_err(|e| e.to_string()));
+    if let Err(e) = written {
+        eprintln!("error: cannot write {}: {e}", out.display());
+        return ExitCode::FAILURE;
+    }
+    for note in &picture.notes {
+        println!("note: {note}");
+    }
+    let [x, y] = picture.origin;
+    println!(
+        "{}: {} x {} px at scale {}, world ({x}, {y}) to ({}, {}) px",
+        out.display(),
+        picture.width(),
+        picture.height(),
+        picture.scale,
+        x + picture.width() as f32 / picture.scale,
+        y + picture.height() as f32 / picture.scale,
+    );
+    ExitCode::SUCCESS
+}
+
+/// The level's name as a file name: letters, digits, `-` and `_` kept,
+/// anything else `_` (`level` when that leaves nothing).
+fn picture_name(loaded: &LoadedLevel) -> String {
+    let name: String = loaded
+        .level
+        .name
+        .chars()
+        .take(64)
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if name.is_empty() {
+        "level".into()
+    } else {
+        name
     }
 }
 

@@ -184,3 +184,42 @@ fn check_json_reports_the_level_as_loaded() {
         }
     }
 }
+
+/// `ledge-level render`: writes the PNG it names, of the size and world box
+/// it says; a refused level, or a scale past the bounds, exits 1 saying why.
+#[test]
+fn render_writes_the_picture_it_describes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("level.png");
+    let run = |args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_ledge-level"))
+            .arg("render")
+            .args(args)
+            .output()
+            .expect("ledge-level runs");
+        (
+            o.status.success(),
+            String::from_utf8_lossy(&o.stdout).into_owned(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (ok, stdout, err) = run(&[FIXTURE, "-o", out.to_str().unwrap(), "--scale", "2"]);
+    assert!(ok, "{stdout}\n{err}");
+    assert!(
+        stdout.contains("level.png: 640 x 320 px at scale 2, world (0, 0) to (320, 160) px"),
+        "{stdout}"
+    );
+    let decoder = png::Decoder::new(std::fs::File::open(&out).unwrap());
+    let reader = decoder.read_info().unwrap();
+    assert_eq!((reader.info().width, reader.info().height), (640, 320));
+
+    let (ok, _, err) = run(&[FIXTURE, "-o", out.to_str().unwrap(), "--scale", "17"]);
+    assert!(!ok);
+    assert!(
+        err.contains("scale 17 is not a number above 0 and at most 16"),
+        "{err}"
+    );
+    let (ok, _, err) = run(&["missing.tmx"]);
+    assert!(!ok);
+    assert!(err.contains("missing.tmx: cannot read the file"), "{err}");
+}
