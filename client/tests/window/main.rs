@@ -10,6 +10,7 @@ mod chat_screenshot;
 mod failure_screenshot;
 mod ghost_screenshot;
 mod levels_screenshot;
+mod overlay_screenshot;
 mod replay_check;
 mod replay_files;
 mod replay_screenshot;

@@ -26,6 +26,7 @@ use crate::chat::{Chat, Key};
 use crate::draw::art::ArtView;
 use crate::draw::camera::{self, Camera};
 use crate::draw::ghost::{self, GhostSprite};
+use crate::draw::overlay::CollisionOverlay;
 use crate::draw::render::{self, EntitySprite, PlayerSprite};
 use crate::draw::{card, chat as chat_view, fx, hud, levels, scene};
 use crate::frame::{sound_notice, FrameClock};
@@ -78,6 +79,8 @@ pub struct Setup {
     pub name: String,
     pub debug: bool,
     pub net: bool,
+    /// Start with the collision overlay shown (`--collision`).
+    pub collision: bool,
     /// Start with the HUD shown.
     pub hud: bool,
     /// Volume, 0..=1.
@@ -147,6 +150,8 @@ struct GameLoop {
     show_net: bool,
     /// The ghosts are drawn (their key toggles them).
     show_ghosts: bool,
+    /// The collision overlay (its key toggles it).
+    collision: CollisionOverlay,
     /// The server's level list is open (its key toggles it; a vote
     /// closes it).
     show_levels: bool,
@@ -266,6 +271,7 @@ impl GameLoop {
             show_hud: setup.hud,
             show_net: setup.net,
             show_ghosts: true,
+            collision: CollisionOverlay::new(setup.collision),
             show_levels: false,
             level_changes: 0,
             splits: Splits::default(),
@@ -317,6 +323,7 @@ impl GameLoop {
         let mut scene = self.compose(dt);
         self.animate_effects(&cued, &mut scene, dt);
         self.draw_world(&scene, now);
+        self.draw_collision(&scene);
         let hud = self.hud_info(&scene, now);
         self.draw_hud(&scene, &hud, stats.as_ref(), now);
         #[cfg(target_arch = "wasm32")]
@@ -478,6 +485,9 @@ impl GameLoop {
         }
         if Bindings::pressed(&bindings.ghosts) {
             self.show_ghosts = !self.show_ghosts;
+        }
+        if Bindings::pressed(&bindings.collision) {
+            self.collision.toggle();
         }
     }
 
@@ -682,6 +692,15 @@ impl GameLoop {
             debug,
             time: now as f32,
         });
+    }
+
+    /// The collision overlay over the world, when shown (remade for each
+    /// level: at joining and at each level change).
+    fn draw_collision(&mut self, scene: &Scene) {
+        let key = self.level_changes * 2 + u64::from(self.setup.play.joined());
+        let level = self.setup.play.level();
+        self.collision
+            .draw(level, key, &scene.view, &scene.entities);
     }
 
     /// Our player's label: its name from the roster, else ours.

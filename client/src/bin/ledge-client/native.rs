@@ -44,7 +44,7 @@ Esc quits.";
 /// Keys (rebind with --keys FILE; --print-keys shows the defaults): arrows
 /// or WASD move, space, Z or K jump, down + jump drops through one-way
 /// ledges, R restarts the run, M mutes, F1 debug overlay, F2 HUD on/off,
-/// F3 network panel, G ghosts, T or Enter chat, V the server's level list
+/// F3 network panel, G ghosts, C collision overlay, T or Enter chat, V the server's level list
 /// (1-9 vote for the next level), Esc quits. Gamepads need
 /// the `gamepad` build feature. Spectating (--spectate): Tab / Shift+Tab
 /// the next player, F free camera (WASD moves it).
@@ -136,6 +136,11 @@ struct Cli {
     /// Start with the network panel and graph (F3) on.
     #[arg(long)]
     net: bool,
+    /// Start with the collision overlay (C) on: what collides, entity
+    /// boxes, spawns and a player's box at each, as `ledge-level render`
+    /// draws them.
+    #[arg(long)]
+    collision: bool,
     /// Start with the whole HUD (F2) off: clean screenshots of the level.
     #[arg(long)]
     no_hud: bool,
@@ -291,6 +296,7 @@ fn run() -> anyhow::Result<()> {
             for w in &loaded.art.warnings {
                 let _ = writeln!(err, "warning: level art: {w}");
             }
+            let _ = writeln!(err, "ledge-client: {}", loaded_line(path, &loaded));
             (loaded.level, loaded.art)
         }
         _ => (ledge_levels::default_level(), Default::default()),
@@ -343,6 +349,7 @@ fn run() -> anyhow::Result<()> {
         name: cli.name,
         debug: cli.debug,
         net: cli.net,
+        collision: cli.collision,
         hud: !cli.no_hud,
         volume: f32::from(cli.volume) / 100.0,
         mute: cli.mute,
@@ -367,6 +374,28 @@ fn run() -> anyhow::Result<()> {
         0 => Ok(()),
         code => std::process::exit(code),
     }
+}
+
+/// The level-load line: the level, its warnings, and when its collision
+/// was guessed (the file says nothing about what collides) that it was.
+fn loaded_line(path: &std::path::Path, loaded: &ledge_levels::LoadedLevel) -> String {
+    let n = loaded.warnings.len() + loaded.art.warnings.len();
+    let warnings = match n {
+        0 => "no warnings".to_owned(),
+        1 => "1 warning (above)".to_owned(),
+        n => format!("{n} warnings (above)"),
+    };
+    let guessed = if ledge_levels::report::guessed_collision(loaded) {
+        "; its collision is GUESSED: the file says nothing about what collides, so whole \
+         layers were made solid (press C to see what collides; `ledge-level render` draws it)"
+    } else {
+        ""
+    };
+    format!(
+        "level {:?} loaded from {}: {warnings}{guessed}",
+        loaded.level.name,
+        path.display()
+    )
 }
 
 /// The replay's options from the command line.

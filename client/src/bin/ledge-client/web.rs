@@ -76,6 +76,7 @@ pub fn main() {
         name,
         debug: param("debug").is_some(),
         net: param("net").is_some(),
+        collision: param("collision").is_some(),
         hud: param("nohud").is_none(),
         volume: 0.8,
         mute: false,

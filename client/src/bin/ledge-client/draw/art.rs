@@ -9,7 +9,6 @@
 //! level has no art.
 
 use ledge_levels::art::{ArtContent, LevelArt, TileGrid, TileSource};
-use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::tilemap::Tilemap;
 use macroquad::prelude::*;
 
@@ -55,7 +54,7 @@ impl ArtView {
                 }
             })
             .collect();
-        let covered = covered_cells(&art, map);
+        let covered = ledge_levels::art::covered::covered_cells(&art, map);
         ArtView {
             art,
             textures,
@@ -252,64 +251,4 @@ impl ArtView {
 
 fn rect_of(s: TileSource) -> Rect {
     Rect::new(s.x as f32, s.y as f32, s.w as f32, s.h as f32)
-}
-
-/// The collision cells of `map` whose centre some tile or unrotated tile
-/// object of a layer without parallax covers (row-major).
-fn covered_cells(art: &LevelArt, map: &Tilemap) -> Vec<bool> {
-    let (w, h) = (map.width() as i64, map.height() as i64);
-    let mut covered = vec![false; (w * h) as usize];
-    if art.is_empty() || w == 0 || h == 0 {
-        return covered;
-    }
-    let px = UNITS_PER_PX as f32;
-    let t = map.tile_size() as f32 / px;
-    let o = vec2(map.origin().x as f32, map.origin().y as f32) / px;
-    let mut mark = |r: Rect| {
-        // Cells whose centre is inside `r`.
-        let c0 = ((r.x - o.x) / t - 0.5).ceil().max(0.0) as i64;
-        let r0 = ((r.y - o.y) / t - 0.5).ceil().max(0.0) as i64;
-        let c1 = (((r.right() - o.x) / t - 0.5).floor() as i64).min(w - 1);
-        let r1 = (((r.bottom() - o.y) / t - 0.5).floor() as i64).min(h - 1);
-        for rr in r0..=r1 {
-            for cc in c0..=c1 {
-                covered[(rr * w + cc) as usize] = true;
-            }
-        }
-    };
-    for layer in &art.layers {
-        if layer.parallax != (1.0, 1.0) || layer.opacity < 0.5 {
-            continue;
-        }
-        let off = vec2(layer.offset.0, layer.offset.1);
-        match &layer.content {
-            ArtContent::Tiles(g) => {
-                for (i, cell) in g.cells.iter().enumerate() {
-                    let Some(cell) = cell else { continue };
-                    let Some(src) = art.source(cell.tileset, cell.tile) else {
-                        continue;
-                    };
-                    let (c, r) = (i as u32 % g.width.max(1), i as u32 / g.width.max(1));
-                    let to = art.tilesets[cell.tileset as usize].offset;
-                    let x = off.x + (c * g.cell_width) as f32 + to.0 as f32;
-                    let y = off.y + ((r + 1) * g.cell_height) as f32 - src.h as f32 + to.1 as f32;
-                    mark(Rect::new(x, y, src.w as f32, src.h as f32));
-                }
-            }
-            ArtContent::Objects(objs) => {
-                for ob in objs.iter().filter(|ob| ob.rotation == 0.0) {
-                    if art.source(ob.tileset, ob.tile).is_some() {
-                        mark(Rect::new(
-                            off.x + ob.x,
-                            off.y + ob.y - ob.height,
-                            ob.width,
-                            ob.height,
-                        ));
-                    }
-                }
-            }
-            ArtContent::Image { .. } => {}
-        }
-    }
-    covered
 }

@@ -3,8 +3,8 @@
 //! in [`art`]), how the players move between ticks ([`anim`]), particles,
 //! shake and flashes ([`fx`]), the ghosts to race ([`ghost`]), the heads-up display ([`hud`]), the results
 //! card once our run is finished ([`card`]), the chat ([`chat`]), the
-//! server's level list and a level's download ([`levels`]) and the
-//! debug overlay ([`debug`]); the world's layers in their order
+//! server's level list and a level's download ([`levels`]), the
+//! debug overlay ([`debug`]) and the collision overlay ([`overlay`]); the world's layers in their order
 //! ([`scene`]), and a replay's HUD ([`replay_hud`]).
 //!
 //! Grouped so that the front end's layout says what it does; this module
@@ -20,6 +20,7 @@ pub mod fx;
 pub mod ghost;
 pub mod hud;
 pub mod levels;
+pub mod overlay;
 pub mod render;
 pub mod replay_hud;
 pub mod scene;

@@ -13,52 +13,64 @@ use macroquad::prelude::*;
 
 use crate::draw::camera::View;
 
-/// The colours of the game.
+/// The colours of the game. Those a level is drawn with are
+/// `ledge_levels::palette::flat`'s (`ledge-level render` draws with them
+/// too).
 pub mod palette {
+    use ledge_levels::palette;
     use macroquad::color::Color;
 
     const fn rgb(r: u8, g: u8, b: u8) -> Color {
         Color::new(r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0, 1.0)
     }
 
+    const fn flat(c: palette::Rgba) -> Color {
+        Color::new(
+            c[0] as f32 / 255.0,
+            c[1] as f32 / 255.0,
+            c[2] as f32 / 255.0,
+            c[3] as f32 / 255.0,
+        )
+    }
+
     /// The sky behind everything.
-    pub const SKY: Color = rgb(104, 164, 226);
+    pub const SKY: Color = flat(palette::flat::SKY);
     /// Distant clouds.
     pub const CLOUD: Color = rgb(236, 242, 250);
     /// Solid ground (tiles and the body of slopes).
-    pub const SOLID: Color = rgb(124, 84, 60);
+    pub const SOLID: Color = flat(palette::flat::SOLID);
     /// Pebbles in the ground.
-    pub const SOLID_SPECK: Color = rgb(104, 70, 50);
+    pub const SOLID_SPECK: Color = flat(palette::flat::SOLID_SPECK);
     /// Edges of the ground facing empty space.
-    pub const SOLID_EDGE: Color = rgb(70, 46, 34);
+    pub const SOLID_EDGE: Color = flat(palette::flat::SOLID_EDGE);
     /// Grass on exposed ground tops and slope surfaces.
-    pub const GRASS: Color = rgb(92, 184, 72);
+    pub const GRASS: Color = flat(palette::flat::GRASS);
     /// The darker line under the grass.
-    pub const GRASS_DARK: Color = rgb(56, 128, 48);
+    pub const GRASS_DARK: Color = flat(palette::flat::GRASS_DARK);
     /// One-way ledges (tiles).
-    pub const PLANK: Color = rgb(196, 142, 78);
+    pub const PLANK: Color = flat(palette::flat::PLANK);
     /// Their shaded underside.
-    pub const PLANK_DARK: Color = rgb(128, 86, 44);
+    pub const PLANK_DARK: Color = flat(palette::flat::PLANK_DARK);
     /// Spikes.
-    pub const SPIKE: Color = rgb(222, 226, 236);
+    pub const SPIKE: Color = flat(palette::flat::SPIKE);
     /// Spike outlines and bases.
-    pub const SPIKE_DARK: Color = rgb(120, 30, 40);
+    pub const SPIKE_DARK: Color = flat(palette::flat::SPIKE_DARK);
     /// Crates (blocks).
-    pub const CRATE: Color = rgb(186, 124, 58);
+    pub const CRATE: Color = flat(palette::flat::CRATE);
     /// Crate boards.
-    pub const CRATE_DARK: Color = rgb(120, 74, 30);
+    pub const CRATE_DARK: Color = flat(palette::flat::CRATE_DARK);
     /// Solid moving platforms.
-    pub const STEEL: Color = rgb(108, 120, 146);
+    pub const STEEL: Color = flat(palette::flat::STEEL);
     /// Their outline.
-    pub const STEEL_DARK: Color = rgb(58, 64, 84);
+    pub const STEEL_DARK: Color = flat(palette::flat::STEEL_DARK);
     /// Their lit top edge.
     pub const STEEL_LIGHT: Color = rgb(170, 184, 210);
     /// One-way moving platforms.
-    pub const ONE_WAY: Color = rgb(240, 196, 72);
+    pub const ONE_WAY: Color = flat(palette::flat::ONE_WAY);
     /// Their see-through underside.
     pub const ONE_WAY_GHOST: Color = Color::new(0.94, 0.77, 0.28, 0.35);
     /// Walkers.
-    pub const WALKER: Color = rgb(170, 60, 160);
+    pub const WALKER: Color = flat(palette::flat::WALKER);
     /// Defeated walkers.
     pub const WALKER_DEAD: Color = Color::new(0.45, 0.45, 0.5, 0.7);
     /// Dust kicked up by feet.
@@ -72,23 +84,23 @@ pub mod palette {
         rgb(250, 250, 250),
     ];
     /// Coins.
-    pub const COIN: Color = rgb(252, 206, 40);
+    pub const COIN: Color = flat(palette::flat::COIN);
     /// Coin shine.
     pub const COIN_LIGHT: Color = rgb(255, 240, 160);
     /// Coin rim.
     pub const COIN_DARK: Color = rgb(186, 132, 18);
     /// Springboard pads.
-    pub const SPRING: Color = rgb(226, 62, 62);
+    pub const SPRING: Color = flat(palette::flat::SPRING);
     /// Springboard coils and bases.
     pub const METAL: Color = rgb(150, 156, 168);
     /// Poles of checkpoints and the goal.
-    pub const POLE: Color = rgb(236, 236, 240);
+    pub const POLE: Color = flat(palette::flat::POLE);
     /// A checkpoint that is the local player's respawn point.
     pub const FLAG_ACTIVE: Color = rgb(64, 224, 120);
     /// Other checkpoints.
-    pub const FLAG_IDLE: Color = rgb(140, 140, 152);
+    pub const FLAG_IDLE: Color = flat(palette::flat::FLAG_IDLE);
     /// The goal.
-    pub const GOAL: Color = rgb(255, 208, 32);
+    pub const GOAL: Color = flat(palette::flat::GOAL);
     /// Outlines of dark things and eye pupils.
     pub const INK: Color = rgb(24, 20, 30);
     /// Eyes.

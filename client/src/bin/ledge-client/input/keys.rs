@@ -31,6 +31,8 @@ hud = ["F2"]
 net = ["F3"]
 # Ghosts (the level's record, your best) on/off.
 ghosts = ["G"]
+# Collision overlay (what collides, entity boxes, spawns) on/off.
+collision = ["C"]
 # Opens the chat line (then Enter sends it, Escape closes it).
 chat = ["T", "Enter"]
 # The server's level list opens/closes (then 1-9 vote for a level).
@@ -53,6 +55,7 @@ struct KeyFile {
     hud: Option<Vec<String>>,
     net: Option<Vec<String>>,
     ghosts: Option<Vec<String>>,
+    collision: Option<Vec<String>>,
     chat: Option<Vec<String>>,
     levels: Option<Vec<String>>,
     quit: Option<Vec<String>>,
@@ -73,6 +76,8 @@ pub struct Bindings {
     pub net: Vec<KeyCode>,
     /// Toggles the ghosts.
     pub ghosts: Vec<KeyCode>,
+    /// Toggles the collision overlay.
+    pub collision: Vec<KeyCode>,
     /// Opens the chat line.
     pub chat: Vec<KeyCode>,
     /// Opens and closes the server's level list (votes).
@@ -97,6 +102,7 @@ impl Default for Bindings {
             hud: Vec::new(),
             net: Vec::new(),
             ghosts: Vec::new(),
+            collision: Vec::new(),
             chat: Vec::new(),
             levels: Vec::new(),
             quit: Vec::new(),
@@ -141,6 +147,7 @@ impl Bindings {
         keys(file.hud, &mut self.hud)?;
         keys(file.net, &mut self.net)?;
         keys(file.ghosts, &mut self.ghosts)?;
+        keys(file.collision, &mut self.collision)?;
         keys(file.chat, &mut self.chat)?;
         keys(file.levels, &mut self.levels)?;
         keys(file.quit, &mut self.quit)?;
@@ -406,6 +413,7 @@ mod tests {
         assert_eq!(b.net, [KeyCode::F3]);
         assert_eq!(b.mute, [KeyCode::M]);
         assert_eq!(b.ghosts, [KeyCode::G]);
+        assert_eq!(b.collision, [KeyCode::C]);
         assert_eq!(b.chat, [KeyCode::T, KeyCode::Enter]);
         assert_eq!(b.levels, [KeyCode::V]);
         assert_eq!(b.buttons[5], (Buttons::RESTART, vec![KeyCode::R]));
@@ -431,7 +439,15 @@ mod tests {
         );
         let mut all: Vec<KeyCode> = b.buttons.iter().flat_map(|(_, k)| k.clone()).collect();
         for keys in [
-            &b.mute, &b.debug, &b.hud, &b.net, &b.ghosts, &b.chat, &b.levels, &b.quit,
+            &b.mute,
+            &b.debug,
+            &b.hud,
+            &b.net,
+            &b.ghosts,
+            &b.collision,
+            &b.chat,
+            &b.levels,
+            &b.quit,
         ] {
             all.extend(keys.iter().copied());
         }
