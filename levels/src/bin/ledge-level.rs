@@ -65,6 +65,10 @@ enum Command {
         /// picture's bounds].
         #[arg(long, value_name = "S")]
         scale: Option<f32>,
+        /// Only this part of the world, in world pixels: X,Y,WIDTH,HEIGHT
+        /// [default: the whole level].
+        #[arg(long, value_name = "X,Y,W,H", value_parser = parse_region)]
+        region: Option<[f32; 4]>,
         /// Leave the collision overlay out (the level as the game draws it).
         #[arg(long)]
         no_overlay: bool,
@@ -91,12 +95,14 @@ fn main() -> ExitCode {
             file,
             output,
             scale,
+            region,
             no_overlay,
             settings,
         } => {
             let options = RenderOptions {
                 scale,
                 overlay: !no_overlay,
+                region,
             };
             render(&file, output, &options, settings)
         }
@@ -149,6 +155,15 @@ fn render(
         y + picture.height() as f32 / picture.scale,
     );
     ExitCode::SUCCESS
+}
+
+/// `X,Y,W,H`: four numbers.
+fn parse_region(s: &str) -> Result<[f32; 4], String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f32>().map_err(|e| format!("{p:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    <[f32; 4]>::try_from(v).map_err(|_| "expected X,Y,WIDTH,HEIGHT in world pixels".to_owned())
 }
 
 /// The level's name as a file name: letters, digits, `-` and `_` kept,

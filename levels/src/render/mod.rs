@@ -41,6 +41,9 @@ pub struct RenderOptions {
     pub scale: Option<f32>,
     /// Draw the collision overlay.
     pub overlay: bool,
+    /// The part of the world to draw, world pixels `[left, top, width,
+    /// height]` (`None`: [`extent`], the whole level).
+    pub region: Option<[f32; 4]>,
 }
 
 impl Default for RenderOptions {
@@ -48,6 +51,7 @@ impl Default for RenderOptions {
         RenderOptions {
             scale: None,
             overlay: true,
+            region: None,
         }
     }
 }
@@ -86,6 +90,9 @@ pub enum RenderError {
     /// A scale that is not a number in `(0, MAX_RENDER_SCALE]`.
     #[error("scale {0} is not a number above 0 and at most {MAX_RENDER_SCALE}")]
     BadScale(f32),
+    /// A region that is not a box of at least one pixel.
+    #[error("region {0:?} is not a box of finite numbers at least 1 px wide and high")]
+    BadRegion([f32; 4]),
     /// The PNG could not be encoded.
     #[error("cannot encode the picture as PNG: {0}")]
     Png(String),
@@ -185,7 +192,15 @@ fn fitting_scale(w: f32, h: f32) -> f32 {
 
 /// Draws `loaded`: its art (or plain colours), then the overlay when asked.
 pub fn render(loaded: &LoadedLevel, options: &RenderOptions) -> Result<Rendered, RenderError> {
-    let [l, t, r, b] = extent(loaded);
+    let [l, t, r, b] = match options.region {
+        Some([x, y, w, h])
+            if [x, y, w, h].iter().all(|v| v.is_finite()) && w >= 1.0 && h >= 1.0 =>
+        {
+            [x.floor(), y.floor(), (x + w).ceil(), (y + h).ceil()]
+        }
+        Some(r) => return Err(RenderError::BadRegion(r)),
+        None => extent(loaded),
+    };
     let (w, h) = (r - l, b - t);
     let mut notes = Vec::new();
     let scale = match options.scale {

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::palette::overlay;
-use ledge_shared::level::{EntityDef, EntityKind, Level};
+use ledge_shared::level::{EntityDef, EntityKind};
 use ledge_shared::tilemap::{Tile, Tilemap};
 
 fn default_loaded() -> LoadedLevel {
@@ -28,6 +28,7 @@ fn the_overlay_is_the_plain_picture_with_each_kind_in_its_colour() {
         &RenderOptions {
             scale: Some(1.0),
             overlay: false,
+            region: None,
         },
     )
     .unwrap();
@@ -98,6 +99,7 @@ fn a_level_without_art_is_drawn_in_the_games_plain_colours() {
         &RenderOptions {
             scale: Some(2.0),
             overlay: false,
+            region: None,
         },
     )
     .unwrap();
@@ -120,11 +122,11 @@ fn wide(apart: i32) -> LoadedLevel {
         pos: glam::IVec2::new(x * UNITS_PER_PX, 0),
         size: glam::IVec2::splat(16 * UNITS_PER_PX),
     };
-    let level = Level {
-        name: "wide".into(),
-        tilemap: Tilemap::new(glam::IVec2::ZERO, 16 * UNITS_PER_PX, 0, 0, Vec::new()).unwrap(),
-        entities: vec![block(0), block(apart)],
-    };
+    // The default level's settings, none of its contents.
+    let mut level = crate::default_level();
+    level.name = "wide".into();
+    level.tilemap = Tilemap::new(glam::IVec2::ZERO, 16 * UNITS_PER_PX, 0, 0, Vec::new()).unwrap();
+    level.entities = vec![block(0), block(apart)];
     LoadedLevel {
         level,
         route: Vec::new(),
@@ -142,6 +144,7 @@ fn a_level_too_large_is_drawn_smaller_or_refused_naming_the_limit() {
         &RenderOptions {
             scale: Some(1.0),
             overlay: true,
+            region: None,
         },
     )
     .err()
@@ -155,12 +158,20 @@ fn a_level_too_large_is_drawn_smaller_or_refused_naming_the_limit() {
     assert!(auto.width() <= MAX_RENDER_SIDE, "{}", auto.width());
     assert!(auto.scale < 0.17 && auto.scale > 0.15, "{}", auto.scale);
     assert!(auto.notes[0].contains("--scale"), "{:?}", auto.notes);
+    // A region of it: drawn at scale 1.
+    let region = RenderOptions {
+        region: Some([99_990.0, -8.0, 40.0, 16.0]),
+        ..RenderOptions::default()
+    };
+    let part = render(&loaded, &region).unwrap();
+    assert_eq!((part.width(), part.height(), part.scale), (40, 16, 1.0));
+    assert_eq!(part.origin, [99_990.0, -8.0]);
     assert!(matches!(
         render(
             &loaded,
             &RenderOptions {
                 scale: Some(f32::NAN),
-                overlay: true
+                ..RenderOptions::default()
             }
         ),
         Err(RenderError::BadScale(_))
