@@ -89,6 +89,30 @@ pub struct PlayLevel {
     pub level: Level,
     /// A fresh game of it, with the server's rules, at tick 0.
     pub game: Game,
+    /// Its warnings, as the start line counts them.
+    pub warnings: LevelWarnings,
+}
+
+/// What a level's warnings come to: how many, and the worst (the kind a
+/// host must see first, [`ledge_levels::report::worst_warning`]).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct LevelWarnings {
+    /// How many (art warnings included).
+    pub count: usize,
+    /// The worst.
+    pub worst: Option<ledge_levels::report::Warning>,
+}
+
+impl std::fmt::Display for LevelWarnings {
+    /// `no warnings`, `1 warning: collision guessed`, `3 warnings, the
+    /// worst: collision guessed`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match (&self.worst, self.count) {
+            (None, _) | (_, 0) => write!(f, "no warnings"),
+            (Some(w), 1) => write!(f, "1 warning: {}", w.kind.summary()),
+            (Some(w), n) => write!(f, "{n} warnings, the worst: {}", w.kind.summary()),
+        }
+    }
 }
 
 /// The levels a server plays, in rotation order: at least one, at most
@@ -126,7 +150,7 @@ impl LevelSet {
                 || "(embedded default level)".to_owned(),
                 |p| p.display().to_string(),
             );
-            let bundle = load(file.as_deref(), settings)?;
+            let (bundle, warnings) = load_counted(file.as_deref(), settings)?;
             let game = Game::with_config(&bundle.level, config).map_err(|source| {
                 LevelLoadError::Game {
                     path: path.clone(),
@@ -148,6 +172,7 @@ impl LevelSet {
                 bundle: bytes::Bytes::from(bytes),
                 level: bundle.level,
                 game,
+                warnings,
             });
         }
         Ok(LevelSet {
@@ -178,6 +203,33 @@ impl LevelSet {
     /// The level whose bundle has this SHA-256, if the server plays it.
     pub fn by_sha256(&self, sha256: &[u8; 32]) -> Option<&PlayLevel> {
         self.levels.iter().find(|l| &l.offer.sha256 == sha256)
+    }
+
+    /// The levels' warnings for the start lines: `level "castle": 2
+    /// warnings, the worst: collision guessed` (the log lists them); for a
+    /// rotation each level with warnings (at most 8 named).
+    pub fn warnings_line(&self) -> String {
+        if let [one] = &self.levels[..] {
+            return format!("level {:?}: {}", one.id, one.warnings);
+        }
+        let warned: Vec<&PlayLevel> = self
+            .levels
+            .iter()
+            .filter(|l| l.warnings.count > 0)
+            .collect();
+        let mut line = format!(
+            "{} levels, {} with warnings",
+            self.levels.len(),
+            warned.len()
+        );
+        for (i, l) in warned.iter().take(8).enumerate() {
+            line.push_str(if i == 0 { ": " } else { "; " });
+            line.push_str(&format!("{:?} {}", l.id, l.warnings));
+        }
+        if warned.len() > 8 {
+            line.push_str(&format!("; and {} more", warned.len() - 8));
+        }
+        line
     }
 
     /// The rotation as players choose from it.
@@ -303,6 +355,14 @@ fn world_maps(text: &str) -> Result<Vec<String>, String> {
 /// (what it ignored or placed, and where), with the art clients draw it
 /// with; or the embedded default level (no art).
 pub fn load(path: Option<&Path>, settings: Option<&Path>) -> Result<LevelBundle, LevelLoadError> {
+    load_counted(path, settings).map(|(bundle, _)| bundle)
+}
+
+/// [`load`], and what its warnings come to.
+fn load_counted(
+    path: Option<&Path>,
+    settings: Option<&Path>,
+) -> Result<(LevelBundle, LevelWarnings), LevelLoadError> {
     match path {
         Some(path) => {
             let loaded =
@@ -316,12 +376,17 @@ pub fn load(path: Option<&Path>, settings: Option<&Path>) -> Result<LevelBundle,
             for w in &loaded.art.warnings {
                 warn!("level art: {w}");
             }
-            Ok(LevelBundle {
+            let warnings = LevelWarnings {
+                count: loaded.warnings.len() + loaded.art.warnings.len(),
+                worst: ledge_levels::report::worst_warning(&loaded),
+            };
+            let bundle = LevelBundle {
                 level: loaded.level,
                 art: loaded.art,
-            })
+            };
+            Ok((bundle, warnings))
         }
-        None => Ok(LevelBundle::default_level()),
+        None => Ok((LevelBundle::default_level(), LevelWarnings::default())),
     }
 }
 
@@ -430,5 +495,28 @@ mod tests {
     fn a_missing_file_is_an_error() {
         let err = load(Some(Path::new("/nonexistent/level.json")), None).unwrap_err();
         assert!(err.to_string().contains("/nonexistent/level.json"), "{err}");
+    }
+
+    /// The start line counts a level's warnings and names the worst:
+    /// echo-slopes' `slopes.json` (shared/testdata) has no collision data.
+    #[test]
+    fn the_warnings_line_names_the_worst_warning() {
+        let slopes = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../shared/testdata/levels/echo-slopes/slopes.json");
+        let set = LevelSet::load(&[], None, GameConfig::default(), 64).unwrap();
+        assert_eq!(set.warnings_line(), "level \"default\": no warnings");
+        if !slopes.is_file() {
+            return;
+        }
+        let set = LevelSet::load(&[slopes], None, GameConfig::default(), 64).unwrap();
+        assert_eq!(
+            set.warnings_line(),
+            "level \"slopes\": 2 warnings, the worst: collision guessed"
+        );
+        let w = &set.get(0).warnings;
+        assert_eq!(
+            w.worst.as_ref().unwrap().kind,
+            ledge_levels::report::WarningKind::GuessedCollision
+        );
     }
 }

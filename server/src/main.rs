@@ -164,6 +164,9 @@ async fn run(config: ledge_server::config::ServerConfig) -> anyhow::Result<()> {
         ));
     }
 
+    // Last, where a host looks: what the level's warnings come to.
+    say(format_args!("{}", server.levels().warnings_line()));
+
     let shutdown = server.shutdown_handle();
     tokio::spawn(async move {
         let signal = signals.recv().await;

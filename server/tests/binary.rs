@@ -143,6 +143,11 @@ fn logs_go_to_stderr_without_colour_and_stdout_says_how_to_join() {
     );
     assert!(!rest.contains("INFO"), "logs on stdout: {rest}");
     assert!(!rest.contains("join"), "one join line: {rest}");
+    // Last, what the level's warnings come to (the embedded level has none).
+    assert!(
+        rest.lines().any(|l| l == "level \"default\": no warnings"),
+        "{rest}"
+    );
 }
 
 #[test]
