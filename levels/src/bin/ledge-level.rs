@@ -309,12 +309,7 @@ fn describe(file: &str, loaded: &LoadedLevel) -> String {
     let px = |u: i32| u as f64 / UNITS_PER_PX as f64;
     let mut out = String::new();
     let _ = writeln!(out, "{file}: ok, level {:?}", level.name);
-    if ledge_levels::report::guessed_collision(loaded) {
-        let _ = writeln!(
-            out,
-            "  collision: GUESSED (the file says nothing about what collides; see the warning)"
-        );
-    }
+    out.push_str(guessed_note(loaded));
     if map.width() == 0 || map.height() == 0 {
         let _ = writeln!(out, "  grid: none (no tile or grid layer collides)");
     } else {
@@ -398,6 +393,15 @@ fn describe(file: &str, loaded: &LoadedLevel) -> String {
         }
     }
     out
+}
+
+/// The line saying the level's collision was guessed, if it was.
+fn guessed_note(loaded: &LoadedLevel) -> &'static str {
+    if ledge_levels::report::guessed_collision(loaded) {
+        "  collision: GUESSED (the file says nothing about what collides; see the warning)\n"
+    } else {
+        ""
+    }
 }
 
 fn counts(map: &BTreeMap<&str, usize>) -> String {

@@ -65,6 +65,19 @@ struct Placement {
 fn blit(canvas: &mut Canvas, image: &Pixmap, src: TileSource, at: &Placement) {
     let [dx, dy, dw, dh] = at.dest;
     let (sw, sh) = (src.w as f32, src.h as f32);
+    let numbers = [
+        dx,
+        dy,
+        dw,
+        dh,
+        at.degrees,
+        at.pivot[0],
+        at.pivot[1],
+        at.opacity,
+    ];
+    if numbers.iter().any(|v| !v.is_finite()) {
+        return;
+    }
     let Some(rect) = Rect::from_xywh(dx, dy, dw, dh) else {
         return;
     };
