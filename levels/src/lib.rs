@@ -41,8 +41,8 @@ mod load;
 mod loaded;
 mod mapping;
 pub mod ogmo;
-pub mod overlay;
 mod options;
+pub mod overlay;
 pub mod palette;
 mod read;
 #[cfg(feature = "render")]
