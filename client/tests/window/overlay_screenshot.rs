@@ -21,6 +21,9 @@
 //! colliding tile in view, and a twentieth of the picture or more,
 //! changed by it).
 //!
+//! The window's level-load line (stderr) says its collision was guessed
+//! exactly when `ledge_levels::report::guessed_collision` says so.
+//!
 //! Needs `xvfb-run` and `shared/testdata`: without either it prints a loud
 //! notice and passes, except with `CI=true` (a missing `xvfb-run` fails).
 
@@ -65,7 +68,7 @@ fn out_dir(tmp: &Path) -> PathBuf {
 
 /// The client's screenshot of `level` with the overlay on, the camera on
 /// `look_at`, and its JSON.
-fn screenshot(xvfb: &Path, level: &str, look_at: (f32, f32), png: &Path) -> (Png, Value) {
+fn screenshot(xvfb: &Path, level: &str, look_at: (f32, f32), png: &Path) -> (Png, Value, String) {
     let mut command = common::client_under_xvfb(xvfb, env!("CARGO_BIN_EXE_ledge-client"), 10, png);
     command
         .arg("--level")
@@ -81,7 +84,8 @@ fn screenshot(xvfb: &Path, level: &str, look_at: (f32, f32), png: &Path) -> (Png
     );
     let json_path = format!("{}.json", png.display());
     let json = serde_json::from_str(&std::fs::read_to_string(json_path).unwrap()).unwrap();
-    (Png::load(png), json)
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    (Png::load(png), json, stderr)
 }
 
 /// How many pixels were compared, how many differ, and a few of them.
@@ -119,11 +123,18 @@ fn check_level(xvfb: &Path, level: &str, look_at: (f32, f32), name: &str) {
     let tmp = tempfile::tempdir().unwrap();
     let dir = out_dir(tmp.path());
     let shot_path = dir.join(format!("{name}-window.png"));
-    let (shot, json) = screenshot(xvfb, level, look_at, &shot_path);
+    let (shot, json, stderr) = screenshot(xvfb, level, look_at, &shot_path);
     let zoom = json["camera"]["zoom"].as_f64().unwrap();
     let (ox, oy) = pair(&json["camera"]["offset"]);
 
     let loaded = ledge_levels::load_level(Path::new(level), None).expect("the level loads");
+    // The level-load line says whether the collision was guessed.
+    let guessed = ledge_levels::report::guessed_collision(&loaded);
+    let line = stderr
+        .lines()
+        .find(|l| l.starts_with("ledge-client: level "))
+        .unwrap_or_else(|| panic!("no level-load line: {stderr}"));
+    assert_eq!(line.contains("its collision is GUESSED"), guessed, "{line}");
     // What the window shows of the world (the level is 3200 px square at
     // zoom 2 for Tiled's: larger than a whole picture may be).
     let (w, h) = (shot.width as f64 / zoom, shot.height as f64 / zoom);
