@@ -20,6 +20,10 @@
 //! A property set to false says the opposite: `solid = false` on a tile makes
 //! it empty, `collision = false` on a layer makes it non-colliding.
 
+pub(crate) mod infer;
+pub(crate) mod names;
+pub(crate) mod resample;
+
 use ledge_shared::tilemap::{Slope, Tile};
 
 use crate::mapping::{normalize, parse_tile_kind};
@@ -231,7 +235,9 @@ const DECORATION_LAYER_WORDS: &[&str] = &[
 pub(crate) fn is_collision_layer_name(name: &str) -> bool {
     let n = normalize(name);
     let words: Vec<&str> = n.split('_').filter(|w| !w.is_empty()).collect();
-    if words.iter().any(|w| DECORATION_LAYER_WORDS.contains(w)) {
+    if words.iter().any(|w| DECORATION_LAYER_WORDS.contains(w))
+        || names::decoration_word(name).is_some()
+    {
         return false;
     }
     COLLISION_LAYER_NAMES.contains(&n.as_str())

@@ -953,7 +953,18 @@ pub fn load_str(
         _ => crate::art::LevelArt::default(),
     };
     let mut warnings = level.warnings;
+    let layers = crate::collision::names::without_decoration(
+        file,
+        level.layers,
+        options,
+        &mut warnings,
+        |l| match l.content {
+            LayerContent::Tiles { .. } | LayerContent::Grid { .. } => Some((&l.name, &l.field)),
+            _ => None,
+        },
+    );
     let mut grids = Vec::new();
+    let mut painted = Vec::new();
     let mut entities = Vec::new();
     // OGMO tile layers say nothing about collision. A level with no
     // collision data at all (no grid layer, no tile table or settings for
@@ -962,19 +973,18 @@ pub fn load_str(
     // so.
     let mapped = |t: &str| options.mapping.has_table(t) || options.has_tile_kinds(t);
     let has_data = options.collision_layers.is_some()
-        || level.layers.iter().any(|l| match &l.content {
+        || layers.iter().any(|l| match &l.content {
             LayerContent::Grid { .. } => true,
             LayerContent::Tiles { tileset, .. } => mapped(tileset),
             _ => false,
         });
     let tile_layer = |l: &OgmoLayer| matches!(l.content, LayerContent::Tiles { .. });
-    let named = level
-        .layers
+    let named = layers
         .iter()
         .any(|l| tile_layer(l) && crate::collision::is_collision_layer_name(&l.name));
     let fallback =
         |l: &OgmoLayer| !has_data && (!named || crate::collision::is_collision_layer_name(&l.name));
-    if !has_data && level.layers.iter().any(tile_layer) {
+    if !has_data && layers.iter().any(tile_layer) {
         warnings.push(format!(
             "{file}: the level has no collision data (no grid layer, no tile table for its tilesets), so every tile of {} is solid; use a grid layer for collision, or map the tiles in the level's settings file (see docs/LEVELS.md, \"What collides\")",
             if named {
@@ -984,10 +994,19 @@ pub fn load_str(
             }
         ));
     }
-    for l in level.layers {
+    for l in layers {
         let listed = options.layer_collides(&l.name);
         let wanted = listed != Some(false);
         let falls_back = fallback(&l);
+        let fallback_ids = match &l.content {
+            LayerContent::Tiles { tileset, ids, .. }
+                if wanted && listed.is_none() && falls_back && !mapped(tileset) =>
+            {
+                let cells: Vec<_> = ids.iter().map(|&i| u32::try_from(i).ok()).collect();
+                Some((tileset.clone(), cells))
+            }
+            _ => None,
+        };
         let tiles = match l.content {
             LayerContent::Tiles { tileset, .. }
                 if wanted && listed.is_none() && !mapped(&tileset) && !falls_back =>
@@ -1068,15 +1087,47 @@ pub fn load_str(
             cells: l.cells,
             tiles,
         });
+        if let Some(f) = fallback_ids {
+            painted.push((grids.len() - 1, f));
+        }
     }
     let name = std::path::Path::new(file)
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
+    crate::collision::names::rename_by_layer(file, &mut entities, options, &mut warnings);
+    painted_layers(file, &mut grids, painted, &entities, options, &mut warnings);
+    crate::collision::resample::onto_one_grid(file, &mut grids, options, &mut warnings)?;
     let mut loaded = assemble(file, name, grids, entities, options)?;
     loaded.warnings.splice(0..0, warnings);
     loaded.art = art;
     Ok(loaded)
+}
+
+/// A tile layer made solid by the fallback: its grid index, tileset and
+/// tile ids (`None` empty).
+type FallbackLayer = (usize, (String, Vec<Option<u32>>));
+
+/// Makes the background tiles of the tile layers painted edge to edge
+/// that collide only by the fallback empty (`crate::collision::infer`):
+/// `painted` holds each one's grid index, tileset and tile ids.
+fn painted_layers(
+    file: &str,
+    grids: &mut [GridLayer],
+    painted: Vec<FallbackLayer>,
+    entities: &[PlacedEntity],
+    options: &LoadOptions,
+    warnings: &mut Vec<String>,
+) {
+    use crate::collision::infer::{apply_painted, painted_warning, solid_elsewhere};
+    for (k, (tileset, cells)) in painted {
+        let others = solid_elsewhere(grids, k, entities);
+        let g = &mut grids[k];
+        if let Some(p) = apply_painted(g, &cells, entities, options, others) {
+            let line = painted_warning(&p, |id| (tileset.clone(), id));
+            warnings.push(format!("{file}: {} (layer {:?}): {line}", g.field, g.name));
+        }
+    }
 }
 
 fn cell_field(layer: &str, key: &str, i: usize, w: u32) -> String {

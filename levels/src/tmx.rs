@@ -25,6 +25,8 @@
 //! * Image layers are art only ([`crate::art`]).
 
 pub(crate) mod common;
+mod objects;
+mod painted;
 
 use std::cell::RefCell;
 use std::collections::{BTreeMap, BTreeSet};
@@ -39,6 +41,7 @@ use ::tiled::{
 use glam::IVec2;
 
 use self::common::{object_name, short_data};
+use self::objects::{DrawnSolids, Role};
 use super::collision::{self, tile_of_props, Outline, Prop, TileShape};
 use super::entities::is_entity_name;
 use super::entities::{
@@ -46,6 +49,7 @@ use super::entities::{
 };
 use super::mapping::normalize;
 use crate::assemble::{assemble, GridLayer};
+use crate::collision::names::decoration_word;
 use crate::error::LevelError;
 use crate::loaded::LoadedLevel;
 use crate::options::{LoadOptions, MAX_LEVEL_TILES};
@@ -156,6 +160,7 @@ fn load(
         fallback: Fallback::None,
         notes: RefCell::new(Notes::default()),
         grid: (0, 0, map.width, map.height),
+        fallback_cells: RefCell::default(),
     }
     .run(path)?;
     loaded.art = crate::art::tiled::from_tiled(&file, &map, options)?;
@@ -173,6 +178,9 @@ struct Conv<'a> {
     /// The collision grid in tiles: left and top column/row, width and
     /// height (the map's size; an infinite map's: the chunks' bounds).
     grid: (i32, i32, u32, u32),
+    /// The tile layers made solid by the fallback, by field: each cell's
+    /// tile (tileset index, id), for [`painted`].
+    fallback_cells: RefCell<Vec<painted::FallbackLayer>>,
 }
 
 /// What collides in a map that carries no collision data at all (no tile
@@ -185,8 +193,12 @@ enum Fallback {
     /// Every tile of the visible tile layers with a collision name
     /// ([`collision::is_collision_layer_name`]).
     NamedLayers,
-    /// Every tile of every visible tile layer.
-    AllLayers,
+    /// Every tile of every visible tile layer; when `but_decoration`, not
+    /// of the layers named for decoration (`collision::names`).
+    AllLayers {
+        /// Leave out the decoration-named layers (some other is not one).
+        but_decoration: bool,
+    },
 }
 
 /// Warnings counted by what they say, with the first place each happened.
@@ -338,15 +350,20 @@ impl Conv<'_> {
             })
         });
         let mut named_layer = false;
+        let mut plain_layer = false;
+        let mut drawn_solids = DrawnSolids::default();
         self.visit(m.layers(), "layers", &mut |info, layer| {
             // A layer said to collide is collision data; one said not to
             // is not (the other layers may still collide by the fallback).
             has_data |= info.collides == Some(true);
             match layer {
-                LayerType::Tiles(_) => {
-                    named_layer |= info.visible && collision::is_collision_layer_name(info.name)
+                LayerType::Tiles(tl) => {
+                    named_layer |= info.visible && collision::is_collision_layer_name(info.name);
+                    plain_layer |= info.visible && decoration_word(info.name).is_none();
+                    drawn_solids.tiles |= info.visible && objects::holds_a_tile(&tl);
                 }
                 LayerType::Objects(ol) => {
+                    self.solid_objects(info, &ol, &mut drawn_solids)?;
                     for o in ol.objects() {
                         let (ox, oy) = (o.x as f64 + info.off.0, o.y as f64 + info.off.1);
                         let (pts, closed) = match &o.shape {
@@ -372,10 +389,18 @@ impl Conv<'_> {
             }
             Ok(())
         })?;
+        // Collision drawn as shapes in object layers is collision data:
+        // the tile layers are then decoration unless the file says.
+        if !has_data && drawn_solids.found(&paths) {
+            has_data = true;
+            self.objects_collide_note(&drawn_solids);
+        }
         self.fallback = match (has_data, named_layer) {
             (true, _) => Fallback::None,
             (false, true) => Fallback::NamedLayers,
-            (false, false) => Fallback::AllLayers,
+            (false, false) => Fallback::AllLayers {
+                but_decoration: plain_layer,
+            },
         };
         let mut grids = Vec::new();
         let mut entities = Vec::new();
@@ -393,15 +418,21 @@ impl Conv<'_> {
             }
             Ok(())
         })?;
+        self.infer_painted(&mut grids, &entities);
         if self.fallback == Fallback::NamedLayers && any_tiles {
             self.notes.get_mut().add(
                 "the map has no collision data (no tile collision shapes, no `solid`/`collides`/`one_way`/`hazard` tile properties, no collision layer property or class), so every tile of the visible layers named like collision layers (collision, solid, walls, ground, terrain, platforms, ...) is solid and the other layers are decoration; mark what collides in Tiled (see docs/LEVELS.md, \"What collides\")".into(),
                 || "map".into(),
             );
         }
-        if self.fallback == Fallback::AllLayers && any_tiles {
+        if let (Fallback::AllLayers { but_decoration }, true) = (self.fallback, any_tiles) {
+            let but = if but_decoration {
+                " (but those named for decoration: camera, background, bg, decor, parallax, ...; list them in collision_layers to make them collide)"
+            } else {
+                ""
+            };
             self.notes.get_mut().add(
-                "the map has no collision data (no tile collision shapes, no `solid`/`collides`/`one_way`/`hazard` tile properties, no collision layer property or class, no layer named \"collision\"), so every tile of every visible tile layer is solid; mark what collides in Tiled (see docs/LEVELS.md, \"What collides\")".into(),
+                format!("the map has no collision data (no tile collision shapes, no `solid`/`collides`/`one_way`/`hazard` tile properties, no collision layer property or class, no layer named \"collision\"), so every tile of every visible tile layer is solid{but}; mark what collides in Tiled (see docs/LEVELS.md, \"What collides\")"),
                 || "map".into(),
             );
         }
@@ -618,7 +649,9 @@ impl Conv<'_> {
         let fallback = match self.fallback {
             Fallback::None => false,
             Fallback::NamedLayers => collision::is_collision_layer_name(info.name),
-            Fallback::AllLayers => true,
+            Fallback::AllLayers { but_decoration } => {
+                !but_decoration || decoration_word(info.name).is_none()
+            }
         };
         let t = self.map.tile_width as f64;
         let mut rules: BTreeMap<(usize, u32), TileRule> = BTreeMap::new();
@@ -686,6 +719,9 @@ impl Conv<'_> {
                     }
                 }
             }
+        }
+        if fallback && info.collides != Some(true) {
+            self.keep_fallback_cells(field, (w, h), &cell, &rules);
         }
         let ts = self.map.tile_width;
         let origin = [ox, oy].map(|o| o as i64 * ts as i64 * UNITS_PER_PX as i64);
@@ -900,30 +936,9 @@ impl Conv<'_> {
     ) -> Result<(), LevelError> {
         let at = || object_place(info, o, name, (x, y));
         let tile = o.get_tile();
-        let own = tile_of_props(props(&o.properties), "")
-            .map_err(|m| self.bad(format!("{f}.properties"), m))?;
-        let from_tile = match (own, &tile) {
-            (None, Some(t)) => match t.get_tile() {
-                Some(td) => tile_of_props(props(&td.properties), &td.user_type)
-                    .map_err(|m| self.bad(format!("{f}.properties"), m))?,
-                None => None,
-            },
-            _ => None,
-        };
-        let said = own.or(from_tile);
-        let unnamed_shape = name.trim().is_empty()
-            && tile.is_none()
-            && matches!(
-                o.shape,
-                ObjectShape::Rect { .. }
-                    | ObjectShape::Ellipse { .. }
-                    | ObjectShape::Polygon { .. }
-                    | ObjectShape::Polyline { .. }
-            );
-        match said {
-            Some(Tile::Solid) | Some(Tile::Slope(_)) => {}
-            None if unnamed_shape => {}
-            Some(Tile::Hazard) => {
+        match self.object_role(info, f, o, name)? {
+            Role::Solid => {}
+            Role::Hazard => {
                 if let Some((l, t, w, h)) = object_box(&o.shape, x, y, tile.is_some()) {
                     let lu = px_to_units(self.file, &format!("{f}.x"), l)?;
                     let tu = px_to_units(self.file, &format!("{f}.y"), t)?;
@@ -934,15 +949,28 @@ impl Conv<'_> {
                 }
                 return Ok(());
             }
-            Some(Tile::OneWay) => {
+            Role::OneWay => {
                 self.notes.borrow_mut().add(
                     "one-way objects are not supported (use one-way tiles or a platform object named \"platform\" with `one_way`); ignored".into(),
                     at,
                 );
                 return Ok(());
             }
-            Some(Tile::Empty) => return Ok(()),
-            None if name.trim().is_empty() => {
+            Role::Empty => return Ok(()),
+            Role::Entity { name: e, why } => {
+                return self.entity_by_name(info, f, o, &e, &why, (x, y), out);
+            }
+            Role::Skip { why } => {
+                self.notes.borrow_mut().add(
+                    format!(
+                        "objects with no ledge name or class are neither collision nor entities by {why}: skipped (give them a ledge name or class, or alias the layer in the level's settings: [entities] {:?} = \"block\")",
+                        info.name
+                    ),
+                    at,
+                );
+                return Ok(());
+            }
+            Role::Marker => {
                 // Decoration (tile objects, drawn), markers
                 // (points), labels (text): nothing to collide
                 // with; said for the ones that are not drawn.
@@ -954,7 +982,7 @@ impl Conv<'_> {
                 }
                 return Ok(());
             }
-            None => {
+            Role::Unknown => {
                 if !self.options.skip_unknown_entities {
                     return Err(LevelError::UnknownEntity {
                         file: self.file.into(),

@@ -211,14 +211,68 @@ fn collides_in(l: &LoadedLevel, c: i32, r: i32, t: i32) -> bool {
     })
 }
 
+/// The background tiles `(layer, tile id)` of the layers of `names` that
+/// are painted edge to edge (at least 9 cells in 10 hold a tile): the most
+/// common tile, and the tiles under the level's entities other than solid
+/// ones and hazards (the importer's evidence, `collision::infer`).
+fn painted_background(
+    map: &tiled::Map,
+    l: &LoadedLevel,
+    names: &[&str],
+) -> std::collections::BTreeSet<(String, u32)> {
+    let mut out = std::collections::BTreeSet::new();
+    let t = map.tile_width as i32 * 256;
+    for layer in map.layers().filter(|x| names.contains(&x.name.as_str())) {
+        let Some(tl) = layer.as_tile_layer() else {
+            continue;
+        };
+        let mut counts = std::collections::BTreeMap::<u32, usize>::new();
+        for r in 0..map.height as i32 {
+            for c in 0..map.width as i32 {
+                if let Some(tile) = tl.get_tile(c, r) {
+                    *counts.entry(tile.id()).or_default() += 1;
+                }
+            }
+        }
+        let placed: usize = counts.values().sum();
+        if placed * 10 < (map.width * map.height) as usize * 9 {
+            continue;
+        }
+        let most = counts
+            .iter()
+            .max_by_key(|(id, n)| (**n, std::cmp::Reverse(**id)));
+        out.insert((layer.name.clone(), *most.unwrap().0));
+        for e in &l.level.entities {
+            if matches!(
+                e.kind,
+                EntityKind::Block | EntityKind::PolygonBlock { .. } | EntityKind::Hazard
+            ) {
+                continue;
+            }
+            let (lo, hi) = ((e.pos - e.size / 2 + 1) / t, (e.pos + e.size / 2 - 1) / t);
+            for r in lo.y..=hi.y {
+                for c in lo.x..=hi.x {
+                    if let Some(tile) = tl.get_tile(c, r) {
+                        out.insert((layer.name.clone(), tile.id()));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
 /// Maps with no collision data of their own: the layers named like
 /// collision layers collide (every tile), the others are decoration (or,
 /// with no such layer, every visible layer collides), and the importer
-/// says so. Checked cell by cell against the layers' own
-/// cells.
+/// says so; a layer painted edge to edge has its background tiles empty
+/// (the most common one and those under the spawn and entities), said.
+/// Checked cell by cell against the layers' own cells.
 #[test]
 fn maps_without_collision_data_collide_their_collision_named_layers() {
     let Some(dir) = corpus() else { return };
+    // The maps whose collision layer is painted edge to edge.
+    let painted = ["rpg/island.tmx", "orthogonal-outside.tmx", "desert.tmx"];
     // (map, the layers that collide, whether by their names)
     for (name, solid_layers, by_name) in [
         ("rpg/island.tmx", &["Ground"][..], true),
@@ -250,14 +304,30 @@ fn maps_without_collision_data_collide_their_collision_named_layers() {
         );
         let map = oracle(&dir.join(name));
         let t = map.tile_width as i32;
+        let background = painted_background(&map, &l, solid_layers);
+        assert_eq!(
+            !background.is_empty(),
+            painted.contains(&name),
+            "{name}: painted edge to edge: {background:?}"
+        );
+        assert_eq!(
+            l.warnings
+                .iter()
+                .any(|w| w.contains("painted edge to edge") && w.contains("[tiles.")),
+            !background.is_empty(),
+            "{name}: {:?}",
+            l.warnings
+        );
         let mut solid = 0;
         for r in 0..map.height as i32 {
             for c in 0..map.width as i32 {
                 let want = map.layers().any(|layer| {
                     solid_layers.contains(&layer.name.as_str())
-                        && layer
-                            .as_tile_layer()
-                            .is_some_and(|tl| tl.get_tile(c, r).is_some())
+                        && layer.as_tile_layer().is_some_and(|tl| {
+                            tl.get_tile(c, r).is_some_and(|tile| {
+                                !background.contains(&(layer.name.clone(), tile.id()))
+                            })
+                        })
                 });
                 let got = collides_in(&l, c, r, t);
                 assert_eq!(got, want, "{name}: cell ({c}, {r})");

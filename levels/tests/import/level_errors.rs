@@ -395,16 +395,15 @@ fn unknown_tiles() {
 #[test]
 fn unknown_entities_name_file_layer_and_entity() {
     // uno.json (a format sample, not a game) loads, and says what it did
-    // not use: its tile layers (a foreign tileset), the grid layer that
-    // does not line up, the unknown entity "Dude"; it has nothing to stand
-    // on but a 2 x 2 corner of grid value "3" (hazard), so its spawn is
-    // placed on top.
+    // not use: its tile layers (a foreign tileset), the unknown entity
+    // "Dude"; its 16 px grid layer is resampled onto the 8 px one (which
+    // covers more), so its spawn is placed on the 8 px layer's "g" cells.
     let l = load_file_with(UNO, &LoadOptions::default()).unwrap();
     let all = l.warnings.join("\n");
     for needle in [
-        "on top of the level at its left edge",
+        "the first free standing spot from the left",
         "tile layer \"tile_1D\" does not collide",
-        "layers[5]: this collision layer of 40 x 30 cells of 8 x 8 px",
+        "layers[4]: layer \"grid_1D\" of 16 px cells is resampled onto the level's grid of 8 px cells",
         "skipped unknown entity \"Dude\" in layer \"entity_layer\"",
     ] {
         assert!(all.contains(needle), "{needle:?} not in:\n{all}");

@@ -16,4 +16,6 @@ mod level_polygon;
 mod level_tiled;
 mod real_levels;
 mod settings;
+mod layer_rules;
+mod stands_still;
 mod tiled_collision;
