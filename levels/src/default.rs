@@ -57,6 +57,26 @@ pub fn default_route() -> Vec<Waypoint> {
     loaded().route
 }
 
+/// Writes the default level into `dir` once per name in `names`
+/// (`NAME.json` each, beside one `ledge.ogmo`), returning the level files'
+/// paths in order: levels with the default level's geometry and route
+/// under other names, so other bundles (another content hash each), for
+/// tests and trials of level rotation and downloads.
+pub fn write_default_copies(
+    dir: &std::path::Path,
+    names: &[&str],
+) -> std::io::Result<Vec<std::path::PathBuf>> {
+    std::fs::write(dir.join("ledge.ogmo"), PROJECT_JSON)?;
+    names
+        .iter()
+        .map(|name| {
+            let path = dir.join(format!("{name}.json"));
+            std::fs::write(&path, LEVEL_JSON)?;
+            Ok(path)
+        })
+        .collect()
+}
+
 fn loaded() -> LoadedLevel {
     match load_default_level() {
         Ok(l) => l,

@@ -54,7 +54,8 @@ pub mod tmx;
 
 pub use bundle::{BundleError, LevelBundle};
 pub use default::{
-    default_level, default_route, load_default_level, DEFAULT_LEVEL_FILE, DEFAULT_PROJECT_FILE,
+    default_level, default_route, load_default_level, write_default_copies, DEFAULT_LEVEL_FILE,
+    DEFAULT_PROJECT_FILE,
 };
 pub use entities::{
     PlacedEntity, PlacedPolygon, PropValue, DEFAULT_PLATFORM_SPEED, DEFAULT_SPRING_STRENGTH,

@@ -424,11 +424,7 @@ mod tests {
     /// A folder holding the default level twice, as `a.json` and `b.json`.
     fn two_copies() -> tempfile::TempDir {
         let dir = tempfile::tempdir().unwrap();
-        let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../levels/default");
-        std::fs::copy(format!("{src}/ledge.ogmo"), dir.path().join("ledge.ogmo")).unwrap();
-        for name in ["b.json", "a.json"] {
-            std::fs::copy(format!("{src}/default.json"), dir.path().join(name)).unwrap();
-        }
+        ledge_levels::write_default_copies(dir.path(), &["b", "a"]).unwrap();
         dir
     }
 

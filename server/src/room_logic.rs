@@ -351,6 +351,9 @@ pub struct RoomLogic {
     recording: Option<MatchRecording>,
     /// Which level, which next, the votes.
     rotation: Rotation,
+    /// The players and whether each finished, refilled each tick for the
+    /// rotation (kept to spare an allocation a tick).
+    finished: Vec<(PlayerId, bool)>,
 }
 
 impl RoomLogic {
@@ -381,6 +384,7 @@ impl RoomLogic {
             metrics,
             config,
             actions: Vec::new(),
+            finished: Vec::new(),
         }
     }
 
@@ -638,8 +642,10 @@ impl RoomLogic {
         if !self.rotation.is_on() {
             return;
         }
-        let players = self.finished();
+        let mut players = std::mem::take(&mut self.finished);
+        self.fill_finished(&mut players);
         let step = self.rotation.tick(self.game.tick(), &players);
+        self.finished = players;
         match step.change_to {
             Some(level) => self.change_level(level),
             None if step.changed => self.broadcast_levels(),
@@ -647,16 +653,27 @@ impl RoomLogic {
         }
     }
 
-    /// The players by id, each with whether it finished the level.
+    /// The players by id, each with whether it finished the level (for
+    /// the rare list sent; the tick reuses a buffer).
     fn finished(&self) -> Vec<(PlayerId, bool)> {
-        self.members
-            .iter()
-            .filter(|(_, m)| !m.spectator)
-            .map(|(&id, _)| {
-                let done = self.game.player(id).is_some_and(|v| v.place.is_some());
-                (id, done)
-            })
-            .collect()
+        let mut players = Vec::new();
+        self.fill_finished(&mut players);
+        players
+    }
+
+    /// `players`: the players by id, each with whether it finished the
+    /// level.
+    fn fill_finished(&self, players: &mut Vec<(PlayerId, bool)>) {
+        players.clear();
+        players.extend(
+            self.members
+                .iter()
+                .filter(|(_, m)| !m.spectator)
+                .map(|(&id, _)| {
+                    let done = self.game.player(id).is_some_and(|v| v.place.is_some());
+                    (id, done)
+                }),
+        );
     }
 
     /// Moves the room to level `index` of its rotation: the match so far is
@@ -1766,11 +1783,7 @@ mod level_change_tests {
     /// The default level, and a copy of it named `second` (another
     /// content hash, the same route).
     pub(crate) fn two_levels(dir: &std::path::Path) -> Vec<PathBuf> {
-        let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../levels/default");
-        std::fs::copy(format!("{src}/ledge.ogmo"), dir.join("ledge.ogmo")).unwrap();
-        let second = dir.join("second.json");
-        std::fs::copy(format!("{src}/default.json"), &second).unwrap();
-        vec![PathBuf::from(format!("{src}/default.json")), second]
+        ledge_levels::write_default_copies(dir, &["default", "second"]).unwrap()
     }
 
     fn room(dir: &std::path::Path, rule: VoteRule) -> RoomLogic {

@@ -134,12 +134,7 @@ impl TestServer {
 /// `dir`: a rotation of two levels (the same ground, another bundle to
 /// download).
 pub fn two_levels(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
-    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../levels/default");
-    for name in ["ledge.ogmo", "default.json"] {
-        std::fs::copy(src.join(name), dir.join(name)).unwrap();
-    }
-    std::fs::copy(src.join("default.json"), dir.join("second.json")).unwrap();
-    vec![dir.join("default.json"), dir.join("second.json")]
+    ledge_levels::write_default_copies(dir, &["default", "second"]).unwrap()
 }
 
 /// Runs `command` to its end with piped output; kills it and fails the test

@@ -146,12 +146,23 @@ async fn write(
         job.replay.header.recorded_at_ms =
             crate::records::unix_millis().saturating_sub((ticks * 1000 / rate) as i64) as u64;
         let mut d = dir.take().expect("returned after each save");
-        let (back, saved) = tokio::task::spawn_blocking(move || {
+        let done = tokio::task::spawn_blocking(move || {
             let saved = save(&mut d, &job);
             (d, saved)
         })
-        .await
-        .expect("saving does not panic");
+        .await;
+        let (back, saved) = match done {
+            Ok(done) => done,
+            // The runtime is going away (the save never ran), or the save
+            // panicked: either way this writer is done, and says so.
+            Err(e) => {
+                metrics.failed.inc();
+                if e.is_panic() {
+                    error!("replay not saved, and no more will be: saving panicked: {e}");
+                }
+                return;
+            }
+        };
         dir = Some(back);
         if let Some(tell) = tell {
             let _ = tell.send(saved.is_ok());

@@ -12,6 +12,8 @@
 //!
 //! A page opened with `?spectate&follow=bob` watches a native runner in a
 //! one-player room: it takes no place, draws bob only, and sees him run.
+//! A page in a two-level rotation follows its room to the next level
+//! (downloaded in the page) and plays on there.
 //!
 //! Without `chromium` these tests print a loud SKIPPED notice and pass,
 //! except with `CI=true`, where they fail.
@@ -464,6 +466,80 @@ fn a_browser_spectates_a_runner_without_a_body() {
         report.won,
         "bob reached the goal beside a spectator: {report}"
     );
+    drop(browser);
+    runtime.block_on(server.stop()).unwrap();
+}
+
+/// A page in a room of a two-level rotation follows the room to the next
+/// level when its time is up: re-welcomed, the level downloaded in the
+/// page (not the embedded one), the page's `ledgeState.level` names it,
+/// and held Right still moves us there.
+#[test]
+fn a_browser_follows_its_room_to_the_next_level_and_plays_on() {
+    if skip_without_chromium("browser_client level change") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let levels = crate::rotation::two_levels(dir.path());
+    let (runtime, server) = web_server(move |c| {
+        c.levels = levels;
+        c.rooms = 1;
+        c.rotation = ledge_server::config::RotationConfig {
+            level_time: Some(Duration::from_secs(6)),
+            results_time: Duration::from_secs(1),
+            vote: ledge_shared::protocol::VoteRule::Off,
+        };
+        if let Some(web) = &mut c.web {
+            web.webtransport = None;
+        }
+    });
+    let web = server.web_addr.expect("the web port");
+    let browser = Browser::launch().expect("launch chromium");
+    let mut page = browser.new_page().expect("a tab");
+    page.open(&format!("http://{web}/?name=ann"))
+        .expect("the page loads");
+    page.wait_until(
+        "window.ledgeState && ledgeState.joined && ledgeState.level && ledgeState.me",
+        Duration::from_secs(30),
+    )
+    .unwrap_or_else(|e| panic!("the page joins: {e}\n{}", page.console_text()));
+    let first = state(&mut page);
+    assert_eq!(first["level"]["id"], "default", "{first}");
+    assert_eq!(first["level"]["changes"], 0, "{first}");
+
+    // The level's time runs out: the room moves to "second", which the
+    // page has to download.
+    page.wait_until(
+        "ledgeState.level && ledgeState.level.id == 'second' && ledgeState.joined && ledgeState.me",
+        Duration::from_secs(30),
+    )
+    .unwrap_or_else(|e| {
+        panic!(
+            "the page moves on: {e}\n{}\n{}",
+            state(&mut page),
+            page.console_text()
+        )
+    });
+    let moved = state(&mut page);
+    assert_eq!(moved["level"]["changes"], 1, "{moved}");
+    assert_eq!(moved["failure"], Value::Null, "{moved}");
+    let x0 = moved["me"]["x"].as_f64().expect("our position");
+    page.key_down(Key::ArrowRight).unwrap();
+    let walked = page.wait_until(
+        &format!(
+            "ledgeState.level.id == 'second' && ledgeState.me.x > {}",
+            // The crate block stands 50 px right of the spawn.
+            x0 + 30.0
+        ),
+        Duration::from_secs(5),
+    );
+    page.key_up(Key::ArrowRight).unwrap();
+    walked.unwrap_or_else(|e| {
+        panic!(
+            "held Right moves us on the second level: {e}: {}",
+            state(&mut page)
+        )
+    });
     drop(browser);
     runtime.block_on(server.stop()).unwrap();
 }

@@ -21,12 +21,7 @@ use ledge_tests::{metric, TestServer};
 /// The default level's files, and a copy of the level named `second`, in
 /// `dir`: the rotation `[default, second]`.
 pub fn two_levels(dir: &Path) -> Vec<PathBuf> {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../levels/default");
-    for name in ["ledge.ogmo", "default.json"] {
-        std::fs::copy(src.join(name), dir.join(name)).unwrap();
-    }
-    std::fs::copy(src.join("default.json"), dir.join("second.json")).unwrap();
-    vec![dir.join("default.json"), dir.join("second.json")]
+    ledge_levels::write_default_copies(dir, &["default", "second"]).unwrap()
 }
 
 /// A server rotating through `two_levels`, one second of results.

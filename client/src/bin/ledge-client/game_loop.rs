@@ -898,6 +898,7 @@ impl GameLoop {
                 })
                 .collect(),
             spectating: self.setup.play.spectating(),
+            level: self.setup.play.level_id(),
         });
     }
 

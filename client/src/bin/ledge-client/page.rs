@@ -350,6 +350,10 @@ pub struct Report<'a> {
     pub players: Vec<DrawnPlayer>,
     /// We watch rather than play (`?spectate`).
     pub spectating: bool,
+    /// The server's level, once welcomed: its id (the name the server
+    /// gives it) and how many times the room moved to another level since
+    /// we joined.
+    pub level: Option<(&'a str, u64)>,
 }
 
 /// A player as drawn this frame: its box on the canvas and its colour.
@@ -477,6 +481,7 @@ fn state(r: &Report<'_>) -> serde_json::Value {
         "failure": r.failure,
         "joined": r.joined,
         "spectating": r.spectating,
+        "level": r.level.map(|(id, changes)| serde_json::json!({"id": id, "changes": changes})),
         "me": r.me.map(|p| serde_json::json!({"x": px(p.x), "y": px(p.y)})),
         "players": players,
         // The level's flat colours, for tests of what the canvas shows.

@@ -390,6 +390,15 @@ impl Play {
         self.connection()?.level_art()
     }
 
+    /// The server's level (online, once welcomed): its id and how many
+    /// times the room moved to another level since we joined.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    pub fn level_id(&self) -> Option<(&str, u64)> {
+        let online = self.connection()?;
+        let welcome = online.game()?.welcome()?;
+        Some((welcome.level_id.as_str(), online.level_changes()))
+    }
+
     /// The level played (the server's, once welcomed).
     pub fn level(&self) -> &Level {
         self.game().map_or(&self.level, ClientGame::level)

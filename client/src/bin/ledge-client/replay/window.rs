@@ -516,6 +516,7 @@ impl ReplayLoop {
             me: me.map(|m| m.pos),
             players,
             spectating: false,
+            level: None,
         };
         page::report_replay(
             &report,
