@@ -153,7 +153,9 @@ impl<'m> Build<'m> {
                     continue;
                 }
                 LayerType::Tiles(tl) => self.tiles(&field, &tl)?.map(ArtContent::Tiles),
-                LayerType::Objects(ol) => Some(ArtContent::Objects(self.objects(&field, &ol)?)),
+                LayerType::Objects(ol) => {
+                    Some(ArtContent::Objects(self.objects(&field, &l.name, &ol)?))
+                }
                 LayerType::Image(il) => match &il.image {
                     Some(img) => {
                         self.image(img, &format!("{field}.image"))?
@@ -229,7 +231,12 @@ impl<'m> Build<'m> {
     }
 
     /// An object layer's visible tile objects (other shapes are not drawn).
-    fn objects(&mut self, field: &str, ol: &ObjectLayer<'m>) -> Result<Vec<ArtObject>, LevelError> {
+    fn objects(
+        &mut self,
+        field: &str,
+        layer: &str,
+        ol: &ObjectLayer<'m>,
+    ) -> Result<Vec<ArtObject>, LevelError> {
         let mut out = Vec::new();
         for (k, o) in ol.objects().enumerate() {
             if !o.visible {
@@ -237,7 +244,7 @@ impl<'m> Build<'m> {
             }
             let Some(t) = o.get_tile() else { continue };
             // The game draws its entities (a coin vanishes when collected).
-            if crate::tmx::common::is_drawn_entity(self.options, &o) {
+            if crate::tmx::common::is_drawn_entity(self.options, layer, &o) {
                 continue;
             }
             let of = format!("{field}.objects[{k}]");

@@ -26,8 +26,33 @@ pub(crate) fn object_name<'o>(options: &LoadOptions, o: &'o ::tiled::ObjectData)
 /// Whether an object stands for an entity that moves or vanishes (a coin,
 /// a walker, a moving platform), which the game draws itself: the level's
 /// art leaves its picture out, or a collected coin would stay on screen.
-pub(crate) fn is_drawn_entity(options: &LoadOptions, o: &::tiled::ObjectData) -> bool {
-    crate::entities::moves_or_vanishes(options.entity_name(object_name(options, o)))
+/// An object without a ledge name counts by its own name's words or its
+/// layer's (`layer`, `collision::names`), unless its own properties say
+/// what it is, as the importer reads it.
+pub(crate) fn is_drawn_entity(options: &LoadOptions, layer: &str, o: &::tiled::ObjectData) -> bool {
+    use crate::collision::names::{layer_thing, Thing};
+    let name = options.entity_name(object_name(options, o));
+    if is_entity_name(name) {
+        return crate::entities::moves_or_vanishes(name);
+    }
+    let marked = !matches!(
+        crate::collision::tile_of_props(super::props(&o.properties), ""),
+        Ok(None)
+    );
+    if marked || options.decoration_layers.iter().any(|n| n == layer) {
+        return false;
+    }
+    if let Some(alias) = options
+        .entity_aliases
+        .get(&crate::mapping::normalize(layer))
+    {
+        return crate::entities::moves_or_vanishes(alias);
+    }
+    let thing = (!name.trim().is_empty())
+        .then(|| layer_thing(name))
+        .flatten()
+        .or_else(|| layer_thing(layer));
+    matches!(thing, Some((Thing::Entity(e), _)) if crate::entities::moves_or_vanishes(e))
 }
 
 /// Whether a finite layer has fewer cells of data than its size: the tiled

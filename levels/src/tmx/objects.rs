@@ -25,8 +25,8 @@ pub(super) enum Role {
     OneWay,
     /// Marked not solid.
     Empty,
-    /// This entity, by its layer's name (or its own, `Goomba`); `word` is
-    /// the name's word that said so.
+    /// This entity, by its layer's name (or its own, `Goomba`), or by the
+    /// settings' `[entities]` alias for the layer.
     Entity {
         /// The ledge entity name.
         name: String,

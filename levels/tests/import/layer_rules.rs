@@ -430,3 +430,46 @@ fn a_tiled_layer_named_for_the_background_does_not_collide() {
         l.warnings
     );
 }
+
+/// A tile object made a coin by its layer's name is the game's to draw (a
+/// collected coin vanishes): the level's art leaves it out, and draws the
+/// tile objects of other layers.
+#[test]
+fn coins_by_their_layer_are_not_drawn_as_art() {
+    let png = concat!(env!("CARGO_MANIFEST_DIR"), "/default/ledge.png");
+    let layers = [
+        object_layer(
+            "Coins",
+            r#"  <object id="1" gid="2" x="96" y="112" width="16" height="16"/>"#,
+        ),
+        object_layer(
+            "Props",
+            r#"  <object id="2" gid="2" x="128" y="112" width="16" height="16"/>"#,
+        ),
+        object_layer(
+            "game",
+            r#"  <object id="3" name="player" x="40" y="128" width="16" height="16"/>"#,
+        ),
+    ];
+    let text = tiled(10, 10, &layers.join("\n"))
+        .replace(
+            "art.png\" width=\"64\" height=\"64\"",
+            &format!("{png}\" width=\"208\" height=\"32\""),
+        )
+        .replace(
+            "tilecount=\"16\" columns=\"4\"",
+            "tilecount=\"26\" columns=\"13\"",
+        );
+    let l = tmx::load_str("t.tmx", &text, &LoadOptions::default()).unwrap();
+    assert_eq!(count(&l, |k| *k == EntityKind::Coin), 1);
+    let drawn: Vec<_> = l
+        .art
+        .layers
+        .iter()
+        .filter_map(|a| match &a.content {
+            ledge_levels::art::ArtContent::Objects(o) if !o.is_empty() => Some(a.name.clone()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(drawn, ["Props"], "{:?}", l.art.warnings);
+}
