@@ -250,17 +250,42 @@ const MAX_LISTED: usize = 4 * MAX_LEVELS;
 /// Largest playlist or world file read, bytes.
 const MAX_LIST_BYTES: u64 = 1 << 20;
 
-/// Level files by extension (what [`ledge_levels::load_level`] reads).
+/// Level files by extension (what [`ledge_levels::load_level`] reads; an
+/// LDtk project stands for all its levels, its `.ldtkl` files are read
+/// through it).
 fn is_level_file(path: &Path) -> bool {
     matches!(
         path.extension().and_then(|e| e.to_str()),
-        Some("json" | "tmx")
+        Some("json" | "tmx" | "ldtk")
     )
+}
+
+/// Whether `path` names a whole LDtk project (`game.ldtk`, not
+/// `game.ldtk#Level_2`).
+fn is_ldtk_project(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("ldtk"))
+}
+
+/// `path`'s levels onto `files`: an LDtk project's every level in its
+/// order (`PROJECT.ldtk#LEVEL` each), any other path as it is.
+fn push_levels(files: &mut Vec<PathBuf>, path: PathBuf) -> Result<(), LevelLoadError> {
+    if !is_ldtk_project(&path) {
+        files.push(path);
+        return Ok(());
+    }
+    let levels = ledge_levels::ldtk::level_paths(&path).map_err(|e| LevelLoadError::List {
+        path: path.display().to_string(),
+        message: format!("{e}: name one of its levels as {}#LEVEL", path.display()),
+    })?;
+    files.extend(levels.into_iter().take(MAX_LISTED + 1));
+    Ok(())
 }
 
 /// The level files `paths` name, in order: files as given, a folder's
 /// level files by name, a playlist's lines (relative to it; `#` starts a
-/// comment), a Tiled world's maps in its order.
+/// comment), a Tiled world's maps in its order, an LDtk project's levels
+/// in its order (wherever it is named).
 fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, LevelLoadError> {
     let mut files = Vec::new();
     for path in paths {
@@ -277,10 +302,14 @@ fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, LevelLoadError> {
                 .take(MAX_LISTED + 1)
                 .collect();
             if found.is_empty() {
-                return Err(list("no level files (.json, .tmx) in this folder".into()));
+                return Err(list(
+                    "no level files (.json, .tmx, .ldtk) in this folder".into(),
+                ));
             }
             found.sort();
-            files.extend(found);
+            for file in found {
+                push_levels(&mut files, file)?;
+            }
         } else if ext == "txt" || ext == "world" {
             let text = read_list(path).map_err(list)?;
             let dir = path.parent().unwrap_or(Path::new("."));
@@ -292,9 +321,11 @@ fn expand(paths: &[PathBuf]) -> Result<Vec<PathBuf>, LevelLoadError> {
             if named.is_empty() {
                 return Err(list("it names no levels".into()));
             }
-            files.extend(named.into_iter().take(MAX_LISTED + 1).map(|n| dir.join(n)));
+            for name in named.into_iter().take(MAX_LISTED + 1) {
+                push_levels(&mut files, dir.join(name))?;
+            }
         } else {
-            files.push(path.clone());
+            push_levels(&mut files, path.clone())?;
         }
         if files.len() > MAX_LISTED {
             return Err(LevelLoadError::TooMany { count: files.len() });
@@ -317,11 +348,18 @@ fn read_list(path: &Path) -> Result<String, String> {
     Ok(text)
 }
 
-/// A playlist's level paths: one per line, blank lines and `#` comments
-/// skipped.
+/// A playlist's level paths: one per line, blank lines and comments
+/// skipped (a `#` at the line's start or after a space: in
+/// `game.ldtk#Level_2` it names an LDtk level).
 fn playlist(text: &str) -> Vec<String> {
+    let uncommented = |line: &str| -> usize {
+        let bytes = line.as_bytes();
+        (0..bytes.len())
+            .find(|&i| bytes[i] == b'#' && (i == 0 || bytes[i - 1].is_ascii_whitespace()))
+            .unwrap_or(bytes.len())
+    };
     text.lines()
-        .map(|l| l.split('#').next().unwrap_or("").trim())
+        .map(|l| l[..uncommented(l)].trim())
         .filter(|l| !l.is_empty())
         .map(str::to_owned)
         .collect()
@@ -455,6 +493,42 @@ mod tests {
         std::fs::write(d.join("game.world"), world).unwrap();
         assert_eq!(ids(&load(&[d.join("game.world")]).unwrap()), ["a", "b"]);
         assert_eq!(ids(&load(&[]).unwrap()).len(), 1, "the embedded level");
+    }
+
+    /// LDtk's own platformer sample (MIT, `../shared/testdata/levels`).
+    const LDTK_PLATFORMER: &str = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/testdata/levels/ldtk-samples/Typical_2D_platformer_example.ldtk"
+    );
+
+    #[test]
+    fn an_ldtk_project_rotates_through_all_its_levels() {
+        let load = |paths: &[PathBuf]| LevelSet::load(paths, None, GameConfig::default(), 32);
+        let project = PathBuf::from(LDTK_PLATFORMER);
+        let names = ledge_levels::ldtk::level_names(&project).unwrap();
+        assert!(names.len() > 1, "{names:?}");
+        let all = load(std::slice::from_ref(&project)).unwrap();
+        assert_eq!(all.levels().len(), names.len());
+        let offers: std::collections::BTreeSet<_> =
+            all.levels().iter().map(|l| l.offer.sha256).collect();
+        assert_eq!(offers.len(), names.len(), "a bundle per level");
+        // One level of it, by name, is one level; in a playlist, all.
+        let one = format!("{LDTK_PLATFORMER}#{}", names[1]);
+        let single = load(&[PathBuf::from(&one)]).unwrap();
+        assert_eq!(single.levels().len(), 1);
+        assert_eq!(single.get(0).offer, all.get(1).offer);
+        let dir = tempfile::tempdir().unwrap();
+        let list = dir.path().join("list.txt");
+        std::fs::write(&list, format!("{LDTK_PLATFORMER}\n{one}\n")).unwrap();
+        assert_eq!(load(&[list]).unwrap().levels().len(), names.len() + 1);
+        // A project that does not read says what to name instead.
+        let bad = dir.path().join("broken.ldtk");
+        std::fs::write(&bad, "{").unwrap();
+        let err = load(&[bad]).unwrap_err().to_string();
+        assert!(
+            err.contains("broken.ldtk") && err.contains("#LEVEL"),
+            "{err}"
+        );
     }
 
     #[test]
