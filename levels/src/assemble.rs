@@ -47,12 +47,20 @@ pub(crate) fn assemble(
             name,
             tilemap,
             entities: Vec::with_capacity(entities.len()),
+            player: Default::default(),
         },
         route: Vec::new(),
         warnings: mismatched,
         art: art::LevelArt::default(),
         layers,
     };
+    out.level.player = crate::scale::choose(
+        file,
+        &out.level.tilemap,
+        &entities,
+        options,
+        &mut out.warnings,
+    )?;
     for e in &entities {
         add_entity(file, e, options, &mut out)?;
     }
@@ -181,7 +189,8 @@ fn add_entity(
         }
         _ => e,
     };
-    match entities::classify(file, e, options.speed_unit)? {
+    let scale = out.level.player.scale;
+    match entities::classify(file, e, (options.speed_unit, scale), &mut out.warnings)? {
         Classified::Entity(d) => {
             let kind = entity_kind_name(&d.kind);
             let st = match out.layers.iter().position(|l| l.name == e.layer) {
@@ -217,7 +226,9 @@ fn add_entity(
 /// Places a player spawn in a level without one, with a warning saying
 /// where: the first free standing spot, else on top of the level.
 fn place_spawn(file: &str, out: &mut LoadedLevel) -> Result<(), LevelError> {
-    let player = ledge_shared::game::PlayerConfig::default();
+    let player = ledge_shared::game::PlayerConfig::default()
+        .scaled(&out.level.player)
+        .unwrap_or_default();
     let px = |u: i32| u as f64 / UNITS_PER_PX as f64;
     let (spawn, where_) = match spawn::find(&out.level, &player) {
         Some(s) => (s, "the first free standing spot from the left"),

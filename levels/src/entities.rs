@@ -6,7 +6,8 @@ use glam::IVec2;
 use super::mapping::normalize;
 use super::{EntityDef, EntityKind, LevelError, PlatformMotion, RouteAction, SpeedUnit, Waypoint};
 use ledge_shared::fixed::{MAX_COORD, MAX_EXTENT, MAX_SPEED, UNITS_PER_PX};
-use ledge_shared::shape::{ConvexPolygon, ShapeError, MAX_POLYGON_VERTICES};
+use ledge_shared::level::Trigger;
+use ledge_shared::shape::{ConvexPolygon, Obb, ShapeError, MAX_POLYGON_VERTICES};
 
 /// The player spawn names every loader (Tiled, OGMO, LDtk) reads, before
 /// the number a name may end with (`Start1`, `player_2`, `Player-3`); also
@@ -131,6 +132,75 @@ pub struct PlacedEntity {
     /// The outline, for an entity drawn as a polygon (an OGMO polygon
     /// entity, a Tiled polygon object); `None` for boxes.
     pub polygon: Option<PlacedPolygon>,
+    /// How the editor turned the box (`centre`, `size` are the box before
+    /// turning); `None` when it is upright.
+    pub turn: Option<Turn>,
+    /// The file gives the size (a Tiled rectangle or tile object, an OGMO
+    /// entity's own `width` and `height`, an LDtk entity), rather than a
+    /// default (a Tiled point, an OGMO project's size): a spawn's size then
+    /// sizes the player.
+    pub sized: bool,
+}
+
+/// How an editor turned a box entity: clockwise on screen (y down) by
+/// `degrees` about `pivot`. A block becomes a polygon block of its turned
+/// outline; a hazard, coin, checkpoint or goal turns (a quarter turn stays
+/// a box, other angles make an [`EntityKind::Turned`]); other entities
+/// stand upright, with a warning.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Turn {
+    /// Degrees, clockwise: finite, not a whole number of turns.
+    pub degrees: f64,
+    /// The point it turns about (OGMO: the entity's origin, Tiled: the
+    /// object's position), absolute, in units.
+    pub pivot: (f64, f64),
+    /// Path of the rotation in the file (`layers[1].entities[3].rotation`).
+    pub field: String,
+}
+
+impl Turn {
+    /// A turn by `degrees` about `pivot` (units), `None` when `degrees` is
+    /// not finite or a whole number of turns.
+    pub fn new(degrees: f64, pivot: (f64, f64), field: String) -> Option<Turn> {
+        (degrees.is_finite() && degrees % 360.0 != 0.0).then_some(Turn {
+            degrees,
+            pivot,
+            field,
+        })
+    }
+
+    /// Whole quarter turns clockwise (0 to 3) when the angle is one (within
+    /// 1e-6 degrees), else `None`.
+    fn quarters(&self) -> Option<u32> {
+        let q = self.degrees / 90.0;
+        ((q - q.round()).abs() < 1e-8).then(|| (q.round() as i64).rem_euclid(4) as u32)
+    }
+
+    /// `p` (units) turned about the pivot.
+    fn apply(&self, p: (f64, f64)) -> (f64, f64) {
+        let (dx, dy) = (p.0 - self.pivot.0, p.1 - self.pivot.1);
+        let (x, y) = match self.quarters() {
+            // Exact for quarter turns.
+            Some(0) => (dx, dy),
+            Some(1) => (-dy, dx),
+            Some(2) => (-dx, -dy),
+            Some(3) => (dy, -dx),
+            _ => {
+                let (sin, cos) = self.degrees.to_radians().sin_cos();
+                (dx * cos - dy * sin, dx * sin + dy * cos)
+            }
+        };
+        (self.pivot.0 + x, self.pivot.1 + y)
+    }
+
+    /// A vector (units) turned, rounded to whole units.
+    fn vector(&self, v: (f64, f64)) -> IVec2 {
+        let (x, y) = self.apply((self.pivot.0 + v.0, self.pivot.1 + v.1));
+        IVec2::new(
+            (x - self.pivot.0).round() as i32,
+            (y - self.pivot.1).round() as i32,
+        )
+    }
 }
 
 /// The outline of a polygon entity as placed: absolute vertices in units,
@@ -165,6 +235,11 @@ pub(crate) fn moves_or_vanishes(name: &str) -> bool {
         class_of(name),
         Some(Class::Coin | Class::Walker | Class::Platform)
     )
+}
+
+/// Whether `name` is a player spawn name ([`SPAWN_NAMES`]).
+pub(crate) fn is_spawn(name: &str) -> bool {
+    matches!(class_of(name), Some(Class::Spawn))
 }
 
 /// Whether `name` is in the entity table ([`ENTITY_NAMES`]).
@@ -290,6 +365,8 @@ struct Params<'a> {
     e: &'a PlacedEntity,
     /// Units of the speeds.
     unit: SpeedUnit,
+    /// The level's player scale (1/256ths): default speeds scale with it.
+    scale: u32,
 }
 
 impl Params<'_> {
@@ -329,7 +406,8 @@ impl Params<'_> {
     /// as units/tick in `(0, MAX_SPEED]`.
     fn speed(&self, keys: &[&str], default: i32) -> Result<i32, LevelError> {
         let Some((field, v)) = self.find(keys) else {
-            return Ok(default);
+            let scaled = (i64::from(default) * i64::from(self.scale) + 128) / 256;
+            return Ok(scaled.clamp(1, i64::from(MAX_SPEED)) as i32);
         };
         let unit = self.unit.name();
         let n = match v {
@@ -388,16 +466,28 @@ impl Params<'_> {
 }
 
 /// Classifies one placed entity through the name table and reads its
-/// parameters.
+/// parameters (speeds in `unit`; default speeds times the level's player
+/// `scale`, in 1/256ths).
 pub(crate) fn classify(
     file: &str,
     e: &PlacedEntity,
-    unit: SpeedUnit,
+    (unit, scale): (SpeedUnit, u32),
+    warnings: &mut Vec<String>,
 ) -> Result<Classified, LevelError> {
-    let p = Params { file, e, unit };
+    let p = Params {
+        file,
+        e,
+        unit,
+        scale,
+    };
     let Some(class) = class_of(&e.name) else {
         return Ok(Classified::Unknown);
     };
+    if let (Some(turn), None) = (&e.turn, &e.polygon) {
+        if let Some(turned) = turned(file, e, turn, &class, warnings)? {
+            return Ok(turned);
+        }
+    }
     if let Some(poly) = &e.polygon {
         if !matches!(class, Class::Block | Class::Polygon) {
             return Err(LevelError::BadPolygon {
@@ -457,6 +547,81 @@ pub(crate) fn classify(
         pos: e.centre,
         size: e.size,
     }))
+}
+
+/// A turned box entity ([`Turn`]): a block as the polygon block of its
+/// turned outline, a hazard, coin, checkpoint or goal turned (a box for a
+/// quarter turn, else [`EntityKind::Turned`]); `None` for the others, which
+/// stand upright (said in `warnings`).
+fn turned(
+    file: &str,
+    e: &PlacedEntity,
+    turn: &Turn,
+    class: &Class,
+    warnings: &mut Vec<String>,
+) -> Result<Option<Classified>, LevelError> {
+    let (c, h) = (
+        (e.centre.x as f64, e.centre.y as f64),
+        (e.size.x as f64 / 2.0, e.size.y as f64 / 2.0),
+    );
+    let trigger = match class {
+        Class::Block => {
+            let corners = [(-h.0, -h.1), (h.0, -h.1), (h.0, h.1), (-h.0, h.1)];
+            let mut poly = PlacedPolygon {
+                field: turn.field.clone(),
+                points: Vec::with_capacity(4),
+                point_fields: Vec::with_capacity(4),
+            };
+            for (i, (dx, dy)) in corners.into_iter().enumerate() {
+                let cf = format!("{} (corner {i})", turn.field);
+                let (x, y) = turn.apply((c.0 + dx, c.1 + dy));
+                let (x, y) = (x.round() as i64, y.round() as i64);
+                check_coord_field(file, &format!("{cf}.x"), x)?;
+                check_coord_field(file, &format!("{cf}.y"), y)?;
+                poly.points.push(IVec2::new(x as i32, y as i32));
+                poly.point_fields.push(cf);
+            }
+            return polygon_block(file, &poly).map(|d| Some(Classified::Entity(d)));
+        }
+        Class::Hazard => Trigger::Hazard,
+        Class::Coin => Trigger::Coin,
+        Class::Checkpoint => Trigger::Checkpoint,
+        Class::Goal => Trigger::Goal,
+        _ => {
+            warnings.push(format!(
+                "{file}: {}: entity {:?} is turned by {} degrees: only blocks, hazards, coins, checkpoints and goals turn in ledge; it stands upright",
+                turn.field, e.name, turn.degrees
+            ));
+            return Ok(None);
+        }
+    };
+    let (x, y) = turn.apply(c);
+    let (x, y) = (x.round() as i64, y.round() as i64);
+    check_coord_field(file, &format!("{}.x", turn.field), x)?;
+    check_coord_field(file, &format!("{}.y", turn.field), y)?;
+    let pos = IVec2::new(x as i32, y as i32);
+    let (kind, size) = match turn.quarters() {
+        Some(q) if q % 2 == 1 => (trigger.kind(), IVec2::new(e.size.y, e.size.x)),
+        Some(_) => (trigger.kind(), e.size),
+        None => {
+            let (u, v) = (turn.vector((h.0, 0.0)), turn.vector((0.0, h.1)));
+            if Obb::from_axes(u, v).is_err() {
+                return Err(LevelError::OutOfBounds {
+                    file: file.into(),
+                    field: turn.field.clone(),
+                    message: format!(
+                        "a {} x {} px box turned by {} degrees is not a shape ledge can collide (too thin or too large)",
+                        e.size.x as f64 / UNITS_PER_PX as f64,
+                        e.size.y as f64 / UNITS_PER_PX as f64,
+                        turn.degrees
+                    ),
+                });
+            }
+            let ext = u.abs() + v.abs();
+            (EntityKind::Turned { trigger, u, v }, ext * 2)
+        }
+    };
+    Ok(Some(Classified::Entity(EntityDef { kind, pos, size })))
 }
 
 /// The platform's centre followed by its nodes; every leg non-empty. A

@@ -48,6 +48,7 @@ mod read;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod report;
+pub mod scale;
 mod settings;
 mod spawn;
 pub mod tmx;
@@ -58,12 +59,12 @@ pub use default::{
     DEFAULT_PROJECT_FILE,
 };
 pub use entities::{
-    PlacedEntity, PlacedPolygon, PropValue, DEFAULT_PLATFORM_SPEED, DEFAULT_SPRING_STRENGTH,
+    PlacedEntity, PlacedPolygon, PropValue, Turn, DEFAULT_PLATFORM_SPEED, DEFAULT_SPRING_STRENGTH,
     DEFAULT_WALKER_SPEED, ENTITY_NAMES, MAX_PATH_NODES, SPAWN_NAMES,
 };
 pub use error::LevelError;
 pub use ledge_shared::level::{
-    EntityDef, EntityKind, Level, LevelFeatures, PlatformMotion, RouteAction, Waypoint,
+    EntityDef, EntityKind, Level, LevelFeatures, PlatformMotion, RouteAction, Trigger, Waypoint,
 };
 pub use load::{load_file, load_file_with, load_level};
 pub use loaded::{entity_kind_name, LayerStats, LoadedLevel};

@@ -63,5 +63,6 @@ pub fn entity_kind_name(kind: &EntityKind) -> &'static str {
         EntityKind::Checkpoint => "checkpoint",
         EntityKind::Goal => "goal",
         EntityKind::Hazard => "hazard",
+        EntityKind::Turned { trigger, .. } => entity_kind_name(&trigger.kind()),
     }
 }

@@ -37,12 +37,13 @@ use serde_json::{Map, Value};
 
 use super::entities::{
     check_coord_field, is_polygon_name, place_box, px_to_units, PlacedEntity, PlacedPolygon,
-    PropValue,
+    PropValue, Turn,
 };
 use crate::assemble::{assemble, GridLayer};
 use crate::error::LevelError;
 use crate::loaded::LoadedLevel;
 use crate::options::{LoadOptions, MAX_LEVEL_TILES};
+use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::tilemap::Tile;
 
 pub use self::model::{
@@ -794,45 +795,13 @@ fn parse_entity(
     };
     let (left, top) = corner(x, y, f)?;
     let (centre, size) = place_box(cx.file, f, left, top, w, h)?;
-    // OGMO turns an entity about its origin. A block turns into a polygon
-    // block of its outline; the other entities are upright boxes.
+    // OGMO turns an entity about its origin (see `Turn`).
     let rotation = cx.opt_num(o, "rotation", f)?.unwrap_or(0.0);
-    let mut polygon = None;
-    if rotation.is_finite() && rotation % 360.0 != 0.0 {
-        if crate::entities::is_block_name(&name) {
-            let corners = [
-                (-origin_x, -origin_y),
-                (w - origin_x, -origin_y),
-                (w - origin_x, h - origin_y),
-                (-origin_x, h - origin_y),
-            ];
-            let pf = join(f, "rotation");
-            let mut poly = PlacedPolygon {
-                field: pf.clone(),
-                points: Vec::with_capacity(4),
-                point_fields: Vec::with_capacity(4),
-            };
-            for (i, (px, py)) in crate::collision::rotate_about(&corners, (x, y), rotation)
-                .into_iter()
-                .enumerate()
-            {
-                let cf = format!("{pf} (corner {i})");
-                let ux = layer.origin.x as i64 + px_to_units(cx.file, &join(&cf, "x"), px)?;
-                let uy = layer.origin.y as i64 + px_to_units(cx.file, &join(&cf, "y"), py)?;
-                check_coord_field(cx.file, &join(&cf, "x"), ux)?;
-                check_coord_field(cx.file, &join(&cf, "y"), uy)?;
-                poly.points.push(IVec2::new(ux as i32, uy as i32));
-                poly.point_fields.push(cf);
-            }
-            polygon = Some(poly);
-        } else {
-            cx.warnings.borrow_mut().push(format!(
-                "{}: {}: entity {name:?} is turned by {rotation} degrees: only blocks turn in ledge; it stands upright",
-                cx.file,
-                join(f, "rotation")
-            ));
-        }
-    }
+    let pivot = (
+        layer.origin.x as f64 + x * UNITS_PER_PX as f64,
+        layer.origin.y as f64 + y * UNITS_PER_PX as f64,
+    );
+    let turn = Turn::new(rotation, pivot, join(f, "rotation"));
     let mut nodes = Vec::new();
     if let Some(v) = o.get("nodes") {
         let nf = join(f, "nodes");
@@ -852,7 +821,9 @@ fn parse_entity(
         size,
         nodes,
         values,
-        polygon,
+        polygon: None,
+        turn,
+        sized: o.contains_key("width") && o.contains_key("height"),
     })
 }
 
@@ -934,6 +905,8 @@ fn parse_polygon(
             points,
             point_fields,
         }),
+        turn: None,
+        sized: false,
     })
 }
 

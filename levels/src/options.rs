@@ -44,6 +44,12 @@ pub struct LoadOptions {
     pub tile_properties: BTreeMap<String, Tile>,
     /// Units of the speeds in the file.
     pub speed_unit: SpeedUnit,
+    /// The level's player scale, in 1/256ths (the settings' `scale`);
+    /// `None`: from the level (see `docs/LEVELS.md`, "Player scale").
+    pub player_scale: Option<u32>,
+    /// The player's size in units, even (the settings' `[player]`);
+    /// `None`: from the level.
+    pub player_size: Option<glam::IVec2>,
 }
 
 /// Units of entity speeds in a level file.
@@ -89,6 +95,8 @@ impl Default for LoadOptions {
             tile_kinds: BTreeMap::new(),
             tile_properties: BTreeMap::new(),
             speed_unit: SpeedUnit::PxPerTick,
+            player_scale: None,
+            player_size: None,
         }
     }
 }

@@ -16,6 +16,9 @@
 //! speed_unit = "px_per_second"
 //! # Refuse a level without a player spawn instead of placing one.
 //! require_spawn = false
+//! # The player's scale: size, speeds and jump times this (default: from
+//! # the level's spawn object or tile size).
+//! scale = 4.0
 //!
 //! [entities]            # editor name = ledge entity name
 //! hero = "player"
@@ -30,6 +33,10 @@
 //!
 //! [grid]                # OGMO grid value = tile kind
 //! g = "solid"
+//!
+//! [player]              # the player's size in px (the scale follows its height)
+//! width = 48
+//! height = 64
 //! ```
 //!
 //! Unknown keys are errors that list the valid ones; every value is checked
@@ -78,6 +85,22 @@ pub struct LevelSettings {
     /// OGMO grid value = tile kind.
     #[serde(default)]
     pub grid: BTreeMap<String, String>,
+    /// The player's scale: its size, speeds and jump times this (1: ledge's
+    /// own 12 x 16 px player), in [1/8, 256].
+    pub scale: Option<f64>,
+    /// The player's size in pixels.
+    pub player: Option<PlayerSettings>,
+}
+
+/// The settings file's `[player]` table: the player's size in pixels (one
+/// side alone: the other keeps ledge's 12:16 proportion).
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlayerSettings {
+    /// Width, px.
+    pub width: Option<f64>,
+    /// Height, px.
+    pub height: Option<f64>,
 }
 
 /// Where a level's settings file is looked for: beside it, named after it
@@ -203,6 +226,16 @@ impl LevelSettings {
         for (value, v) in &self.grid {
             let k = kind(format!("grid.{value}"), v)?;
             o.mapping = o.mapping.with_grid_value(value, k);
+        }
+        if let Some(v) = self.scale {
+            o.player_scale =
+                Some(crate::scale::settings_scale(v).map_err(|m| bad("scale".into(), m))?);
+        }
+        if let Some(p) = &self.player {
+            o.player_size = Some(
+                crate::scale::settings_size(p.width, p.height)
+                    .map_err(|(k, m)| bad(format!("player.{k}"), m))?,
+            );
         }
         Ok(o)
     }

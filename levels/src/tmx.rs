@@ -45,7 +45,7 @@ use self::objects::{DrawnSolids, Role};
 use super::collision::{self, tile_of_props, Outline, Prop, TileShape};
 use super::entities::is_entity_name;
 use super::entities::{
-    check_coord_field, place_box, px_to_units, PlacedEntity, PlacedPolygon, PropValue,
+    check_coord_field, place_box, px_to_units, PlacedEntity, PlacedPolygon, PropValue, Turn,
 };
 use super::mapping::normalize;
 use crate::assemble::{assemble, GridLayer};
@@ -899,6 +899,8 @@ impl Conv<'_> {
                     nodes: Vec::new(),
                     values: Vec::new(),
                     polygon: Some(polygon),
+                    turn: None,
+                    sized: false,
                 });
                 continue;
             }
@@ -907,6 +909,15 @@ impl Conv<'_> {
             let t = px_to_units(self.file, &format!("{f}.y"), top)?;
             let (centre, size) = place_box(self.file, &f, l, t, w, h)?;
             let (values, nodes) = self.entity_values(&f, &o, paths, centre, size, (w, h))?;
+            // Tiled turns an object about its position (a tile object's
+            // bottom-left corner); a point has nothing to turn, nor a size.
+            let sized = !matches!(o.shape, ObjectShape::Point(..));
+            let turn = sized
+                .then(|| {
+                    let u = f64::from(UNITS_PER_PX);
+                    Turn::new(o.rotation as f64, (x * u, y * u), format!("{f}.rotation"))
+                })
+                .flatten();
             out.push(PlacedEntity {
                 name,
                 layer: info.name.into(),
@@ -917,6 +928,8 @@ impl Conv<'_> {
                 nodes,
                 values,
                 polygon: None,
+                turn,
+                sized,
             });
         }
         Ok(())
@@ -1314,5 +1327,7 @@ fn geometry_entity(
         nodes: Vec::new(),
         values: Vec::new(),
         polygon,
+        turn: None,
+        sized: false,
     }
 }

@@ -126,7 +126,8 @@ impl LevelSet {
     /// Loads every level `paths` names (each a level file, a folder of
     /// them, a playlist `.txt` or a Tiled `.world`; none: the embedded
     /// default level), each with `settings` or its own settings file, as
-    /// games of `config`; each bundle at most `max_bundle` bytes.
+    /// games of `config` with the player scaled for each level
+    /// ([`GameConfig::for_level`]); each bundle at most `max_bundle` bytes.
     pub fn load(
         paths: &[PathBuf],
         settings: Option<&Path>,
@@ -151,12 +152,16 @@ impl LevelSet {
                 |p| p.display().to_string(),
             );
             let (bundle, warnings) = load_counted(file.as_deref(), settings)?;
-            let game = Game::with_config(&bundle.level, config).map_err(|source| {
-                LevelLoadError::Game {
+            // The level's player scale: what this level's `Welcome` and
+            // `LevelChange` carry, and clients predict with.
+            let game = config
+                .for_level(&bundle.level)
+                .map_err(GameError::BadConfig)
+                .and_then(|c| Game::with_config(&bundle.level, c))
+                .map_err(|source| LevelLoadError::Game {
                     path: path.clone(),
                     source,
-                }
-            })?;
+                })?;
             let bytes = bundle.encode();
             if bytes.len() as u64 > max_level_mib << 20 {
                 return Err(LevelLoadError::TooLarge {

@@ -1850,6 +1850,56 @@ mod level_change_tests {
         all
     }
 
+    /// The player configuration a `Welcome` or `LevelChange` carries.
+    fn player_of(w: &ledge_shared::protocol::Welcome) -> ledge_shared::game::PlayerConfig {
+        decode_sim_config::<ledge_shared::game::GameConfig>(&w.sim_config)
+            .unwrap()
+            .player
+    }
+
+    #[test]
+    fn each_level_of_a_rotation_sends_its_own_player_scale() {
+        let dir = tempfile::tempdir().unwrap();
+        let paths = two_levels(dir.path());
+        // The second level's settings make its player twice ledge's.
+        std::fs::write(dir.path().join("second.ledge.toml"), "scale = 2.0\n").unwrap();
+        let levels = LevelSet::load(&paths, None, Default::default(), 32).unwrap();
+        let mut room = room_of(levels, VoteRule::Off);
+        let welcome = room.join(PlayerId(1), "ann".into()).unwrap().welcome;
+        room.take_actions(&mut Vec::new());
+        let base = ledge_shared::game::PlayerConfig::default();
+        assert_eq!(player_of(&welcome), base);
+        room.change_level(1);
+        let mut changed = Vec::new();
+        room.take_actions(&mut changed);
+        let change = controls(&changed, PlayerId(1))
+            .into_iter()
+            .find_map(|m| match m {
+                ServerControl::LevelChange(w) => Some(w),
+                _ => None,
+            })
+            .expect("a LevelChange");
+        let p = player_of(&change);
+        assert_eq!((p.half, p.jump_speed), (base.half * 2, base.jump_speed * 2));
+        assert_eq!(
+            p,
+            room.game().config().player,
+            "the room plays what it sends"
+        );
+        // Back to the first level: ledge's own player again.
+        room.change_level(0);
+        let mut back = Vec::new();
+        room.take_actions(&mut back);
+        let again = controls(&back, PlayerId(1))
+            .into_iter()
+            .find_map(|m| match m {
+                ServerControl::LevelChange(w) => Some(w),
+                _ => None,
+            })
+            .expect("a LevelChange");
+        assert_eq!(player_of(&again), base);
+    }
+
     #[test]
     fn a_majority_vote_moves_the_room_to_the_next_level_ticks_going_on() {
         let dir = tempfile::tempdir().unwrap();

@@ -176,10 +176,12 @@ impl ClientGame {
     /// sending.
     pub fn offline(level: Level, now: Instant) -> Result<ClientGame, ClientError> {
         let me = PlayerId(1);
+        // The level's own player scale (`Game::from_level`).
         let game = Game::from_level(&level)?;
+        let player_half = game.config().player.half;
         let predictor = Predictor::offline(game, me)?;
         Ok(ClientGame {
-            player_half: GameConfig::default().player.half,
+            player_half,
             me,
             name: None,
             names: BTreeMap::new(),

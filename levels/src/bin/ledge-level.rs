@@ -375,6 +375,11 @@ fn describe(file: &str, loaded: &LoadedLevel) -> String {
             let _ = writeln!(out, "  spawn: none");
         }
     }
+    let _ = writeln!(
+        out,
+        "  player: {}",
+        ledge_levels::scale::describe(&loaded.level)
+    );
     if !loaded.route.is_empty() {
         let _ = writeln!(out, "  bot route: {} waypoints", loaded.route.len());
     }

@@ -110,6 +110,8 @@ pub(crate) fn placed(
             nodes,
             values: values(e),
             polygon: None,
+            turn: None,
+            sized: true,
         });
     }
     for (ident, (count, first)) in patrols {

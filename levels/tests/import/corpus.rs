@@ -501,3 +501,39 @@ fn ogmo_files_load_with_no_settings_and_say_what_they_skipped() {
         );
     }
 }
+
+/// Sticker Knight's `hero` (a 128 x 160 px tile object from a template) is
+/// the spawn, and the player has its size: scale 10 (160 px over ledge's
+/// 16 px), so its jump is ten times ledge's, as its blocks are.
+#[test]
+fn sticker_knights_player_is_its_hero() {
+    let Some(dir) = corpus() else { return };
+    for (map, foot) in [("sandbox.tmx", (109, 979)), ("sandbox2.tmx", (352, 448))] {
+        let l = load(&dir, &format!("sticker-knight/map/{map}")).unwrap();
+        let spawns: Vec<_> = l
+            .level
+            .entities
+            .iter()
+            .filter(|e| e.kind == EntityKind::PlayerSpawn)
+            .collect();
+        assert_eq!(spawns.len(), 1, "{map}");
+        let s = spawns[0];
+        let px = |u: i32| u / 256;
+        assert_eq!(
+            (px(s.pos.x), px(s.pos.y + s.size.y / 2)),
+            foot,
+            "{map}: the hero's bottom centre"
+        );
+        assert!(
+            !l.warnings.iter().any(|w| w.contains("no player spawn")),
+            "{map}"
+        );
+        assert_eq!(l.level.player.scale, 10 * 256, "{map}");
+        let config = ledge_shared::game::GameConfig::default()
+            .for_level(&l.level)
+            .unwrap();
+        assert_eq!(config.player.half, IVec2::new(64, 80) * 256, "{map}");
+        let game = Game::from_level(&l.level).unwrap();
+        assert_eq!(game.config().player.half, IVec2::new(64, 80) * 256);
+    }
+}

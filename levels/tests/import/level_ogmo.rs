@@ -435,11 +435,11 @@ fn default_level_file_loads_from_disk_like_the_embedded_one() {
 }
 
 #[test]
-fn a_turned_block_is_a_polygon_and_other_turned_entities_are_said() {
+fn a_turned_block_is_a_polygon_and_a_turned_walker_is_said() {
     let text = r#"{"layers": [{"name": "e", "entities": [
         {"name": "player", "x": 0, "y": 0, "width": 16, "height": 16},
         {"name": "block", "x": 100, "y": 100, "width": 20, "height": 10, "originX": 10, "originY": 5, "rotation": 90},
-        {"name": "coin", "x": 50, "y": 50, "width": 8, "height": 8, "rotation": 45}
+        {"name": "walker", "x": 50, "y": 50, "width": 8, "height": 8, "rotation": 45}
     ]}]}"#;
     let l = ogmo::load_str("t.json", text, None, &LoadOptions::default()).unwrap();
     let block = &l.level.entities[1];
@@ -451,9 +451,12 @@ fn a_turned_block_is_a_polygon_and_other_turned_entities_are_said() {
     abs.sort_by_key(|p| (p.x, p.y));
     let p = |x: i32, y: i32| IVec2::new(x, y) * 256;
     assert_eq!(abs, [p(95, 90), p(95, 110), p(105, 90), p(105, 110)]);
-    assert_eq!(l.level.entities[2].kind, EntityKind::Coin);
+    assert!(matches!(
+        l.level.entities[2].kind,
+        EntityKind::Walker { .. }
+    ));
     assert_eq!(
         l.warnings,
-        ["t.json: layers[0].entities[2].rotation: entity \"coin\" is turned by 45 degrees: only blocks turn in ledge; it stands upright"]
+        ["t.json: layers[0].entities[2].rotation: entity \"walker\" is turned by 45 degrees: only blocks, hazards, coins, checkpoints and goals turn in ledge; it stands upright"]
     );
 }

@@ -9,6 +9,7 @@ use glam::IVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::fixed::{check_extent, MAX_SPEED};
+use crate::level::{Level, PlayerScale, MAX_PLAYER_SCALE, MIN_PLAYER_SCALE};
 use crate::world::SimConfig;
 
 /// What a player keeps of a platform's velocity when it leaves it (walks or
@@ -235,6 +236,66 @@ impl PlayerConfig {
     }
 }
 
+impl PlayerConfig {
+    /// This configuration for a level's player ([`PlayerScale`]): every
+    /// length, speed and acceleration times `scale / 256` (rounded to the
+    /// nearest unit; a positive value stays at least 1), the half extents
+    /// the level's when it gives them; ticks and `max_walkable_slope` (a
+    /// ratio) unchanged. Scale 256 without half extents changes nothing.
+    /// Refused when the scale is outside [`MIN_PLAYER_SCALE`,
+    /// `MAX_PLAYER_SCALE`] or the result breaks [`PlayerConfig::validate`].
+    pub fn scaled(&self, s: &PlayerScale) -> Result<PlayerConfig, String> {
+        if !(MIN_PLAYER_SCALE..=MAX_PLAYER_SCALE).contains(&s.scale) {
+            return Err(format!(
+                "player scale {}/256 is outside [{MIN_PLAYER_SCALE}, {MAX_PLAYER_SCALE}]/256",
+                s.scale
+            ));
+        }
+        let k = i64::from(s.scale);
+        let mul = |v: i32| -> i32 {
+            let r = (i64::from(v) * k + 128).div_euclid(256);
+            let r = if v > 0 { r.max(1) } else { r };
+            r.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
+        };
+        let mut c = *self;
+        for v in [
+            &mut c.run_accel,
+            &mut c.run_brake,
+            &mut c.air_accel,
+            &mut c.air_brake,
+            &mut c.max_run_speed,
+            &mut c.jump_speed,
+            &mut c.jump_gravity,
+            &mut c.gravity,
+            &mut c.max_fall_speed,
+            &mut c.snap_distance,
+            &mut c.stomp_bounce_speed,
+            &mut c.stomp_tolerance,
+        ] {
+            *v = mul(*v);
+        }
+        c.half = match s.half {
+            Some(h) => h,
+            None => IVec2::new(mul(self.half.x), mul(self.half.y)),
+        };
+        c.validate()?;
+        Ok(c)
+    }
+}
+
+impl GameConfig {
+    /// This configuration with the player scaled for `level`
+    /// ([`PlayerConfig::scaled`] by [`Level::player`]): what a server plays
+    /// the level with and sends its clients in `Welcome`.
+    pub fn for_level(mut self, level: &Level) -> Result<GameConfig, String> {
+        self.player = self
+            .player
+            .scaled(&level.player)
+            .map_err(|e| format!("level {:?}: {e}", level.name))?;
+        Ok(self)
+    }
+}
+
 /// Everything [`super::Game::with_config`] can tune.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct GameConfig {
@@ -245,4 +306,50 @@ pub struct GameConfig {
     /// only [`crate::world::SweepMode::Auto`] sweeps its fast movers),
     /// broad phase, pipeline and detection threads (these never do).
     pub sim: SimConfig,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::level::ScaleSource;
+
+    fn scale(scale: u32, half: Option<IVec2>) -> PlayerScale {
+        PlayerScale {
+            scale,
+            half,
+            source: ScaleSource::Settings,
+        }
+    }
+
+    #[test]
+    fn scale_one_changes_nothing_and_others_scale_lengths_and_speeds() {
+        let d = PlayerConfig::default();
+        assert_eq!(d.scaled(&PlayerScale::default()), Ok(d));
+        let twice = d.scaled(&scale(512, None)).unwrap();
+        assert_eq!(twice.half, d.half * 2);
+        assert_eq!(
+            (twice.jump_speed, twice.gravity, twice.max_run_speed),
+            (2 * d.jump_speed, 2 * d.gravity, 2 * d.max_run_speed)
+        );
+        assert_eq!(
+            (twice.jump_hold_ticks, twice.max_walkable_slope),
+            (d.jump_hold_ticks, d.max_walkable_slope)
+        );
+        let sized = d.scaled(&scale(512, Some(IVec2::new(100, 200)))).unwrap();
+        assert_eq!(sized.half, IVec2::new(100, 200));
+        // The smallest scale keeps every positive value positive.
+        let small = d.scaled(&scale(MIN_PLAYER_SCALE, None)).unwrap();
+        assert!(small.validate().is_ok() && small.air_brake >= 1);
+        assert!(d.scaled(&scale(MAX_PLAYER_SCALE, None)).is_ok());
+    }
+
+    #[test]
+    fn scales_out_of_bounds_are_refused() {
+        let d = PlayerConfig::default();
+        for s in [0, MIN_PLAYER_SCALE - 1, MAX_PLAYER_SCALE + 1, u32::MAX] {
+            assert!(d.scaled(&scale(s, None)).is_err(), "{s}");
+        }
+        assert!(d.scaled(&scale(256, Some(IVec2::new(0, 5)))).is_err());
+        assert!(d.scaled(&scale(256, Some(IVec2::splat(i32::MAX)))).is_err());
+    }
 }

@@ -7,8 +7,10 @@
 use glam::IVec2;
 
 use super::path::PathSchedule;
+use super::rect::Rect;
 use super::state::kind;
 use crate::level::EntityKind;
+use crate::shape::Obb;
 use crate::world::BodyId;
 
 /// The type of a level entity, for drawing ([`super::EntityView`]).
@@ -52,6 +54,7 @@ impl EntityType {
             EntityKind::Checkpoint => EntityType::Checkpoint,
             EntityKind::Goal => EntityType::Goal,
             EntityKind::Hazard => EntityType::Hazard,
+            EntityKind::Turned { trigger, .. } => Self::of(&trigger.kind()),
         }
     }
 
@@ -89,4 +92,18 @@ pub(super) struct Ent {
     pub(super) dir: i32,
     /// Coin: who picked it up.
     pub(super) collector: Option<u32>,
+    /// A turned trigger's shape ([`EntityKind::Turned`]): what touches it
+    /// (`half` is the even box around it).
+    pub(super) turned: Option<Obb>,
+}
+
+impl Ent {
+    /// Whether the interior of box `r` overlaps this entity's (its box at
+    /// `pos`, or its turned shape).
+    pub(super) fn touches(&self, pos: IVec2, r: &Rect) -> bool {
+        match &self.turned {
+            None => Rect::new(pos, self.half).overlaps(r),
+            Some(obb) => r.overlaps_obb(pos, obb.u(), obb.v()),
+        }
+    }
 }

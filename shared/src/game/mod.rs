@@ -101,7 +101,7 @@ use crate::fixed::{check_coord, check_speed};
 use crate::input::Buttons;
 use crate::level::{EntityDef, EntityKind, Level};
 use crate::protocol::{is_replicated, EntityState, PlayerId, StateSnapshot};
-use crate::shape::{Aabb, ConvexPolygon};
+use crate::shape::{Aabb, ConvexPolygon, Obb};
 use crate::tilemap::Tilemap;
 use crate::world::hash::Fnv1a;
 use crate::world::{BodyDesc, BodyId, ColliderDesc, OneWay, Sides, World, TILEMAP_LAYER};
@@ -348,9 +348,13 @@ pub struct Game {
 }
 
 impl Game {
-    /// Builds the game for `level` with the default configuration.
+    /// Builds the game for `level` with the default configuration, its
+    /// player scaled for the level ([`GameConfig::for_level`]).
     pub fn from_level(level: &Level) -> Result<Self, GameError> {
-        Self::with_config(level, GameConfig::default())
+        let config = GameConfig::default()
+            .for_level(level)
+            .map_err(GameError::BadConfig)?;
+        Self::with_config(level, config)
     }
 
     /// Builds the game for `level` with `config`.
@@ -432,6 +436,7 @@ impl Game {
             alive: true,
             dir: -1,
             collector: None,
+            turned: None,
         };
         self.build_entity(level, i, def, shape, &mut e)?;
         self.ents.push(e);
@@ -514,6 +519,14 @@ impl Game {
             EntityKind::Checkpoint => self.checkpoints.push(i),
             EntityKind::Goal => self.goals.push(i),
             EntityKind::Hazard => self.hazards.push(i),
+            EntityKind::Turned { trigger, u, v } => {
+                e.turned = Some(Obb::from_axes(*u, *v).map_err(|x| bad(format!("turned: {x}")))?);
+                let def = EntityDef {
+                    kind: trigger.kind(),
+                    ..def.clone()
+                };
+                return self.build_entity(level, i, &def, shape, e);
+            }
         }
         Ok(())
     }

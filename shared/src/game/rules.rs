@@ -421,7 +421,7 @@ impl Game {
             let r = Rect::new(pos, cfg.half);
             self.hazards
                 .iter()
-                .find(|&&h| Rect::new(self.ents[h].pos, self.ents[h].half).overlaps(&r))
+                .find(|&&h| self.ents[h].touches(self.ents[h].pos, &r))
                 .map(|&h| HurtCause::Hazard(ENTITY_ID_BASE + h as u32))
         }
     }
@@ -565,7 +565,7 @@ impl Game {
         for k in 0..self.coins.len() {
             let c = self.coins[k];
             let e = &self.ents[c];
-            if e.collector.is_none() && Rect::new(e.pos, e.half).overlaps(r) {
+            if e.collector.is_none() && e.touches(e.pos, r) {
                 self.ents[c].collector = Some(id.0);
                 let total = self.coins_of(id);
                 self.events.push(GameEvent::CoinPicked {
@@ -578,7 +578,7 @@ impl Game {
         for k in 0..self.checkpoints.len() {
             let c = self.checkpoints[k];
             let e = &self.ents[c];
-            if p.st.checkpoint as usize != c + 1 && Rect::new(e.pos, e.half).overlaps(r) {
+            if p.st.checkpoint as usize != c + 1 && e.touches(e.pos, r) {
                 p.st.checkpoint = (c + 1) as u16;
                 self.events.push(GameEvent::Checkpoint {
                     player: id,
@@ -590,7 +590,7 @@ impl Game {
             && self
                 .goals
                 .iter()
-                .any(|&k| Rect::new(self.ents[k].pos, self.ents[k].half).overlaps(r))
+                .any(|&k| self.ents[k].touches(self.ents[k].pos, r))
         {
             p.st.won = true;
             p.run.order = self.next_order();

@@ -12,7 +12,10 @@ mod model;
 use glam::IVec2;
 use serde::{Deserialize, Serialize};
 
-pub use model::{EntityDef, EntityKind, Level, PlatformMotion};
+pub use model::{
+    EntityDef, EntityKind, Level, PlatformMotion, PlayerScale, ScaleSource, Trigger,
+    MAX_PLAYER_SCALE, MIN_PLAYER_SCALE,
+};
 
 use crate::tilemap::Tile;
 
@@ -148,7 +151,8 @@ impl Level {
                 EntityKind::Coin
                 | EntityKind::Checkpoint
                 | EntityKind::Goal
-                | EntityKind::Hazard => f.triggers = true,
+                | EntityKind::Hazard
+                | EntityKind::Turned { .. } => f.triggers = true,
             }
         }
         f

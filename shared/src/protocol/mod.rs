@@ -79,7 +79,9 @@ pub use snapshot::{
 /// 11: level rotation and votes: `ServerControl::Levels`,
 /// `ServerControl::LevelChange`, `ClientControl::Vote`, and
 /// `ClientControl::GetLevel::sha256` (which of the server's levels).
-pub const PROTOCOL_VERSION: u32 = 11;
+/// 12: the level bundle's `Level` carries the level's player scale
+/// (`Level::player`) and turned triggers (`EntityKind::Turned`).
+pub const PROTOCOL_VERSION: u32 = 12;
 
 /// ALPN identifier for the TLS handshake, so a ledge endpoint never talks to
 /// an unrelated QUIC peer. It names the application, not the version:

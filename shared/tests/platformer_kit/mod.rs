@@ -113,6 +113,7 @@ pub fn level(rows: &[&str], entities: Vec<EntityDef>) -> Level {
         name: "test".into(),
         tilemap: map(rows),
         entities,
+        player: Default::default(),
     }
 }
 
@@ -138,6 +139,7 @@ pub fn level_sized(size: i32, rows: &[&str], entities: Vec<EntityDef>) -> Level 
         name: "test".into(),
         tilemap: map_at(IVec2::ZERO, size, rows),
         entities,
+        player: Default::default(),
     }
 }
 
@@ -161,9 +163,10 @@ impl Sim {
         }
     }
 
-    /// A game of `level` with the default configuration and player 1.
+    /// A game of `level` with the default configuration, its player scaled
+    /// for the level (as `Game::from_level`), and player 1.
     pub fn new(level: &Level) -> Self {
-        Self::with(level, GameConfig::default())
+        Self::with(level, GameConfig::default().for_level(level).unwrap())
     }
 
     /// Steps once with `b`; keeps the tick's events.

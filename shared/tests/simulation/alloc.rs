@@ -106,6 +106,7 @@ fn game_ticks_allocate_nothing_in_steady_state() {
             ),
             e(EntityKind::Checkpoint, at(10, 1), IVec2::splat(T)),
         ],
+        player: Default::default(),
     };
     let mut game = Game::from_level(&level).unwrap();
     for id in 1..=3 {

@@ -160,6 +160,7 @@ fn run_players(config: GameConfig, ticks: u32, step: i32, blocks: bool) -> Resul
         name: "seams".to_owned(),
         tilemap: Tilemap::new(IVec2::ZERO, TILE, cols, rows, tiles)?,
         entities,
+        player: Default::default(),
     };
     let mut game = Game::with_config(&level, config)?;
     let n = offsets.len() as u32;

@@ -401,6 +401,7 @@ fn room(patches: &[(usize, usize, Tile)], entities: &[(EntityKind, i32, i32)]) -
                 size: IVec2::splat(T),
             })
             .collect(),
+        player: Default::default(),
     }
 }
 
