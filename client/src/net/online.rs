@@ -40,7 +40,7 @@ use ledge_shared::protocol::{
 };
 
 use crate::game::ClientGame;
-use crate::ghost::Ghost;
+use crate::ghost::{Ghost, GhostBuilder, GHOST_TICKS_PER_FRAME};
 #[cfg(not(target_arch = "wasm32"))]
 use crate::net::background::{ConnectRequest, NetOptions, NetThread};
 #[cfg(not(target_arch = "wasm32"))]
@@ -135,6 +135,9 @@ pub struct OnlineGame<
     standings: u64,
     /// The runs to race against, played from their replays.
     ghosts: Vec<Ghost>,
+    /// Ghosts still being played from their replays (at most one of
+    /// each kind), [`GHOST_TICKS_PER_FRAME`] ticks per update.
+    building: Vec<GhostBuilder>,
     /// Why the last ghost the server sent could not be played, if so.
     ghost_error: Option<String>,
     /// Snapshots arrived since the last [`OnlineGame::take_arrivals`].
@@ -228,6 +231,7 @@ impl<N: Network> OnlineGame<N> {
             standing: None,
             standings: 0,
             ghosts: Vec::new(),
+            building: Vec::new(),
             ghost_error: None,
             arrivals: 0,
             last_news: None,
@@ -259,6 +263,7 @@ impl<N: Network> OnlineGame<N> {
         while let Some(event) = self.net.try_recv() {
             self.take(event, now);
         }
+        self.build_ghosts(GHOST_TICKS_PER_FRAME);
         let Some(game) = &mut self.game else {
             return 0;
         };
@@ -398,6 +403,7 @@ impl<N: Network> OnlineGame<N> {
         self.changing = None;
         self.level_changes += 1;
         self.ghosts.clear();
+        self.building.clear();
         self.ghost_error = None;
         self.standing = None;
         self.latest = None;
@@ -479,22 +485,59 @@ impl<N: Network> OnlineGame<N> {
         self.ghost_error.as_deref()
     }
 
-    /// Plays a ghost's replay into its track (a run of a few seconds plays
-    /// in milliseconds); replaces the ghost of the same kind.
+    /// Ghosts still being played from their replays: each is added to
+    /// [`OnlineGame::ghosts`] once complete (a few updates after it
+    /// arrived; a 30-minute run in about a hundred).
+    pub fn ghosts_building(&self) -> usize {
+        self.building.len()
+    }
+
+    /// Starts playing a ghost's replay into its track
+    /// ([`OnlineGame::build_ghosts`] goes on each update); it replaces the
+    /// ghost of the same kind once complete, and one of its kind still
+    /// being built at once.
     fn add_ghost(&mut self, run: &GhostRun) {
         let Some(level) = self.level() else {
             self.ghost_error = Some("a ghost came before the level".into());
             return;
         };
-        match Ghost::from_run(level, run) {
-            Ok(ghost) => {
-                self.ghosts.retain(|g| g.record != ghost.record);
-                self.ghosts.push(ghost);
-                self.ghosts.sort_by_key(|g| !g.record);
+        match GhostBuilder::new(level, run) {
+            Ok(builder) => {
+                self.building.retain(|b| b.record() != run.record);
+                self.building.push(builder);
             }
             Err(e) => {
                 tracing::warn!("ghost of {} not shown: {e}", run.player);
                 self.ghost_error = Some(e.to_string());
+            }
+        }
+    }
+
+    /// Steps the ghosts being built, `max_ticks` in all (the oldest
+    /// first); a complete one replaces the ghost of its kind, one that
+    /// fails is dropped with its reason ([`OnlineGame::ghost_error`]).
+    fn build_ghosts(&mut self, max_ticks: u64) {
+        let mut budget = max_ticks;
+        let mut i = 0;
+        while i < self.building.len() && budget > 0 {
+            let builder = &mut self.building[i];
+            match builder.build(budget) {
+                Ok(n) => budget -= n,
+                Err(e) => {
+                    let b = self.building.remove(i);
+                    tracing::warn!("ghost of {} not shown: {e}", b.player());
+                    self.ghost_error = Some(e.to_string());
+                    continue;
+                }
+            }
+            if !self.building[i].is_done() {
+                i += 1;
+                continue;
+            }
+            if let Some(ghost) = self.building.remove(i).finish() {
+                self.ghosts.retain(|g| g.record != ghost.record);
+                self.ghosts.push(ghost);
+                self.ghosts.sort_by_key(|g| !g.record);
             }
         }
     }
@@ -622,7 +665,9 @@ mod tests {
 
     use ledge_levels::LevelBundle;
     use ledge_shared::input::Buttons;
-    use ledge_shared::protocol::{LevelChoice, LevelList, PlayerId, Standing, VoteRule, Welcome};
+    use ledge_shared::protocol::{
+        GhostRun, LevelChoice, LevelList, PlayerId, Standing, VoteRule, Welcome,
+    };
 
     use super::OnlineGame;
     use crate::net::download::Fetched;
@@ -798,5 +843,72 @@ mod tests {
         game.update(Instant::now(), Buttons::NONE);
         assert_eq!(game.standings(), 3);
         assert_eq!(game.standing(), Some(&Err("records are off".into())));
+    }
+
+    /// Ghosts are built a budget of ticks at a time and shown once
+    /// complete; a newer one of the same kind replaces the one being
+    /// built; one whose replay fails says why and leaves the ghosts as
+    /// they were.
+    #[test]
+    fn ghosts_are_built_across_updates_and_shown_once_complete() {
+        use crate::ghost::tests::{diverging_run, recorded_run};
+        use crate::ghost::Ghost;
+        let level = bundle("default");
+        let mut game = OnlineGame::with_network(Queued(VecDeque::new()), "server", "ada");
+        game.net.0.extend([
+            NetEvent::Level(level.clone(), Fetched::default()),
+            NetEvent::Connected(welcome_to(&level.level, 10)),
+        ]);
+        game.update(Instant::now(), Buttons::NONE);
+        let record = recorded_run(true);
+        let expected = Ghost::from_run(&level.level, &record).unwrap();
+        let now = Instant::now();
+        game.take(NetEvent::Ghost(Box::new(recorded_run(true))), now);
+        game.build_ghosts(50);
+        assert_eq!(game.ghosts_building(), 1);
+        assert!(game.ghosts().is_empty(), "not shown before complete");
+        // A newer record replaces the one being built.
+        let newer = GhostRun {
+            millis: 1,
+            ..record.clone()
+        };
+        game.take(NetEvent::Ghost(Box::new(newer)), now);
+        game.take(NetEvent::Ghost(Box::new(recorded_run(false))), now);
+        assert_eq!(game.ghosts_building(), 2);
+        let mut updates = 0;
+        while game.ghosts_building() > 0 {
+            game.build_ghosts(50);
+            updates += 1;
+        }
+        assert!(updates > 2 * u64::from(expected.ticks()) / 50, "{updates}");
+        let ghosts = game.ghosts();
+        assert_eq!(ghosts.len(), 2, "the record and our best");
+        assert_eq!(
+            ghosts[0],
+            Ghost {
+                millis: 1,
+                ..expected.clone()
+            }
+        );
+        assert!(!ghosts[1].record);
+        assert_eq!(game.ghost_error(), None);
+        // A broken best: its reason, and the ghosts stay.
+        game.take(
+            NetEvent::Ghost(Box::new(GhostRun {
+                record: false,
+                ..diverging_run()
+            })),
+            now,
+        );
+        while game.ghosts_building() > 0 {
+            game.update(Instant::now(), Buttons::NONE);
+        }
+        assert!(
+            game.ghost_error()
+                .is_some_and(|e| e.contains("differently") || e.contains("hash")),
+            "{:?}",
+            game.ghost_error()
+        );
+        assert_eq!(game.ghosts().len(), 2);
     }
 }
