@@ -589,6 +589,9 @@ impl GameLoop {
             (None, None) => shown.unwrap_or_else(|| level_px.center()),
         };
         let screen = vec2(screen_width(), screen_height());
+        // The level's player scale (it may change with the level).
+        let scale = self.setup.play.level().player.scale as f32 / 256.0;
+        self.camera.set_scale(scale);
         let view = self
             .camera
             .update(focus, level_px, screen, dt.as_secs_f32());

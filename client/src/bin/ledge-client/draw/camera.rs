@@ -59,16 +59,40 @@ pub fn zoom_for(screen: Vec2) -> f32 {
 }
 
 /// A camera following a target.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct Camera {
     /// World pixel at the screen centre; `None` until the first frame.
     centre: Option<Vec2>,
+    /// The level's player scale (1: ledge's own 12 x 16 px player): the
+    /// view shows that many times the world, so a level made for a larger
+    /// player looks as the default level does.
+    scale: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Camera {
+        Camera {
+            centre: None,
+            scale: 1.0,
+        }
+    }
 }
 
 impl Camera {
     /// A camera that snaps to its first target.
     pub fn new() -> Camera {
         Camera::default()
+    }
+
+    /// Follows the level's player scale from now on
+    /// (`ledge_shared::level::PlayerScale::scale` / 256; values outside
+    /// 1/8..=256 are held to it, a non-finite one is 1).
+    pub fn set_scale(&mut self, scale: f32) {
+        self.scale = if scale.is_finite() {
+            scale.clamp(0.125, 256.0)
+        } else {
+            1.0
+        };
     }
 
     /// Moves towards `target` (world px) for a frame of `dt` seconds, keeps
@@ -78,7 +102,7 @@ impl Camera {
     /// frame) is jumped to; otherwise the camera eases towards it, never
     /// lagging more than [`MAX_LAG`] of half the view.
     pub fn update(&mut self, target: Vec2, level: Rect, screen: Vec2, dt: f32) -> View {
-        let zoom = zoom_for(screen);
+        let zoom = zoom_for(screen) / self.scale;
         let half_view = screen / zoom / 2.0;
         let goal = clamp_centre(target, level, half_view);
         let centre = match self.centre {
@@ -183,5 +207,21 @@ mod tests {
         let v = cam.update(Vec2::new(0.0, 0.0), small, big, 0.0);
         assert_eq!(v.zoom, 4.0);
         assert_eq!(v.to_screen(Vec2::new(100.0, 50.0)), big / 2.0);
+    }
+
+    #[test]
+    fn a_level_for_a_larger_player_is_seen_from_further_away() {
+        let big = Rect::new(0.0, 0.0, 16000.0, 4800.0);
+        let mut plain = Camera::new();
+        let mut scaled = Camera::new();
+        scaled.set_scale(10.0);
+        let a = plain.update(Vec2::new(800.0, 240.0), LEVEL, SCREEN, 0.0);
+        let b = scaled.update(Vec2::new(8000.0, 2400.0), big, SCREEN, 0.0);
+        assert_eq!(b.zoom * 10.0, a.zoom);
+        // The same view of a level ten times as large.
+        assert_eq!(b.visible().w, a.visible().w * 10.0);
+        scaled.set_scale(f32::NAN);
+        let c = scaled.update(Vec2::new(8000.0, 2400.0), big, SCREEN, 0.0);
+        assert_eq!(c.zoom, a.zoom);
     }
 }
