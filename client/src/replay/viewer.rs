@@ -4,9 +4,19 @@
 //! frame's duration: the replay steps as many ticks as are due at its
 //! speed ([`SPEEDS`]), and the frame is drawn between the last two
 //! ([`ReplayViewer::view`]). Space pauses, the speed keys pick another of
-//! [`SPEEDS`], seeking goes anywhere between the start and the end
-//! ([`Playback::seek`]: back from the nearest checkpoint), and the camera
-//! follows one of the players in the game or none ([`Follow`]).
+//! [`SPEEDS`], seeking goes anywhere between the start and the end, and
+//! the camera follows one of the players in the game or none
+//! ([`Follow`]).
+//!
+//! A seek ([`ReplayViewer::seek`]) goes at once to the nearest checkpoint
+//! at or before its target (one every 5 s of what was played so far,
+//! [`Playback::restore_nearest`]) and steps the rest in the frames after,
+//! at most [`SEEK_TICKS_PER_FRAME`] each ([`ReplayViewer::seeking`] says
+//! where to; [`ReplayViewer::tick`] is the tick reached so far): the End
+//! of a 30-minute match played for the first time takes a few seconds of
+//! frames rather than one frozen frame. It lands exactly where one seek
+//! in one go does ([`ReplayViewer::finish_seek`]: the same tick and
+//! state); a newer seek replaces one under way.
 //!
 //! A run's replay opens at the run's start (the replay itself starts at a
 //! keyframe up to 10 s earlier), following the runner; a match's at its
@@ -37,6 +47,15 @@ const NORMAL_SPEED: usize = 2;
 /// does not stall the next one stepping them all).
 pub const MAX_DUE_TICKS: f64 = 240.0;
 
+/// Most ticks a seek steps per frame ([`ReplayViewer::advance`]). A tick
+/// of a match replay costs about 4 µs with 8 players in a release build
+/// (the ghosts' measure, [`crate::ghost::GHOST_TICKS_PER_FRAME`]): 600
+/// ticks (10 s of play) is about 2.5 ms of a frame, so a 5 s skip lands
+/// in the frame it was asked in, and the End of a 30-minute match played
+/// for the first time (108,000 ticks) in 180 frames, 3 s, each frame
+/// drawn.
+pub const SEEK_TICKS_PER_FRAME: u64 = 600;
+
 /// A replay being watched (see the module documentation).
 #[derive(Debug)]
 pub struct ReplayViewer {
@@ -54,6 +73,8 @@ pub struct ReplayViewer {
     home: u64,
     /// The tick the replay failed to play on at, and why.
     failed: Option<(u64, ReplayError)>,
+    /// Where a seek under way goes.
+    target: Option<u64>,
 }
 
 impl ReplayViewer {
@@ -73,6 +94,7 @@ impl ReplayViewer {
             before,
             follow: Follow::Free,
             failed: None,
+            target: None,
         };
         match kind {
             ReplayKind::Run {
@@ -80,6 +102,7 @@ impl ReplayViewer {
             } => {
                 viewer.follow = Follow::Player(player);
                 viewer.seek(start_tick)?;
+                viewer.finish_seek()?;
                 viewer.home = viewer.tick();
             }
             ReplayKind::Match => {
@@ -208,7 +231,14 @@ impl ReplayViewer {
     /// A frame of `seconds` passed: steps the ticks due at the speed (none
     /// while paused or at the end), at most `max_ticks`. Returns the ticks
     /// stepped; an error stops the replay where it failed.
+    ///
+    /// During a seek it plays nothing (and returns 0): it steps on towards
+    /// the seek's target, at most [`SEEK_TICKS_PER_FRAME`] ticks.
     pub fn advance(&mut self, seconds: f64, max_ticks: u64) -> Result<u64, ReplayError> {
+        if self.target.is_some() {
+            self.seek_on(SEEK_TICKS_PER_FRAME)?;
+            return Ok(0);
+        }
         if !self.paused && !self.at_end() {
             let ticks = seconds.max(0.0) * f64::from(self.tick_rate()) * f64::from(self.speed());
             self.due = (self.due + ticks).min(MAX_DUE_TICKS);
@@ -243,22 +273,65 @@ impl ReplayViewer {
         self.due.clamp(0.0, 1.0) as f32
     }
 
-    /// Goes to game tick `tick`, clamped to the replay (and to before a
-    /// failure).
+    /// Starts a seek to game tick `tick`, clamped to the replay (and to
+    /// before a failure), replacing one under way: at once to the nearest
+    /// checkpoint at or before it, then on in the frames after
+    /// ([`ReplayViewer::advance`]; see the module documentation).
     pub fn seek(&mut self, tick: u64) -> Result<(), ReplayError> {
         let target = tick.clamp(self.start_tick(), self.limit());
-        if let Err(e) = self.playback.seek(target) {
+        if let Err(e) = self.playback.restore_nearest(target) {
+            self.target = None;
             return Err(self.fail(e));
         }
+        self.target = Some(target);
+        self.seek_on(0)
+    }
+
+    /// Where the seek under way goes, if one is.
+    pub fn seeking(&self) -> Option<u64> {
+        self.target
+    }
+
+    /// Steps the seek under way to its target now, however far.
+    pub fn finish_seek(&mut self) -> Result<(), ReplayError> {
+        self.seek_on(u64::MAX)
+    }
+
+    /// Steps the seek under way at most `max_ticks` on; once at its target
+    /// it is done (nothing blended across it). An error stops the replay
+    /// there, as playing does.
+    fn seek_on(&mut self, max_ticks: u64) -> Result<(), ReplayError> {
+        let Some(target) = self.target else {
+            return Ok(());
+        };
+        let mut stepped = 0;
+        while self.tick() < target && stepped < max_ticks {
+            match self.playback.step() {
+                Ok(true) => stepped += 1,
+                Ok(false) => break,
+                Err(e) => {
+                    self.target = None;
+                    return Err(self.fail(e));
+                }
+            }
+        }
         self.before.take(self.playback.game());
-        self.due = 0.0;
+        if self.tick() >= target || self.playback.at_end() {
+            self.target = None;
+            self.due = 0.0;
+        } else {
+            // Drawn as reached so far.
+            self.due = 1.0;
+        }
         Ok(())
     }
 
-    /// Seeks `seconds` forward (negative: back) from where it stands.
+    /// Seeks `seconds` forward (negative: back) from where it stands (or
+    /// from where the seek under way goes).
     pub fn skip(&mut self, seconds: f64) -> Result<(), ReplayError> {
         let ticks = (seconds * f64::from(self.tick_rate())).round() as i64;
-        let target = (self.tick() as i64).saturating_add(ticks).max(0) as u64;
+        let from = self.target.unwrap_or_else(|| self.tick());
+        let target = (from as i64).saturating_add(ticks).max(0) as u64;
         self.seek(target)
     }
 

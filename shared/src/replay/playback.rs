@@ -176,6 +176,31 @@ impl Playback {
         Ok(())
     }
 
+    /// Goes to the nearest checkpoint at or before `tick` (clamped to the
+    /// replay's span) when that is nearer to it than where the playback
+    /// stands (`tick` is behind, or a checkpoint lies ahead on the way);
+    /// steps nothing. Stepping on to `tick` then lands exactly where
+    /// [`Playback::seek`] does, a few ticks at a time if need be.
+    pub fn restore_nearest(&mut self, tick: u64) -> Result<(), ReplayError> {
+        let tick = tick.clamp(self.replay.start_tick(), self.replay.end_tick());
+        let now = self.game.tick();
+        let Some(i) = self.checkpoints.iter().rposition(|c| c.state.tick <= tick) else {
+            return Ok(());
+        };
+        let at = self.checkpoints[i].state.tick;
+        if tick < now || at > now {
+            let c = &self.checkpoints[i];
+            self.game
+                .restore(&c.state)
+                .map_err(|e| ReplayError::Unplayable {
+                    tick: c.state.tick,
+                    detail: e.to_string(),
+                })?;
+            self.cursor = c.cursor.clone();
+        }
+        Ok(())
+    }
+
     /// Plays to the end, checking every hash: the ticks stepped.
     pub fn play_to_end(&mut self) -> Result<u64, ReplayError> {
         let mut n = 0;

@@ -95,6 +95,7 @@ fn seeking_lands_where_the_game_was() {
     let mut v = viewer(replay);
     for target in [700, 30, 1199, 299, 0, 1200, 650] {
         v.seek(target).unwrap();
+        v.finish_seek().unwrap();
         assert_eq!(v.tick(), target);
         assert_eq!(p1(&v), pos[target as usize], "at {target}");
         // Nothing blended across the seek.
@@ -104,11 +105,15 @@ fn seeking_lands_where_the_game_was() {
         );
     }
     v.seek(100).unwrap();
+    v.finish_seek().unwrap();
     v.skip(5.0).unwrap();
+    v.finish_seek().unwrap();
     assert_eq!(v.tick(), 400);
     v.skip(-10.0).unwrap();
+    v.finish_seek().unwrap();
     assert_eq!(v.tick(), 0, "clamped to the start");
     v.seek_end().unwrap();
+    v.finish_seek().unwrap();
     assert_eq!(v.tick(), 1200);
     assert!(v.at_end());
     assert_eq!(v.game().state_hash(), game.state_hash());
@@ -122,6 +127,7 @@ fn seeking_lands_where_the_game_was() {
     assert_eq!((v.tick(), v.paused()), (0, false));
     v.toggle_pause().unwrap();
     v.seek_end().unwrap();
+    v.finish_seek().unwrap();
     assert!(v.paused());
     v.toggle_pause().unwrap();
     assert_eq!((v.tick(), v.paused()), (0, false));
@@ -145,10 +151,12 @@ fn the_camera_follows_one_player_in_the_game_or_nobody() {
     // Player 2 leaves at tick 900: the first player in the game is shown,
     // and 2 again when seeking back.
     v.seek(1000).unwrap();
+    v.finish_seek().unwrap();
     assert_eq!(v.follow(), Follow::Player(PlayerId(2)));
     assert_eq!(v.followed(), Some(PlayerId(1)));
     assert_eq!(v.players(), vec![PlayerId(1), PlayerId(3)]);
     v.seek(500).unwrap();
+    v.finish_seek().unwrap();
     assert_eq!(v.followed(), Some(PlayerId(2)));
     let view = v.view();
     assert_eq!(view.local.as_ref().unwrap().id, PlayerId(2));
@@ -185,8 +193,10 @@ fn a_run_opens_at_its_start_following_the_runner() {
     assert_eq!(v.elapsed(), 320);
     assert_eq!(v.total(), 1400);
     v.seek(0).unwrap();
+    v.finish_seek().unwrap();
     assert!(v.followed().is_none(), "nobody in the game yet");
     v.seek_home().unwrap();
+    v.finish_seek().unwrap();
     assert_eq!(v.tick(), 320);
 }
 
@@ -205,6 +215,7 @@ fn a_replay_that_plays_differently_stops_where_it_fails() {
     }
     let mut v = viewer(replay);
     v.seek(590).unwrap();
+    v.finish_seek().unwrap();
     let err = v.advance(1.0, u64::MAX).unwrap_err();
     assert!(
         matches!(err, ReplayError::Diverged { tick: 600, .. }),
@@ -216,10 +227,137 @@ fn a_replay_that_plays_differently_stops_where_it_fails() {
     // Never stepped past it, whatever is asked.
     assert_eq!(v.advance(1.0, u64::MAX).unwrap(), 0);
     v.seek_end().unwrap();
+    v.finish_seek().unwrap();
     assert_eq!(v.tick(), 599, "the last tick before the failure");
     v.seek(100).unwrap();
+    v.finish_seek().unwrap();
     assert_eq!(p1(&v), pos[100]);
     v.skip(100.0).unwrap();
+    v.finish_seek().unwrap();
     assert_eq!(v.tick(), 599);
     assert_eq!(p1(&v), pos[599]);
+}
+
+/// Where a seek in one go lands: the tick and the state's hash.
+fn one_go(replay: &Replay, tick: u64) -> (u64, u64) {
+    let mut p = Playback::new(&ledge_levels::default_level(), replay.clone()).unwrap();
+    p.seek(tick).unwrap();
+    (p.tick(), p.game().state_hash())
+}
+
+fn landed(v: &ReplayViewer) -> (u64, u64) {
+    (v.tick(), v.game().state_hash())
+}
+
+/// Frames until the seek under way is done, checking none steps more
+/// than its budget and none plays; the frames.
+fn frames_to_seek(v: &mut ReplayViewer) -> u32 {
+    let mut frames = 0;
+    while v.seeking().is_some() {
+        let before = v.tick();
+        assert_eq!(
+            v.advance(1.0 / 60.0, u64::MAX).unwrap(),
+            0,
+            "nothing played"
+        );
+        let after = v.tick();
+        assert!(
+            after <= before + SEEK_TICKS_PER_FRAME,
+            "{before} -> {after}"
+        );
+        if v.seeking().is_some() {
+            assert_eq!(v.alpha(), 1.0, "drawn as reached");
+        }
+        frames += 1;
+        assert!(frames < 1000);
+    }
+    frames
+}
+
+#[test]
+fn a_long_seek_is_spread_over_frames_and_lands_as_one_in_one_go() {
+    let (replay, game, _) = record(3000);
+    let mut v = viewer(replay.clone());
+    v.seek(2900).unwrap();
+    assert_eq!(
+        (v.seeking(), v.tick()),
+        (Some(2900), 0),
+        "nothing played yet"
+    );
+    let frames = frames_to_seek(&mut v);
+    assert_eq!(frames, 5, "2900 ticks, 600 a frame");
+    assert_eq!(landed(&v), one_go(&replay, 2900));
+    // Played on from there as before.
+    assert_eq!(v.advance(1.0, u64::MAX).unwrap(), 60);
+    assert_eq!(landed(&v), one_go(&replay, 2960));
+    // Back, then forward again: from the checkpoint at 2700, in a frame.
+    v.seek(10).unwrap();
+    assert_eq!(landed(&v), (0, one_go(&replay, 0).1), "the checkpoint at 0");
+    assert_eq!(frames_to_seek(&mut v), 1);
+    assert_eq!(landed(&v), one_go(&replay, 10));
+    v.seek(2850).unwrap();
+    assert_eq!(v.tick(), 2700, "the nearest checkpoint at once");
+    assert_eq!(frames_to_seek(&mut v), 1);
+    assert_eq!(landed(&v), one_go(&replay, 2850));
+    v.seek_end().unwrap();
+    frames_to_seek(&mut v);
+    assert_eq!(landed(&v), (3000, game.state_hash()));
+    assert!(v.at_end());
+    // A skip under way counts from where it goes (a fresh viewer: no
+    // checkpoints past the start yet).
+    let mut v = viewer(replay.clone());
+    v.skip(5.0).unwrap();
+    v.skip(5.0).unwrap();
+    assert_eq!(v.seeking(), Some(600));
+    frames_to_seek(&mut v);
+    assert_eq!(landed(&v), one_go(&replay, 600));
+}
+
+#[test]
+fn a_seek_under_way_gives_way_to_a_newer_one() {
+    let (replay, _, _) = record(3000);
+    let mut v = viewer(replay.clone());
+    v.seek(2900).unwrap();
+    v.advance(1.0 / 60.0, u64::MAX).unwrap();
+    assert_eq!(v.tick(), 600);
+    // Further on: on from where it stands.
+    v.seek(1000).unwrap();
+    assert_eq!((v.seeking(), v.tick()), (Some(1000), 600));
+    assert_eq!(frames_to_seek(&mut v), 1);
+    assert_eq!(landed(&v), one_go(&replay, 1000));
+    // Behind where it stands: from the checkpoint before.
+    v.seek(2900).unwrap();
+    v.advance(1.0 / 60.0, u64::MAX).unwrap();
+    v.advance(1.0 / 60.0, u64::MAX).unwrap();
+    assert_eq!(v.tick(), 2200);
+    v.seek(1250).unwrap();
+    assert_eq!(v.tick(), 1200);
+    assert_eq!(frames_to_seek(&mut v), 1);
+    assert_eq!(landed(&v), one_go(&replay, 1250));
+}
+
+#[test]
+fn a_seek_across_a_failure_stops_where_it_fails() {
+    let (mut replay, _, _) = record(1200);
+    let mut seen = 0;
+    for e in &mut replay.events {
+        if let Event::Hash(h) = e {
+            seen += 1;
+            if seen == 15 {
+                *h ^= 1;
+            }
+        }
+    }
+    let mut v = viewer(replay);
+    v.seek(1100).unwrap();
+    assert!(v.advance(1.0 / 60.0, u64::MAX).is_ok(), "up to 600");
+    let err = v.advance(1.0 / 60.0, u64::MAX).unwrap_err();
+    assert!(
+        matches!(err, ReplayError::Diverged { tick: 900, .. }),
+        "{err}"
+    );
+    assert_eq!((v.failed_at(), v.seeking()), (Some(900), None));
+    v.seek_end().unwrap();
+    frames_to_seek(&mut v);
+    assert_eq!(v.tick(), 899, "the last tick before the failure");
 }

@@ -52,7 +52,8 @@ pub fn time_text(ticks: u64, rate: u32) -> String {
 /// The replay panel's lines, as drawn.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ReplayLines {
-    /// `replay 0:12.50 / 3:25.75   1x   paused`.
+    /// `replay 0:12.50 / 3:25.75   1x   paused` (or `end`, or `seeking
+    /// to 3:25.75...` while a seek is under way).
     pub clock: String,
     /// What it is: `ada's run: 0:41.23, 1st   room-1 on Default`, or
     /// `match   room-1 on Default`.
@@ -67,7 +68,13 @@ impl ReplayLines {
     /// The lines for `viewer` as it stands.
     pub fn of(viewer: &ReplayViewer) -> ReplayLines {
         let rate = viewer.tick_rate();
-        let state = if viewer.at_end() && viewer.failure().is_none() {
+        let seeking = viewer.seeking().map(|to| {
+            let to = to.saturating_sub(viewer.start_tick());
+            format!("   seeking to {}...", time_text(to, rate))
+        });
+        let state = if let Some(seeking) = &seeking {
+            seeking.as_str()
+        } else if viewer.at_end() && viewer.failure().is_none() {
             "   end"
         } else if viewer.paused() {
             "   paused"

@@ -70,7 +70,11 @@ pub fn viewer(level: &Level, replay: Replay, opening: &Opening) -> Result<Replay
         if !(start..=end).contains(&tick) {
             return Err(Refused::SeekOutside { tick, start, end });
         }
-        viewer.seek(tick).map_err(Refused::NotPlayed)?;
+        // At once: it opens there (before the first frame).
+        viewer
+            .seek(tick)
+            .and_then(|()| viewer.finish_seek())
+            .map_err(Refused::NotPlayed)?;
     }
     if let Some(speed) = opening.speed {
         viewer.set_speed(speed);

@@ -12,7 +12,9 @@
 //! (at the end it plays again), `-`/`+` (or `[`/`]`) slower and faster,
 //! Left/Right 5 s back and forward, Home/End to where it opened and to
 //! the end, Tab follows the next player (Shift+Tab the one before), F a
-//! free camera (WASD moves it).
+//! free camera (WASD moves it). A long seek goes on over the next frames
+//! ([`ledge_client::replay::viewer::SEEK_TICKS_PER_FRAME`] ticks each,
+//! drawn as it goes, the HUD saying `seeking to m:ss.cc...`).
 
 #[cfg(not(target_arch = "wasm32"))]
 use std::path::PathBuf;
@@ -282,15 +284,21 @@ impl ReplayLoop {
         }
     }
 
-    /// Steps the ticks due (at most those `--exit-after-ticks` leaves).
+    /// Steps the ticks due (at most those `--exit-after-ticks` leaves),
+    /// or a seek under way on by its budget of ticks (then what changed
+    /// is not sounded: the cues start afresh).
     fn play(&mut self, dt: f32) {
         let remaining = self
             .watch
             .exit_after
             .map_or(u64::MAX, |n| n.saturating_sub(self.played));
+        let seeking = self.watch.viewer.seeking().is_some();
         match self.watch.viewer.advance(f64::from(dt), remaining) {
             Ok(n) => self.played += n,
             Err(e) => self.failure(&e),
+        }
+        if seeking {
+            self.afresh();
         }
     }
 
