@@ -87,7 +87,7 @@ impl Ghost {
 /// and 4 to 5 µs with the 8 players of a full room in a release build on
 /// a 2-core VM (`cargo run --release -p ledge-client --example
 /// ghost_build -- 8 29`: a 29-minute run among 8 players took 484 ms in
-/// one go, one frame; 300 ticks per frame, 1.8 ms at worst over 350
+/// one go, one frame; 300 ticks per frame, a median of 1.1 ms over 350
 /// frames). 300 ticks keeps a frame's share near 1 ms (a fraction of a
 /// 60 Hz frame's 16.7 ms, even at a few times that cost in a browser's
 /// wasm); a 10 s record is built in two to four frames, a 30-minute run

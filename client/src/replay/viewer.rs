@@ -50,7 +50,8 @@ pub const MAX_DUE_TICKS: f64 = 240.0;
 /// Most ticks a seek steps per frame ([`ReplayViewer::advance`]). A tick
 /// of a match replay costs about 4 µs with 8 players in a release build
 /// (the ghosts' measure, [`crate::ghost::GHOST_TICKS_PER_FRAME`]): 600
-/// ticks (10 s of play) is about 2.5 ms of a frame, so a 5 s skip lands
+/// ticks (10 s of play) is about 2 ms of a frame (`cargo run --release -p
+/// ledge-client --example replay_seek`), so a 5 s skip lands
 /// in the frame it was asked in, and the End of a 30-minute match played
 /// for the first time (108,000 ticks) in 180 frames, 3 s, each frame
 /// drawn.
