@@ -1022,30 +1022,14 @@ pub fn load_str(
                     })
                 })
                 .collect::<Result<Vec<_>, _>>()?,
-            LayerContent::Grid { key, values } if wanted => {
-                // Values the mapping does not know are solid (OGMO's own
-                // grids use "0" for empty and "1" for solid), said once per
-                // value.
-                let mut unknown: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
-                let tiles = values
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| {
-                        options.mapping.grid_tile(v).unwrap_or_else(|| {
-                            unknown.entry(v).or_insert((i, 0)).1 += 1;
-                            Tile::Solid
-                        })
-                    })
-                    .collect();
-                for (v, (first, n)) in unknown {
-                    warnings.push(format!(
-                        "{file}: {}: grid value {v:?} ({n} cells) of layer {:?} is read as solid (ledge reads \"0\" as empty, \"1\" solid, \"2\" one-way, \"3\" hazard, \"4\"-\"9\" slopes, or tile kind names)",
-                        cell_field(&l.field, key, first, l.cells.0),
-                        l.name
-                    ));
-                }
-                tiles
-            }
+            LayerContent::Grid { key, values } if wanted => grid_tiles(
+                file,
+                (&l.field, &l.name, l.cells.0),
+                key,
+                &values,
+                options,
+                &mut warnings,
+            ),
             LayerContent::Entities(es) => {
                 entities.extend(es);
                 continue;
@@ -1075,6 +1059,39 @@ pub fn load_str(
     loaded.warnings.splice(0..0, warnings);
     loaded.art = art;
     Ok(loaded)
+}
+
+/// A grid layer's tiles: values the mapping does not know are solid
+/// (OGMO's own grids use "0" for empty and "1" for solid), said once per
+/// value.
+/// `layer`: its field, name and width in cells.
+fn grid_tiles(
+    file: &str,
+    (field, name, width): (&str, &str, u32),
+    key: &str,
+    values: &[String],
+    options: &LoadOptions,
+    warnings: &mut Vec<String>,
+) -> Vec<Tile> {
+    let mut unknown: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
+    let tiles = values
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            options.mapping.grid_tile(v).unwrap_or_else(|| {
+                unknown.entry(v).or_insert((i, 0)).1 += 1;
+                Tile::Solid
+            })
+        })
+        .collect();
+    for (v, (first, n)) in unknown {
+        warnings.push(format!(
+            "{file}: {}: grid value {v:?} ({n} cells) of layer {:?} is read as solid (ledge reads \"0\" as empty, \"1\" solid, \"2\" one-way, \"3\" hazard, \"4\"-\"9\" slopes, or tile kind names)",
+            cell_field(field, key, first, width),
+            name
+        ));
+    }
+    tiles
 }
 
 /// A tile layer made solid by the fallback: its grid index, tileset and

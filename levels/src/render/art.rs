@@ -11,7 +11,10 @@ use tiny_skia::{FilterQuality, Paint, Pattern, Pixmap, Rect, SpreadMode, Transfo
 use crate::art::{ArtContent, LevelArt, TileGrid, TileSource};
 
 use super::canvas::Canvas;
-use super::MAX_DECODED_IMAGE_PIXELS;
+
+/// Most pixels of the level's images decoded for one picture (32 Mi);
+/// images past it are not drawn (said in `Rendered::notes`).
+pub const MAX_DECODED_IMAGE_PIXELS: u64 = 1 << 25;
 
 /// The art's images decoded (`None`: it did not decode, or was left out
 /// past [`MAX_DECODED_IMAGE_PIXELS`]; said in `notes`).

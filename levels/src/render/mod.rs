@@ -29,9 +29,7 @@ pub const MAX_RENDER_SIDE: u32 = 16384;
 pub const MAX_RENDER_PIXELS: u64 = 1 << 25;
 /// Largest scale (picture pixels per world pixel).
 pub const MAX_RENDER_SCALE: f32 = 16.0;
-/// Most pixels of the level's images decoded for one picture (32 Mi);
-/// images past it are not drawn (said in [`Rendered::notes`]).
-pub const MAX_DECODED_IMAGE_PIXELS: u64 = 1 << 25;
+pub use art::MAX_DECODED_IMAGE_PIXELS;
 
 /// How to draw.
 #[derive(Debug, Clone, Copy, PartialEq)]

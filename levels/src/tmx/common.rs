@@ -8,8 +8,10 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
+use crate::collision::Prop;
 use crate::entities::is_entity_name;
 use crate::LoadOptions;
+use ::tiled::PropertyValue;
 
 /// The name an object goes by: its class (`type` before Tiled 1.9), else
 /// its name, also when the class is no ledge entity (after the settings'
@@ -36,7 +38,7 @@ pub(crate) fn is_drawn_entity(options: &LoadOptions, layer: &str, o: &::tiled::O
         return crate::entities::moves_or_vanishes(name);
     }
     let marked = !matches!(
-        crate::collision::tile_of_props(super::props(&o.properties), ""),
+        crate::collision::tile_of_props(props(&o.properties), ""),
         Ok(None)
     );
     if marked || options.decoration_layers.iter().any(|n| n == layer) {
@@ -67,4 +69,21 @@ pub(crate) fn short_data(fl: &::tiled::FiniteTileLayer<'_>) -> bool {
             fl.get_tile_data(w as i32 - 1, h as i32 - 1).is_some()
         }))
         .is_err()
+}
+
+/// A property as `crate::collision` reads it.
+pub(super) fn prop(v: &PropertyValue) -> Prop<'_> {
+    match v {
+        PropertyValue::BoolValue(b) => Prop::Bool(*b),
+        PropertyValue::StringValue(s) => Prop::Text(s),
+        _ => Prop::Other,
+    }
+}
+
+/// A Tiled property list as the collision rules read it.
+pub(super) fn props(p: &::tiled::Properties) -> impl Iterator<Item = (&str, Prop<'_>)> {
+    // Sorted, so the outcome does not depend on the map's hash order.
+    let mut v: Vec<_> = p.iter().map(|(k, v)| (k.as_str(), prop(v))).collect();
+    v.sort_by(|a, b| a.0.cmp(b.0));
+    v.into_iter()
 }
