@@ -877,3 +877,23 @@ impl Cdp {
         }
     }
 }
+
+/// Builds the page into `web/dist` with `scripts/build-web` (a no-op when
+/// it is up to date: CI builds it before the tests) and returns that
+/// directory; fails the test, with the script's output, if it does not
+/// build.
+pub fn build_web() -> PathBuf {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = Command::new("bash")
+        .arg(root.join("scripts/build-web"))
+        .current_dir(&root)
+        .output()
+        .expect("run scripts/build-web");
+    assert!(
+        out.status.success(),
+        "scripts/build-web failed:\n{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    root.join("web/dist")
+}

@@ -163,14 +163,7 @@ impl Playback {
                 .iter()
                 .rposition(|c| c.state.tick <= tick)
                 .unwrap_or(0);
-            let c = &self.checkpoints[i];
-            self.game
-                .restore(&c.state)
-                .map_err(|e| ReplayError::Unplayable {
-                    tick: c.state.tick,
-                    detail: e.to_string(),
-                })?;
-            self.cursor = c.cursor.clone();
+            self.restore_checkpoint(i)?;
         }
         while self.game.tick() < tick && self.step()? {}
         Ok(())
@@ -189,15 +182,21 @@ impl Playback {
         };
         let at = self.checkpoints[i].state.tick;
         if tick < now || at > now {
-            let c = &self.checkpoints[i];
-            self.game
-                .restore(&c.state)
-                .map_err(|e| ReplayError::Unplayable {
-                    tick: c.state.tick,
-                    detail: e.to_string(),
-                })?;
-            self.cursor = c.cursor.clone();
+            self.restore_checkpoint(i)?;
         }
+        Ok(())
+    }
+
+    /// Puts the game and the event cursor back to checkpoint `i`.
+    fn restore_checkpoint(&mut self, i: usize) -> Result<(), ReplayError> {
+        let c = &self.checkpoints[i];
+        self.game
+            .restore(&c.state)
+            .map_err(|e| ReplayError::Unplayable {
+                tick: c.state.tick,
+                detail: e.to_string(),
+            })?;
+        self.cursor = c.cursor.clone();
         Ok(())
     }
 

@@ -20,8 +20,6 @@
 
 use std::collections::BTreeMap;
 use std::net::SocketAddr;
-use std::path::PathBuf;
-use std::process::Command;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -29,27 +27,9 @@ use ledge_client::{JoinOptions, SessionEvent};
 use ledge_server::config::WebConfig;
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::protocol::PlayerId;
-use ledge_tests::browser::{skip_without_chromium, Browser, Key, Options, Page};
+use ledge_tests::browser::{build_web, skip_without_chromium, Browser, Key, Options, Page};
 use ledge_tests::TestServer;
 use serde_json::Value;
-
-/// Builds the page into `web/dist` (a no-op when it is up to date: CI
-/// builds it before the tests) and returns that directory.
-fn build_web() -> PathBuf {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let out = Command::new("bash")
-        .arg(root.join("scripts/build-web"))
-        .current_dir(&root)
-        .output()
-        .expect("run scripts/build-web");
-    assert!(
-        out.status.success(),
-        "scripts/build-web failed:\n{}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    root.join("web/dist")
-}
 
 /// A server on its own runtime serving the freshly built page on a web
 /// port (loopback, WebTransport on), after `adjust` changed its settings.

@@ -19,7 +19,6 @@
 
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 use ledge_levels::{default_level, LevelBundle};
@@ -27,30 +26,12 @@ use ledge_server::config::WebConfig;
 use ledge_server::replays::ReplaysTarget;
 use ledge_shared::fixed::UNITS_PER_PX;
 use ledge_shared::replay::{self, Event, Playback, ReplayError, ReplayKind};
-use ledge_tests::browser::{skip_without_chromium, Browser, Key, Page};
+use ledge_tests::browser::{build_web, skip_without_chromium, Browser, Key, Page};
 use ledge_tests::web::http_get_from;
 use ledge_tests::TestServer;
 use serde_json::Value;
 
 use crate::records::race;
-
-/// Builds the page into `web/dist` (a no-op when it is up to date) and
-/// returns that directory.
-fn build_web() -> PathBuf {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let out = Command::new("bash")
-        .arg(root.join("scripts/build-web"))
-        .current_dir(&root)
-        .output()
-        .expect("run scripts/build-web");
-    assert!(
-        out.status.success(),
-        "scripts/build-web failed:\n{}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    root.join("web/dist")
-}
 
 /// A server on its own runtime serving the freshly built page on a web
 /// port (loopback, WebSocket only: the replay needs no game connection),
